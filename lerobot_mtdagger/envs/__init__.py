@@ -1,0 +1,1 @@
+"""Task suites (MetaWorld, drawers) with state, RGB and point-cloud observations."""

@@ -1,0 +1,1 @@
+"""The ``Expert`` protocol and the experts of each task suite."""

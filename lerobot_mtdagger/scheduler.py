@@ -1,0 +1,821 @@
+"""Performance-aware scheduling of expert demonstrations across tasks.
+
+Implements the paper's Method section "Performance-Aware Scheduling via Adaptive Filtering and
+Allocation", the appendix "Two important techniques of Performance-aware Scheduling" and the
+softmax allocation of "Implementation details":
+
+1. Measure, per task, the raw success rate of the previous round's DAgger rollouts (Task Need) or
+   the drop of the per-task imitation loss during the round's training (Performance Gain).
+2. Smooth the success rates with one scalar Kalman filter per task (``KalmanSuccessEstimator``):
+   predict ``P += Q``, then update with the adaptive measurement noise ``R = R0 / (n + 1)``.
+3. Rank-normalise the chosen metric to [0, 1] (``rank_normalize``).
+4. Turn the scores into a budget split with a temperature softmax, give every task at least
+   ``n_min`` episodes and repair the total to exactly the budget (``allocate``).
+
+Every allocation returns an ``Allocation`` record with the measurements, the Kalman state, the
+metric, the scores and the probabilities it used; ``recompute_allocation`` rebuilds an allocation
+from such a record alone, so a stored round can be audited.
+
+This module is pure numpy (plus draccus for the command-line configs): no torch, no environment.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import draccus
+import numpy as np
+
+METHODS: tuple[str, ...] = ("uniform", "need", "need_raw", "gain")
+"""Scheduling methods known to ``make_scheduler``."""
+
+STATE_FORMAT_VERSION = 1
+
+ArrayLike = Sequence[float] | np.ndarray
+
+
+# --------------------------------------------------------------------------------------------------
+# Input checks
+# --------------------------------------------------------------------------------------------------
+
+
+def _as_vector(values: ArrayLike, name: str, num_tasks: int | None = None) -> np.ndarray:
+    """Converts ``values`` to a 1-D float64 array, checking its length.
+
+    Args:
+        values: One value per task.
+        name: The argument's name, for error messages.
+        num_tasks: The required length, or None to only require a non-empty vector.
+
+    Returns:
+        A new float64 array of shape (num_tasks,).
+
+    Raises:
+        ValueError: If ``values`` is not 1-D, is empty, or has the wrong length.
+    """
+    array = np.array(values, dtype=np.float64, copy=True)
+    if array.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D sequence with one value per task, got shape {array.shape}.")
+    if array.size == 0:
+        raise ValueError(f"{name} is empty: give one value per task.")
+    if num_tasks is not None and array.size != num_tasks:
+        raise ValueError(f"{name} has {array.size} values but the scheduler has num_tasks={num_tasks}.")
+    return array
+
+
+def _require_finite(array: np.ndarray, name: str) -> None:
+    """Raises a ValueError naming the first non-finite entry of ``array``."""
+    bad = np.flatnonzero(~np.isfinite(array))
+    if bad.size:
+        index = int(bad[0])
+        raise ValueError(
+            f"{name}[{index}] = {array[index]} is not finite; every task needs a finite value "
+            f"({bad.size} bad value(s) at indices {bad[:10].tolist()})."
+        )
+
+
+def _require_integer(value: Any, name: str, minimum: int) -> int:
+    """Returns ``value`` as an int, raising a ValueError unless it is an integer >= ``minimum``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} must be an integer, got {value!r} ({type(value).__name__}).")
+    if value < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {value}.")
+    return int(value)
+
+
+def _require_positive(value: float, name: str) -> float:
+    """Returns ``value`` as a float, raising a ValueError unless it is finite and > 0."""
+    value = float(value)
+    if not math.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} must be a finite number > 0, got {value}.")
+    return value
+
+
+# --------------------------------------------------------------------------------------------------
+# Kalman filter of success probabilities
+# --------------------------------------------------------------------------------------------------
+
+
+class KalmanSuccessEstimator:
+    """One scalar Kalman filter per task over the policy's success probability.
+
+    The state is assumed constant between rounds. Each round:
+
+    - predict: ``P <- P + Q`` (``p`` unchanged);
+    - update, for each task with ``n > 0`` rollouts and measured success rate ``s``:
+      ``R = R0 / (n + 1)``, ``K = P / (P + R)``, ``p <- p + K (s - p)``, ``P <- (1 - K) P``.
+
+    A task with no rollouts this round has no measurement and is only predicted.
+
+    Attributes:
+        p: Estimated success probability per task, shape (num_tasks,).
+        P: Variance of the estimate per task, shape (num_tasks,).
+    """
+
+    def __init__(
+        self, num_tasks: int, p0: float = 0.5, P0: float = 0.25, Q: float = 0.03, R0: float = 0.5
+    ) -> None:
+        """Initialises every task at ``(p0, P0)``.
+
+        Args:
+            num_tasks: Number of tasks (>= 1).
+            p0: Initial success estimate, in [0, 1].
+            P0: Initial variance (>= 0).
+            Q: Process noise added at every predict step (>= 0).
+            R0: Measurement noise scale (> 0); a round with n rollouts has noise R0 / (n + 1).
+
+        Raises:
+            ValueError: On a bad hyperparameter.
+        """
+        self.num_tasks = _require_integer(num_tasks, "num_tasks", 1)
+        if not (math.isfinite(p0) and 0.0 <= p0 <= 1.0):
+            raise ValueError(f"p0 must be a success probability in [0, 1], got {p0}.")
+        for name, value in (("P0", P0), ("Q", Q)):
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ValueError(f"{name} must be a finite variance >= 0, got {value}.")
+        self.p0, self.P0, self.Q = float(p0), float(P0), float(Q)
+        self.R0 = _require_positive(R0, "R0")
+        self.p = np.full(self.num_tasks, self.p0)
+        self.P = np.full(self.num_tasks, self.P0)
+
+    def update(self, success_rate: ArrayLike, episodes: ArrayLike) -> None:
+        """Runs one predict and one update step per task.
+
+        Args:
+            success_rate: Measured success rate per task in [0, 1]; ignored (may be NaN) where
+                ``episodes`` is 0.
+            episodes: Number of rollouts behind each measurement (integers >= 0).
+
+        Raises:
+            ValueError: On mismatched lengths, negative or fractional episode counts, or a
+                success rate that is NaN or outside [0, 1] for a task with rollouts.
+        """
+        rate, counts = check_measurements(success_rate, episodes, self.num_tasks)
+        measured = counts > 0
+        predicted_P = self.P + self.Q
+        noise = self.R0 / (counts + 1.0)
+        gain = predicted_P / (predicted_P + noise)
+        self.p = np.where(measured, self.p + gain * (np.where(measured, rate, 0.0) - self.p), self.p)
+        self.P = np.where(measured, (1.0 - gain) * predicted_P, predicted_P)
+
+    def snapshot(self) -> dict[str, list[float]]:
+        """Returns the current estimate as a JSON-ready ``{"p": [...], "P": [...]}``."""
+        return {"p": self.p.tolist(), "P": self.P.tolist()}
+
+    def load_snapshot(self, snapshot: Mapping[str, Sequence[float]]) -> None:
+        """Restores an estimate written by ``snapshot``.
+
+        Raises:
+            ValueError: If the snapshot has the wrong length or non-finite values.
+        """
+        p = _as_vector(snapshot["p"], "kalman p", self.num_tasks)
+        P = _as_vector(snapshot["P"], "kalman P", self.num_tasks)
+        _require_finite(p, "kalman p")
+        _require_finite(P, "kalman P")
+        self.p, self.P = p, P
+
+
+def check_measurements(
+    success_rate: ArrayLike, episodes: ArrayLike, num_tasks: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Validates one round of per-task success measurements.
+
+    Args:
+        success_rate: Measured success rate per task; NaN is allowed only where episodes is 0.
+        episodes: Rollouts per task, integers >= 0.
+        num_tasks: The required length of both.
+
+    Returns:
+        ``(success_rate, episodes)`` as float64 arrays.
+
+    Raises:
+        ValueError: With the offending task index and value.
+    """
+    rate = _as_vector(success_rate, "success_rate", num_tasks)
+    counts = _as_vector(episodes, "episodes", num_tasks)
+    _require_finite(counts, "episodes")
+    if np.any(counts < 0) or np.any(counts != np.round(counts)):
+        index = int(np.flatnonzero((counts < 0) | (counts != np.round(counts)))[0])
+        raise ValueError(f"episodes[{index}] = {counts[index]} is not a non-negative integer count.")
+    measured = counts > 0
+    bad = measured & ~(np.isfinite(rate) & (rate >= 0.0) & (rate <= 1.0))
+    if np.any(bad):
+        index = int(np.flatnonzero(bad)[0])
+        raise ValueError(
+            f"success_rate[{index}] = {rate[index]} is not a rate in [0, 1] although the task had "
+            f"{int(counts[index])} rollout(s)."
+        )
+    return rate, counts
+
+
+# --------------------------------------------------------------------------------------------------
+# Rank normalisation and softmax allocation
+# --------------------------------------------------------------------------------------------------
+
+
+def rank_normalize(values: ArrayLike) -> np.ndarray:
+    """Rank-normalises a metric to [0, 1]: ``(rank - 1) / (N - 1)``.
+
+    Rank 1 is the lowest value; tied values share their average rank; a single task gets 0.
+    Costs O(N log N).
+
+    Args:
+        values: One finite metric value per task.
+
+    Returns:
+        The normalised scores, shape (N,).
+
+    Raises:
+        ValueError: If ``values`` is empty, not 1-D or holds a NaN or infinity.
+    """
+    array = _as_vector(values, "values")
+    _require_finite(array, "values")
+    n = array.size
+    if n == 1:
+        return np.zeros(1)
+    order = np.argsort(array, kind="stable")
+    sorted_values = array[order]
+    # Start index of each run of equal values in sorted order.
+    run_starts = np.flatnonzero(np.r_[True, sorted_values[1:] != sorted_values[:-1]])
+    run_ends = np.r_[run_starts[1:], n]  # exclusive
+    # 1-based average rank of a run covering positions [start, end): (start + 1 + end) / 2.
+    run_ranks = (run_starts + 1 + run_ends) / 2.0
+    ranks = np.empty(n)
+    ranks[order] = np.repeat(run_ranks, run_ends - run_starts)
+    return (ranks - 1.0) / (n - 1.0)
+
+
+def softmax(scores: ArrayLike, temperature: float) -> np.ndarray:
+    """Returns ``exp(score / T) / sum(exp(score / T))``, computed stably.
+
+    Raises:
+        ValueError: If a score is not finite or ``temperature`` is not a finite number > 0.
+    """
+    temperature = _require_positive(temperature, "temperature")
+    array = _as_vector(scores, "scores")
+    _require_finite(array, "scores")
+    logits = array / temperature
+    weights = np.exp(logits - logits.max())
+    return weights / weights.sum()
+
+
+def allocate(scores: ArrayLike, budget: int, temperature: float, n_min: int) -> np.ndarray:
+    """Splits ``budget`` episodes across tasks by ``softmax(scores / T)``.
+
+    The paper writes ``n_i = max(n_min, rho_i * B)`` "with minor adjustments" so the total is about
+    B, and says the floor applies "for tasks with non-zero scores". We give EVERY task at least
+    ``n_min`` (a task at the lowest rank has score 0 and would otherwise be starved) and make the
+    total exactly B:
+
+    1. Water-filling: the lowest-probability tasks whose share would fall below ``n_min`` get
+       exactly ``n_min``; the rest of the budget is split among the others in proportion to their
+       probabilities. These floored tasks are always a prefix of the tasks sorted by probability.
+    2. Largest remainder: the others get the floor of their share, and the units left over go to
+       the largest fractional parts (ties: higher probability first, then lower task index).
+
+    Guarantees: integers >= n_min summing to ``budget``; a task with a higher score never gets
+    fewer episodes; where no floor binds, every task is within 1 of ``softmax * budget``.
+    Costs O(N log N).
+
+    Args:
+        scores: One finite priority score per task (higher = more episodes).
+        budget: Episodes to hand out this round, an integer >= n_min * num_tasks.
+        temperature: Softmax temperature T > 0 (lower = sharper).
+        n_min: Minimum episodes per task, an integer >= 0.
+
+    Returns:
+        Episodes per task, int64 array of shape (num_tasks,).
+
+    Raises:
+        ValueError: On a bad argument, or if the budget cannot give every task ``n_min``.
+    """
+    probability = softmax(scores, temperature)
+    return allocate_probabilities(probability, budget, n_min, np.asarray(scores, dtype=np.float64))
+
+
+def allocate_probabilities(
+    probability: np.ndarray, budget: int, n_min: int, scores: np.ndarray | None = None
+) -> np.ndarray:
+    """Turns allocation probabilities into integer episode counts (see ``allocate``).
+
+    Args:
+        probability: Non-negative probabilities summing to 1, shape (num_tasks,).
+        budget: Episodes to hand out, an integer >= n_min * num_tasks.
+        n_min: Minimum episodes per task, an integer >= 0.
+        scores: The scores behind ``probability``; they break ties between probabilities that are
+            equal in floating point although their scores differ (tiny score gaps), so that a higher
+            score never gets fewer episodes. None: no tie-break beyond the task index.
+
+    Returns:
+        Episodes per task, int64 array of shape (num_tasks,).
+
+    Raises:
+        ValueError: On a bad budget or n_min.
+    """
+    budget = _require_integer(budget, "budget", 0)
+    n_min = _require_integer(n_min, "n_min", 0)
+    num_tasks = probability.size
+    if budget < n_min * num_tasks:
+        raise ValueError(
+            f"budget={budget} is smaller than n_min * num_tasks = {n_min} * {num_tasks} = "
+            f"{n_min * num_tasks}: raise the budget to at least {n_min * num_tasks} or lower n_min."
+        )
+    tie_break = np.zeros(num_tasks) if scores is None else scores
+    ascending = np.lexsort((tie_break, probability))
+    sorted_probability = probability[ascending]
+    num_floored = _num_floored_tasks(sorted_probability, budget, n_min)
+
+    counts = np.full(num_tasks, n_min, dtype=np.int64)
+    free = ascending[num_floored:]
+    free_budget = budget - n_min * num_floored
+    share = probability[free] / probability[free].sum() * free_budget
+    base = np.floor(share).astype(np.int64)
+    leftover = free_budget - int(base.sum())
+    # Hand the leftover units to the largest remainders; ties go to higher probability, then to
+    # higher score, then to the lower task index.
+    priority = np.lexsort((free, -tie_break[free], -probability[free], -(share - base)))
+    base[priority[:leftover]] += 1
+    counts[free] = base
+    return counts
+
+
+def _num_floored_tasks(sorted_probability: np.ndarray, budget: int, n_min: int) -> int:
+    """Number of lowest-probability tasks pinned to ``n_min`` by water-filling.
+
+    With the k lowest tasks pinned, the others share ``budget - k * n_min`` in proportion to their
+    probability. Pinning a task whose share is below ``n_min`` only shrinks the others' shares, so
+    the answer is the smallest k at which the lowest unpinned task's share reaches ``n_min``.
+
+    Args:
+        sorted_probability: Probabilities in ascending order, shape (N,).
+        budget: Total episodes (>= n_min * N).
+        n_min: Minimum per task.
+
+    Returns:
+        k in [0, N - 1].
+    """
+    n = sorted_probability.size
+    if n_min == 0:
+        return 0
+    k = np.arange(n)
+    # Probability mass of tasks k..N-1, summed from the largest for accuracy.
+    remaining_mass = np.cumsum(sorted_probability[::-1])[::-1]
+    lowest_share = sorted_probability * (budget - n_min * k) / remaining_mass
+    fits = lowest_share >= n_min * (1.0 - 1e-12)
+    fits[-1] = True  # the largest task always gets budget - (N - 1) * n_min >= n_min
+    return int(np.argmax(fits))
+
+
+# --------------------------------------------------------------------------------------------------
+# Schedulers
+# --------------------------------------------------------------------------------------------------
+
+
+@dataclass
+class SchedulerConfig(draccus.ChoiceRegistry):
+    """Hyperparameters of a scheduler; select the method with ``--scheduler.type=<method>``.
+
+    Defaults are the paper's (hyperparameter table, MetaWorld column).
+
+    Attributes:
+        temperature: Softmax temperature T > 0.
+        n_min: Minimum episodes per task per round (1 for MetaWorld, 5 for the drawers).
+        p0: Initial Kalman success estimate.
+        P0: Initial Kalman variance.
+        Q: Kalman process noise per round.
+        R0: Kalman measurement noise scale; a round of n rollouts has noise R0 / (n + 1).
+    """
+
+    temperature: float = 0.5
+    n_min: int = 1
+    p0: float = 0.5
+    P0: float = 0.25
+    Q: float = 0.03
+    R0: float = 0.5
+
+    def __post_init__(self) -> None:
+        _require_positive(self.temperature, "scheduler.temperature")
+        _require_integer(self.n_min, "scheduler.n_min", 0)
+        # The Kalman filter checks p0, P0, Q and R0 with named errors.
+        KalmanSuccessEstimator(1, p0=self.p0, P0=self.P0, Q=self.Q, R0=self.R0)
+
+    @classmethod
+    def default_choice_name(cls) -> str:
+        """Method used when the command line sets scheduler options but no ``type``: task need."""
+        return "need"
+
+    @property
+    def type(self) -> str:
+        """The method name this config is registered under."""
+        return self.get_choice_name(self.__class__)
+
+    def hyperparameters(self) -> dict[str, float | int]:
+        """The fields as a plain dict (``make_scheduler`` keyword arguments)."""
+        return dataclasses.asdict(self)
+
+
+@SchedulerConfig.register_subclass("uniform")
+@dataclass
+class UniformSchedulerConfig(SchedulerConfig):
+    """Uniform DAgger: the same number of episodes for every task."""
+
+
+@SchedulerConfig.register_subclass("need")
+@dataclass
+class NeedSchedulerConfig(SchedulerConfig):
+    """MTDAgger-TN: task need ``1 - p_hat`` with Kalman-filtered success ``p_hat``."""
+
+
+@SchedulerConfig.register_subclass("need_raw")
+@dataclass
+class NeedRawSchedulerConfig(SchedulerConfig):
+    """Task need on the raw measured success rate (the paper's "TN without Kalman filter")."""
+
+
+@SchedulerConfig.register_subclass("gain")
+@dataclass
+class GainSchedulerConfig(SchedulerConfig):
+    """MTDAgger-PG: performance gain ``max(0, L_start - L_end)`` per task."""
+
+
+@dataclass
+class Allocation:
+    """One allocation and everything it was computed from (JSON-ready through ``to_dict``).
+
+    List fields are aligned with the experiment's task order. Measurement fields are None when the
+    scheduler has not received that measurement yet (for example before the first policy rollouts).
+
+    Attributes:
+        method: Scheduling method.
+        budget: Episodes handed out.
+        temperature: Softmax temperature.
+        n_min: Minimum episodes per task.
+        success_rate: Last measured raw success rate per task (NaN where a task had no rollouts).
+        episodes: Rollouts behind ``success_rate``.
+        gain: Last performance gain per task.
+        raw_success: Latest raw success rate per task over all updates (``p0`` for a task never
+            measured); the ``need_raw`` metric is ``1 - raw_success``.
+        kalman_prior: Kalman state before the last success update ({"p", "P"}).
+        kalman_posterior: Kalman state after it (the state used by ``need``).
+        metric: The method's metric per task (need, gain, or zeros for uniform).
+        score: Rank-normalised metric.
+        probability: ``softmax(score / T)``.
+        episodes_per_task: The allocation.
+        kalman: Hyperparameters of the Kalman filter ({"p0", "P0", "Q", "R0"}).
+        notes: Human-readable remarks (for example "no rollouts measured yet: the prior decides").
+    """
+
+    method: str
+    budget: int
+    temperature: float
+    n_min: int
+    success_rate: list[float] | None
+    episodes: list[int] | None
+    gain: list[float] | None
+    raw_success: list[float]
+    kalman_prior: dict[str, list[float]]
+    kalman_posterior: dict[str, list[float]]
+    metric: list[float]
+    score: list[float]
+    probability: list[float]
+    episodes_per_task: list[int]
+    kalman: dict[str, float]
+    notes: list[str] = dataclasses.field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Returns the record as JSON-ready builtins (NaN success rates become None)."""
+        record = dataclasses.asdict(self)
+        if record["success_rate"] is not None:
+            record["success_rate"] = [None if math.isnan(v) else v for v in record["success_rate"]]
+        return record
+
+    @classmethod
+    def from_dict(cls, record: Mapping[str, Any]) -> Allocation:
+        """Rebuilds an ``Allocation`` from ``to_dict`` output (extra keys are ignored).
+
+        Raises:
+            ValueError: If a required key is missing.
+        """
+        names = [f.name for f in dataclasses.fields(cls)]
+        missing = [n for n in names if n not in record and n != "notes"]
+        if missing:
+            raise ValueError(f"Allocation record is missing keys {missing}.")
+        values = {n: record[n] for n in names if n in record}
+        if values["success_rate"] is not None:
+            values["success_rate"] = [math.nan if v is None else float(v) for v in values["success_rate"]]
+        return cls(**values)
+
+
+def _metric_uniform(scheduler: Scheduler) -> np.ndarray:
+    return np.zeros(scheduler.num_tasks)
+
+
+def _metric_need(scheduler: Scheduler) -> np.ndarray:
+    return 1.0 - scheduler.kalman.p
+
+
+def _metric_need_raw(scheduler: Scheduler) -> np.ndarray:
+    return 1.0 - scheduler.raw_success
+
+
+def _metric_gain(scheduler: Scheduler) -> np.ndarray:
+    return scheduler.gain.copy()
+
+
+_METRICS: dict[str, Callable[[Scheduler], np.ndarray]] = {
+    "uniform": _metric_uniform,
+    "need": _metric_need,
+    "need_raw": _metric_need_raw,
+    "gain": _metric_gain,
+}
+
+
+class Scheduler:
+    """Allocates each DAgger round's demonstration budget across tasks.
+
+    Every method tracks the same measurements (so every record can show them); only the metric it
+    ranks differs:
+
+    - ``uniform``: zeros, so every task gets ``B / N`` (leftover units to the lowest task indices).
+    - ``need``: ``1 - p_hat`` with ``p_hat`` the Kalman-filtered success rate.
+    - ``need_raw``: ``1 - s`` with ``s`` the last raw measured success rate of the task (``p0`` for a
+      task never measured).
+    - ``gain``: ``max(0, L_start - L_end)`` from the last training round (0 before the first).
+
+    Before any measurement every metric is constant across tasks, so the first allocation is
+    uniform: the prior decides.
+    """
+
+    def __init__(self, method: str, num_tasks: int, config: SchedulerConfig | None = None) -> None:
+        """Creates a scheduler.
+
+        Args:
+            method: One of ``METHODS``.
+            num_tasks: Number of tasks (>= 1).
+            config: Hyperparameters; the paper's defaults when None.
+
+        Raises:
+            ValueError: On an unknown method or a bad hyperparameter.
+        """
+        if method not in _METRICS:
+            raise ValueError(f"Unknown scheduling method {method!r}; known methods: {list(METHODS)}.")
+        self.method = method
+        self.config = config if config is not None else SchedulerConfig()
+        self.kalman = KalmanSuccessEstimator(
+            num_tasks, p0=self.config.p0, P0=self.config.P0, Q=self.config.Q, R0=self.config.R0
+        )
+        self.num_tasks = self.kalman.num_tasks
+        self.raw_success = np.full(self.num_tasks, self.config.p0)
+        self.gain = np.zeros(self.num_tasks)
+        self.last_success_rate: np.ndarray | None = None
+        self.last_episodes: np.ndarray | None = None
+        self.last_gain: np.ndarray | None = None
+        self.kalman_prior = self.kalman.snapshot()
+        self.num_updates = 0
+
+    def update(
+        self,
+        *,
+        success_rate: ArrayLike | None = None,
+        episodes: ArrayLike | None = None,
+        gain: ArrayLike | None = None,
+    ) -> None:
+        """Feeds one round's measurements.
+
+        Args:
+            success_rate: Raw success rate of the round's rollouts per task (NaN allowed where a
+                task had 0 rollouts). Must come with ``episodes``.
+            episodes: Rollouts per task behind ``success_rate``.
+            gain: Per-task loss drop ``L_start - L_end`` of the round's training; negative values
+                are clipped to 0 (``max(0, .)``).
+
+        Raises:
+            ValueError: On a bad measurement; the scheduler is left unchanged.
+        """
+        if (success_rate is None) != (episodes is None):
+            raise ValueError("success_rate and episodes go together: pass both or neither.")
+        checked_gain = None
+        if gain is not None:
+            checked_gain = _as_vector(gain, "gain", self.num_tasks)
+            _require_finite(checked_gain, "gain")
+        if success_rate is not None:
+            rate, counts = check_measurements(success_rate, episodes, self.num_tasks)
+            self.kalman_prior = self.kalman.snapshot()
+            self.kalman.update(rate, counts)
+            self.raw_success = np.where(counts > 0, rate, self.raw_success)
+            self.last_success_rate, self.last_episodes = rate, counts
+        if checked_gain is not None:
+            self.gain = np.maximum(checked_gain, 0.0)
+            self.last_gain = self.gain.copy()
+        self.num_updates += 1
+
+    def metric(self) -> np.ndarray:
+        """The method's current metric per task (higher = more episodes)."""
+        return _METRICS[self.method](self)
+
+    def allocate(self, budget: int) -> Allocation:
+        """Allocates ``budget`` episodes and returns the full record.
+
+        Raises:
+            ValueError: If ``budget`` is not an integer >= n_min * num_tasks.
+        """
+        metric = self.metric()
+        score = rank_normalize(metric)
+        probability = softmax(score, self.config.temperature)
+        counts = allocate_probabilities(probability, budget, self.config.n_min, score)
+        notes = []
+        if self.last_success_rate is None and self.method in ("need", "need_raw"):
+            notes.append("no rollouts measured yet: the prior decides (uniform allocation)")
+        if self.last_gain is None and self.method == "gain":
+            notes.append("no training gain measured yet: uniform allocation")
+        return Allocation(
+            method=self.method,
+            budget=int(budget),
+            temperature=self.config.temperature,
+            n_min=self.config.n_min,
+            success_rate=None if self.last_success_rate is None else self.last_success_rate.tolist(),
+            episodes=None if self.last_episodes is None else [int(n) for n in self.last_episodes],
+            gain=None if self.last_gain is None else self.last_gain.tolist(),
+            raw_success=self.raw_success.tolist(),
+            kalman_prior=self.kalman_prior,
+            kalman_posterior=self.kalman.snapshot(),
+            metric=metric.tolist(),
+            score=score.tolist(),
+            probability=probability.tolist(),
+            episodes_per_task=counts.tolist(),
+            kalman={"p0": self.config.p0, "P0": self.config.P0, "Q": self.config.Q, "R0": self.config.R0},
+            notes=notes,
+        )
+
+    def state_dict(self) -> dict[str, Any]:
+        """Returns the full state as JSON-ready builtins (round-trips exactly through ``json``)."""
+
+        def optional(array: np.ndarray | None) -> list[float] | None:
+            if array is None:
+                return None
+            return [None if math.isnan(v) else v for v in array.tolist()]
+
+        return {
+            "format_version": STATE_FORMAT_VERSION,
+            "method": self.method,
+            "num_tasks": self.num_tasks,
+            "config": self.config.hyperparameters(),
+            "kalman": self.kalman.snapshot(),
+            "kalman_prior": self.kalman_prior,
+            "raw_success": self.raw_success.tolist(),
+            "gain": self.gain.tolist(),
+            "last_success_rate": optional(self.last_success_rate),
+            "last_episodes": optional(self.last_episodes),
+            "last_gain": optional(self.last_gain),
+            "num_updates": self.num_updates,
+        }
+
+    def load_state_dict(self, state: Mapping[str, Any]) -> None:
+        """Restores a state written by ``state_dict``.
+
+        Raises:
+            ValueError: If the state belongs to another method, task count or format version.
+        """
+        if state.get("format_version") != STATE_FORMAT_VERSION:
+            raise ValueError(
+                f"Scheduler state has format_version={state.get('format_version')!r}; this version "
+                f"reads {STATE_FORMAT_VERSION}."
+            )
+        if state["method"] != self.method or state["num_tasks"] != self.num_tasks:
+            raise ValueError(
+                f"Scheduler state is for method={state['method']!r} with num_tasks={state['num_tasks']}, "
+                f"but this scheduler is method={self.method!r} with num_tasks={self.num_tasks}."
+            )
+
+        def optional(values: Sequence[float | None] | None) -> np.ndarray | None:
+            if values is None:
+                return None
+            return np.array([math.nan if v is None else v for v in values], dtype=np.float64)
+
+        self.config = type(self.config)(**state["config"])
+        self.kalman = KalmanSuccessEstimator(
+            self.num_tasks, p0=self.config.p0, P0=self.config.P0, Q=self.config.Q, R0=self.config.R0
+        )
+        self.kalman.load_snapshot(state["kalman"])
+        self.kalman_prior = {"p": list(state["kalman_prior"]["p"]), "P": list(state["kalman_prior"]["P"])}
+        self.raw_success = _as_vector(state["raw_success"], "raw_success", self.num_tasks)
+        self.gain = _as_vector(state["gain"], "gain", self.num_tasks)
+        self.last_success_rate = optional(state["last_success_rate"])
+        self.last_episodes = optional(state["last_episodes"])
+        self.last_gain = optional(state["last_gain"])
+        self.num_updates = int(state["num_updates"])
+
+
+def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int) -> Scheduler:
+    """Creates a scheduler by method name.
+
+    Args:
+        method: One of ``uniform``, ``need``, ``need_raw``, ``gain``.
+        num_tasks: Number of tasks.
+        **hyperparameters: Any ``SchedulerConfig`` field (temperature, n_min, p0, P0, Q, R0).
+
+    Returns:
+        The scheduler.
+
+    Raises:
+        ValueError: On an unknown method, an unknown hyperparameter or a bad value.
+    """
+    if method not in _METRICS:
+        raise ValueError(f"Unknown scheduling method {method!r}; known methods: {list(METHODS)}.")
+    known = {f.name for f in dataclasses.fields(SchedulerConfig)}
+    unknown = sorted(set(hyperparameters) - known)
+    if unknown:
+        raise ValueError(f"Unknown scheduler hyperparameter(s) {unknown}; known: {sorted(known)}.")
+    config_class = SchedulerConfig.get_choice_class(method)
+    return Scheduler(method, num_tasks, config_class(**hyperparameters))
+
+
+def scheduler_from_config(config: SchedulerConfig, num_tasks: int) -> Scheduler:
+    """Creates the scheduler selected by a (command-line) config."""
+    return Scheduler(config.type, num_tasks, config)
+
+
+def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
+    """Recomputes an allocation from its stored record alone.
+
+    For ``need`` the Kalman posterior is recomputed from the stored prior and measurements (when
+    the record carries measurements), so a tampered metric or Kalman state is detected too.
+
+    Args:
+        record: An ``Allocation.to_dict()`` record.
+
+    Returns:
+        The allocation recomputed from the record's inputs.
+
+    Raises:
+        ValueError: If the record is incomplete or inconsistent with itself.
+    """
+    stored = Allocation.from_dict(record)
+    num_tasks = len(stored.episodes_per_task)
+    config_class = SchedulerConfig.get_choice_class(stored.method) if stored.method in _METRICS else None
+    if config_class is None:
+        raise ValueError(f"Record has unknown method {stored.method!r}; known methods: {list(METHODS)}.")
+    config = config_class(temperature=stored.temperature, n_min=stored.n_min, **stored.kalman)
+    kalman = KalmanSuccessEstimator(num_tasks, p0=config.p0, P0=config.P0, Q=config.Q, R0=config.R0)
+    kalman.load_snapshot(stored.kalman_prior)
+    if stored.success_rate is not None:
+        kalman.update(stored.success_rate, stored.episodes)
+    if stored.method == "need":
+        metric = 1.0 - kalman.p
+    elif stored.method == "need_raw":
+        metric = 1.0 - np.asarray(stored.raw_success, dtype=np.float64)
+    elif stored.method == "gain":
+        metric = np.zeros(num_tasks) if stored.gain is None else np.maximum(np.asarray(stored.gain), 0.0)
+    else:
+        metric = np.zeros(num_tasks)
+    score = rank_normalize(metric)
+    probability = softmax(score, config.temperature)
+    counts = allocate_probabilities(probability, stored.budget, config.n_min, score)
+    return dataclasses.replace(
+        stored,
+        kalman_posterior=kalman.snapshot(),
+        metric=metric.tolist(),
+        score=score.tolist(),
+        probability=probability.tolist(),
+        episodes_per_task=counts.tolist(),
+    )
+
+
+def allocation_mismatches(record: Mapping[str, Any], rtol: float = 1e-9) -> list[str]:
+    """Lists the fields of a stored allocation record that its own inputs do not reproduce.
+
+    Args:
+        record: An ``Allocation.to_dict()`` record.
+        rtol: Relative tolerance for float fields.
+
+    Returns:
+        One message per mismatching field; empty when the record checks out.
+    """
+    recomputed = recompute_allocation(record)
+    problems = []
+    for name in ("metric", "score", "probability"):
+        if not np.allclose(record[name], getattr(recomputed, name), rtol=rtol, atol=1e-12):
+            problems.append(f"{name}: stored {record[name]} != recomputed {getattr(recomputed, name)}")
+    if record["method"] == "need" and record.get("success_rate") is not None:
+        for key in ("p", "P"):
+            stored, again = record["kalman_posterior"][key], recomputed.kalman_posterior[key]
+            if not np.allclose(stored, again, rtol=rtol, atol=1e-12):
+                problems.append(f"kalman_posterior.{key}: stored {stored} != recomputed {again}")
+    if record.get("success_rate") is not None:
+        measured = np.asarray(record["episodes"]) > 0
+        rate = np.asarray(recomputed.success_rate)[measured]
+        if not np.array_equal(np.asarray(record["raw_success"])[measured], rate):
+            problems.append("raw_success does not hold the measured success_rate of the measured tasks")
+    if list(record["episodes_per_task"]) != recomputed.episodes_per_task:
+        problems.append(
+            f"episodes_per_task: stored {record['episodes_per_task']} != "
+            f"recomputed {recomputed.episodes_per_task}"
+        )
+    if sum(record["episodes_per_task"]) != record["budget"]:
+        total = sum(record["episodes_per_task"])
+        problems.append(f"episodes_per_task sums to {total}, budget is {record['budget']}")
+    return problems
