@@ -1,1 +1,115 @@
-"""Task suites (MetaWorld, drawers) with state, RGB and point-cloud observations."""
+"""Task suites with state, RGB and point-cloud observations.
+
+``make_suite(name, tasks=None, obs_mode="state", ...)`` builds a suite:
+
+==================  =====================================================================
+name                tasks
+==================  =====================================================================
+metaworld-mt10      MetaWorld's MT10 list (v3 envs)
+metaworld-mt25      MetaWorld's MT25 list
+metaworld-mt50      MetaWorld's MT50 list (all v3 tasks)
+metaworld           any explicit ``tasks=[...]`` list of v3 task names
+==================  =====================================================================
+
+``tasks=[...]`` with a named list selects a subset in the given order. Rendering uses MuJoCo's EGL
+backend unless ``MUJOCO_GL`` is already set (``osmesa`` is the fallback without EGL).
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
+
+from collections.abc import Sequence  # noqa: E402
+
+from lerobot_mtdagger.envs.base import (  # noqa: E402
+    IMAGE_KEY,
+    OBS_MODES,
+    POINTCLOUD_KEY,
+    STATE_KEY,
+    ObservationConfig,
+    TaskSuite,
+)
+from lerobot_mtdagger.envs.rendering import CropBox  # noqa: E402
+
+SUITE_NAMES: tuple[str, ...] = ("metaworld-mt10", "metaworld-mt25", "metaworld-mt50", "metaworld")
+
+__all__ = [
+    "IMAGE_KEY",
+    "OBS_MODES",
+    "POINTCLOUD_KEY",
+    "STATE_KEY",
+    "SUITE_NAMES",
+    "CropBox",
+    "ObservationConfig",
+    "TaskSuite",
+    "make_suite",
+]
+
+
+def make_suite(
+    name: str,
+    *,
+    tasks: Sequence[str] | None = None,
+    obs_mode: str = "state",
+    image_size: int = 84,
+    camera: str | None = None,
+    num_points: int = 1024,
+    pointcloud_cameras: Sequence[str] | None = None,
+    depth_size: int = 84,
+    pointcloud_color: bool = False,
+    crop: CropBox | None = None,
+    include_goal: bool = True,
+    max_episode_steps: int | None = None,
+) -> TaskSuite:
+    """Builds a task suite.
+
+    Args:
+        name: One of ``SUITE_NAMES``.
+        tasks: Task subset (any order); required for ``metaworld``, optional for the named lists.
+        obs_mode: ``state``, ``rgb`` or ``pointcloud``.
+        image_size: RGB image side in pixels.
+        camera: RGB camera name (suite default when None).
+        num_points: Points per cloud.
+        pointcloud_cameras: Depth cameras of the cloud (suite default when None).
+        depth_size: Depth image side in pixels.
+        pointcloud_color: Add per-point RGB.
+        crop: Crop box of the cloud (suite default when None).
+        include_goal: Append the goal position to the proprioceptive state in rgb/pointcloud modes.
+        max_episode_steps: Truncation length (the task's max path length when None).
+
+    Returns:
+        The suite.
+
+    Raises:
+        ValueError: On an unknown suite, task or observation setting.
+    """
+    observation = ObservationConfig(
+        obs_mode=obs_mode,
+        image_size=image_size,
+        camera=camera,
+        num_points=num_points,
+        pointcloud_cameras=None if pointcloud_cameras is None else tuple(pointcloud_cameras),
+        depth_size=depth_size,
+        pointcloud_color=pointcloud_color,
+        crop=crop,
+        include_goal=include_goal,
+    )
+    if name not in SUITE_NAMES:
+        raise ValueError(f"Unknown suite {name!r}; available suites: {list(SUITE_NAMES)}.")
+    from lerobot_mtdagger.envs.metaworld import MT10_TASKS, MT25_TASKS, MT50_TASKS, MetaWorldSuite
+
+    named_lists = {"metaworld-mt10": MT10_TASKS, "metaworld-mt25": MT25_TASKS, "metaworld-mt50": MT50_TASKS}
+    if name == "metaworld":
+        if not tasks:
+            raise ValueError("Suite 'metaworld' needs an explicit tasks=[...] list of v3 task names.")
+        task_names = list(tasks)
+    else:
+        available = named_lists[name]
+        task_names = list(tasks) if tasks else list(available)
+        outside = [t for t in task_names if t not in available]
+        if outside:
+            raise ValueError(f"Task(s) {outside} are not in {name}; its tasks: {list(available)}.")
+    return MetaWorldSuite(task_names, observation, max_episode_steps=max_episode_steps, name=name)

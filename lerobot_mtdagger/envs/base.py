@@ -1,0 +1,186 @@
+"""The task-suite interface shared by the MetaWorld and drawer suites.
+
+A suite is a fixed, ordered list of tasks (task index i is ``task_names[i]`` everywhere: datasets,
+policy config, scheduler), plus:
+
+- ``make_env(task_name, seed=None)``: a gymnasium env whose observations are dicts keyed by LeRobot
+  feature names (``observation.state`` always, ``observation.image`` in ``rgb`` mode,
+  ``observation.pointcloud`` in ``pointcloud`` mode); ``info["success"]`` at every step and
+  ``info["privileged_state"]``, the low-dimensional state the expert acts on;
+- ``make_expert(task_name)``: an ``Expert`` for that task;
+- ``features``: the LeRobot feature dict of what the suite emits plus ``action``;
+- ``make_vector_env(task_names, seeds)``: several tasks' envs stepped in parallel processes.
+"""
+
+from __future__ import annotations
+
+import abc
+import dataclasses
+import functools
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import gymnasium as gym
+
+from lerobot_mtdagger.envs.rendering import CropBox
+from lerobot_mtdagger.experts import Expert
+
+OBS_MODES: tuple[str, ...] = ("state", "rgb", "pointcloud")
+
+STATE_KEY = "observation.state"
+IMAGE_KEY = "observation.image"
+POINTCLOUD_KEY = "observation.pointcloud"
+
+
+@dataclass(frozen=True)
+class ObservationConfig:
+    """What a suite's envs show the policy.
+
+    Attributes:
+        obs_mode: ``state``, ``rgb`` or ``pointcloud``.
+        image_size: Side of the square RGB image in ``rgb`` mode, pixels.
+        camera: Camera of the RGB image.
+        num_points: Points per cloud in ``pointcloud`` mode (the paper uses 4096; smaller on CPU).
+        pointcloud_cameras: Depth cameras fused into the cloud (None: the suite's default).
+        depth_size: Side of the square depth images behind the cloud, pixels.
+        pointcloud_color: Append per-point RGB in [0, 1] (cloud shape (num_points, 6)).
+        crop: Workspace box of the cloud in world coordinates (None: the suite's default).
+        include_goal: In ``rgb`` and ``pointcloud`` modes, append the goal position to the
+            proprioceptive state (many MetaWorld goals are invisible in the scene).
+    """
+
+    obs_mode: str = "state"
+    image_size: int = 84
+    camera: str | None = None
+    num_points: int = 1024
+    pointcloud_cameras: tuple[str, ...] | None = None
+    depth_size: int = 84
+    pointcloud_color: bool = False
+    crop: CropBox | None = None
+    include_goal: bool = True
+
+    def __post_init__(self) -> None:
+        if self.obs_mode not in OBS_MODES:
+            raise ValueError(f"Unknown obs_mode {self.obs_mode!r}; choose one of {list(OBS_MODES)}.")
+        if self.image_size <= 0:
+            raise ValueError(f"image_size must be > 0, got {self.image_size}.")
+        if self.depth_size <= 0:
+            raise ValueError(f"depth_size must be > 0, got {self.depth_size}.")
+        if self.num_points <= 0:
+            raise ValueError(f"num_points must be > 0, got {self.num_points}.")
+        if self.pointcloud_cameras is not None and len(self.pointcloud_cameras) == 0:
+            raise ValueError("pointcloud_cameras is empty: name at least one camera or pass None.")
+
+
+class TaskSuite(abc.ABC):
+    """A fixed, ordered set of tasks with envs, experts and LeRobot features."""
+
+    name: str
+
+    def __init__(self, task_names: Sequence[str], observation: ObservationConfig) -> None:
+        """Stores the task order and the observation settings.
+
+        Raises:
+            ValueError: On an empty or duplicated task list.
+        """
+        task_names = list(task_names)
+        if not task_names:
+            raise ValueError(f"Suite {self.name!r} needs at least one task.")
+        duplicates = sorted({t for t in task_names if task_names.count(t) > 1})
+        if duplicates:
+            raise ValueError(f"Task names must be unique; repeated: {duplicates}.")
+        self.task_names = task_names
+        self.observation = observation
+
+    @property
+    def obs_mode(self) -> str:
+        """The observation mode of every env of the suite."""
+        return self.observation.obs_mode
+
+    def task_index(self, task_name: str) -> int:
+        """Index of ``task_name`` in ``task_names``.
+
+        Raises:
+            ValueError: If the task is not in the suite.
+        """
+        if task_name not in self.task_names:
+            raise ValueError(
+                f"Task {task_name!r} is not in suite {self.name!r}; its tasks: {self.task_names}."
+            )
+        return self.task_names.index(task_name)
+
+    @abc.abstractmethod
+    def make_env(self, task_name: str, seed: int | None = None) -> gym.Env:
+        """Builds the env of one task; ``seed`` seeds its first reset."""
+
+    @abc.abstractmethod
+    def make_expert(self, task_name: str) -> Expert:
+        """Builds the expert of one task."""
+
+    @property
+    @abc.abstractmethod
+    def features(self) -> dict[str, dict[str, Any]]:
+        """LeRobot feature dict (dtype, shape, names) of the observations plus ``action``."""
+
+    @property
+    @abc.abstractmethod
+    def action_dim(self) -> int:
+        """Size of the action vector."""
+
+    def with_observation(self, **changes: Any) -> TaskSuite:
+        """A copy of the suite with some observation settings changed."""
+        clone = self.__class__.__new__(self.__class__)
+        clone.__dict__.update(self.__dict__)
+        clone.observation = dataclasses.replace(self.observation, **changes)
+        return clone
+
+    def make_vector_env(
+        self, task_names: Sequence[str], seeds: Sequence[int], asynchronous: bool = True
+    ) -> gym.vector.VectorEnv:
+        """Several tasks' envs stepped together (one process each when ``asynchronous``).
+
+        Autoreset is disabled: reset finished sub-envs with
+        ``envs.reset(options={"reset_mask": done})``. Infos carry ``success`` and
+        ``privileged_state`` per sub-env. Renderers are created inside the worker processes.
+
+        Args:
+            task_names: One task per sub-env (repeats allowed).
+            seeds: Seed of each sub-env's first reset.
+            asynchronous: Worker processes (True) or in-process stepping (False).
+
+        Raises:
+            ValueError: On mismatched lengths or an unknown task.
+        """
+        if len(task_names) != len(seeds):
+            raise ValueError(
+                f"Got {len(task_names)} task names but {len(seeds)} seeds; give one seed per env."
+            )
+        for task_name in task_names:
+            self.task_index(task_name)
+        env_fns = [
+            functools.partial(self.make_env, t, int(s)) for t, s in zip(task_names, seeds, strict=True)
+        ]
+        mode = gym.vector.AutoresetMode.DISABLED
+        if asynchronous:
+            return gym.vector.AsyncVectorEnv(env_fns, autoreset_mode=mode)
+        return gym.vector.SyncVectorEnv(env_fns, autoreset_mode=mode)
+
+    def __repr__(self) -> str:
+        name = self.__class__.__name__
+        return f"{name}(name={self.name!r}, tasks={len(self.task_names)}, obs_mode={self.obs_mode!r})"
+
+
+def state_feature(names: Sequence[str]) -> dict[str, Any]:
+    """LeRobot feature of a float32 state vector."""
+    return {"dtype": "float32", "shape": (len(names),), "names": list(names)}
+
+
+def image_feature(size: int) -> dict[str, Any]:
+    """LeRobot feature of a square RGB image stored as PNG frames (no video decoding needed)."""
+    return {"dtype": "image", "shape": (size, size, 3), "names": ["height", "width", "channels"]}
+
+
+def pointcloud_feature(num_points: int, channels: int) -> dict[str, Any]:
+    """LeRobot feature of a point cloud: channels are x, y, z (world frame, metres) then r, g, b."""
+    return {"dtype": "float32", "shape": (num_points, channels), "names": ["points", "channels"]}

@@ -1,0 +1,320 @@
+"""MetaWorld 3.1 (v3 environments) as multitask suites with state, RGB and point-cloud observations.
+
+What each observation mode shows the policy:
+
+- ``state``: ``observation.state`` is MetaWorld's 39-d goal-visible vector: hand xyz, gripper
+  opening, up to two objects' position + quaternion (14, zero-padded), the same 18 values of the
+  previous step, and the goal xyz. This is also the expert's privileged state.
+- ``rgb``: ``observation.image`` (H x W x 3 uint8 from ``camera``, default ``corner``) and
+  ``observation.state`` = hand xyz + gripper opening (+ goal xyz when ``include_goal``; many
+  MetaWorld goals, e.g. reach and push targets, are not drawn in the scene).
+- ``pointcloud``: ``observation.pointcloud`` ((num_points, 3) float32, world frame, metres; from the
+  depth cameras ``corner`` and ``corner2`` by default, cropped to the box x in [-0.6, 0.6], y in
+  [0.2, 1.1], z in [0.01, 0.7], which removes the table top (z = 0), the floor and the background)
+  and the same proprioceptive ``observation.state`` as ``rgb``.
+
+Episodes truncate at ``max_episode_steps`` (MetaWorld's max path length, 500). A seeded reset
+reproduces the initial object and goal positions: the object/goal vector is drawn from the env's
+own generator, re-seeded by ``reset(seed=...)``. MetaWorld's success does not persist after it
+first happens; an episode counts as successful if ``info["success"]`` was true at any step.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from metaworld.env_dict import ALL_V3_ENVIRONMENTS, MT10_V3, MT25_V3, MT50_V3
+
+from lerobot_mtdagger.envs.base import (
+    IMAGE_KEY,
+    POINTCLOUD_KEY,
+    STATE_KEY,
+    ObservationConfig,
+    TaskSuite,
+    image_feature,
+    pointcloud_feature,
+    state_feature,
+)
+from lerobot_mtdagger.envs.rendering import CropBox, PointCloudCamera, SceneRenderer, camera_rays
+from lerobot_mtdagger.experts import ActionCheckedExpert, Expert
+from lerobot_mtdagger.experts.metaworld import MetaWorldScriptedExpert
+
+logger = logging.getLogger(__name__)
+
+MT10_TASKS: tuple[str, ...] = tuple(MT10_V3)
+MT25_TASKS: tuple[str, ...] = tuple(MT25_V3)
+MT50_TASKS: tuple[str, ...] = tuple(MT50_V3)
+ALL_TASKS: tuple[str, ...] = tuple(ALL_V3_ENVIRONMENTS)
+
+METAWORLD_CROP = CropBox(low=(-0.6, 0.2, 0.01), high=(0.6, 1.1, 0.7))
+DEFAULT_CAMERA = "corner"
+# MetaWorld's corner cameras are mounted upside down (their image "up" is the world's down); their
+# RGB observations are rotated by 180 degrees so the table is at the bottom of the image.
+UPSIDE_DOWN_CAMERAS = frozenset({"corner", "corner2", "corner3", "corner4"})
+DEFAULT_POINTCLOUD_CAMERAS: tuple[str, ...] = ("corner", "corner2")
+ACTION_DIM = 4
+STATE_DIM = 39
+
+_OBJECT_NAMES = [f"obj{k}_{axis}" for k in (0, 1) for axis in ("x", "y", "z", "qw", "qx", "qy", "qz")]
+_FRAME_NAMES = ["hand_x", "hand_y", "hand_z", "gripper", *_OBJECT_NAMES]
+STATE_NAMES: list[str] = _FRAME_NAMES + [f"prev_{n}" for n in _FRAME_NAMES] + ["goal_x", "goal_y", "goal_z"]
+PROPRIO_NAMES: list[str] = ["hand_x", "hand_y", "hand_z", "gripper"]
+GOAL_NAMES: list[str] = ["goal_x", "goal_y", "goal_z"]
+ACTION_NAMES: list[str] = ["dx", "dy", "dz", "grip"]
+
+
+def observation_state_names(config: ObservationConfig) -> list[str]:
+    """Names of the entries of ``observation.state`` in the mode of ``config``."""
+    if config.obs_mode == "state":
+        return STATE_NAMES
+    return PROPRIO_NAMES + (GOAL_NAMES if config.include_goal else [])
+
+
+def _make_raw_env(task_name: str) -> Any:
+    """Builds a v3 env with the goal visible and seedable random resets.
+
+    This is MetaWorld's goal-observable setting without its frozen goal: ``seeded_rand_vec`` makes
+    every reset draw the object/goal vector from the env's ``np_random``.
+    """
+    env = ALL_V3_ENVIRONMENTS[task_name]()
+    env._partially_observable = False
+    del env.sawyer_observation_space  # cached property computed for the hidden goal
+    env._freeze_rand_vec = False
+    env.seeded_rand_vec = True
+    env._set_task_called = True
+    return env
+
+
+class MetaWorldTaskEnv(gym.Env):
+    """One MetaWorld v3 task with LeRobot-keyed dict observations."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 80}
+
+    def __init__(
+        self,
+        task_name: str,
+        observation: ObservationConfig,
+        seed: int | None = None,
+        max_episode_steps: int | None = None,
+    ) -> None:
+        """Builds the env (about 0.2 s: it loads the task's MJCF model).
+
+        Args:
+            task_name: A MetaWorld v3 task name such as ``reach-v3``.
+            observation: What the env shows the policy.
+            seed: Seed of the first reset (later unseeded resets continue its random stream).
+            max_episode_steps: Truncation length; MetaWorld's max path length (500) when None.
+        """
+        self.task_name = task_name
+        self.observation_config = observation
+        self._env = _make_raw_env(task_name)
+        self.max_episode_steps = int(max_episode_steps or self._env.max_path_length)
+        limit = self._env.max_path_length
+        if not 0 < self.max_episode_steps <= limit:
+            raise ValueError(f"max_episode_steps must be in [1, {limit}], got {self.max_episode_steps}.")
+        self._pending_seed = seed
+        self._elapsed = 0
+        self._needs_reset = True
+        self._point_rng = np.random.default_rng(seed)
+        self._renderer: SceneRenderer | None = None
+        self._cloud: PointCloudCamera | None = None
+        self._setup_rendering()
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (ACTION_DIM,), dtype=np.float32)
+        self.observation_space = self._make_observation_space()
+
+    # ---------------------------------------------------------------------------------------------
+    # Spaces and rendering
+    # ---------------------------------------------------------------------------------------------
+
+    def _setup_rendering(self) -> None:
+        config = self.observation_config
+        model = self._env.model
+        if config.obs_mode == "rgb":
+            self._renderer = SceneRenderer(model, config.image_size, config.image_size)
+            self._camera = config.camera or DEFAULT_CAMERA
+            camera_rays(model, self._camera, 1, 1)  # fail now, not at the first frame, on a misspelt camera
+        elif config.obs_mode == "pointcloud":
+            self._renderer = SceneRenderer(model, config.depth_size, config.depth_size)
+            self._cloud = PointCloudCamera(
+                self._renderer,
+                config.pointcloud_cameras or DEFAULT_POINTCLOUD_CAMERAS,
+                config.crop or METAWORLD_CROP,
+                config.num_points,
+                with_color=config.pointcloud_color,
+            )
+
+    def _make_observation_space(self) -> gym.spaces.Dict:
+        config = self.observation_config
+        spaces: dict[str, gym.Space] = {
+            STATE_KEY: gym.spaces.Box(
+                -np.inf, np.inf, (len(observation_state_names(config)),), dtype=np.float32
+            )
+        }
+        if config.obs_mode == "rgb":
+            spaces[IMAGE_KEY] = gym.spaces.Box(
+                0, 255, (config.image_size, config.image_size, 3), dtype=np.uint8
+            )
+        elif config.obs_mode == "pointcloud":
+            assert self._cloud is not None
+            shape = (config.num_points, self._cloud.channels)
+            spaces[POINTCLOUD_KEY] = gym.spaces.Box(-np.inf, np.inf, shape, dtype=np.float32)
+        return gym.spaces.Dict(spaces)
+
+    def _observation(self, raw: np.ndarray) -> dict[str, np.ndarray]:
+        config = self.observation_config
+        if config.obs_mode == "state":
+            return {STATE_KEY: raw.astype(np.float32)}
+        state = raw[:4] if not config.include_goal else np.concatenate([raw[:4], raw[36:39]])
+        observation = {STATE_KEY: state.astype(np.float32)}
+        if config.obs_mode == "rgb":
+            assert self._renderer is not None
+            observation[IMAGE_KEY] = self._rgb(self._camera)
+        else:
+            assert self._cloud is not None
+            observation[POINTCLOUD_KEY] = self._cloud.capture(self._env.data, self._point_rng)
+        return observation
+
+    def _rgb(self, camera: str) -> np.ndarray:
+        assert self._renderer is not None
+        image = self._renderer.rgb(self._env.data, camera)
+        if camera in UPSIDE_DOWN_CAMERAS:
+            image = np.ascontiguousarray(image[::-1, ::-1])
+        return image
+
+    def render(self) -> np.ndarray:
+        """An RGB frame of the observation camera (for videos), (H, W, 3) uint8."""
+        if self._renderer is None:
+            size = self.observation_config.image_size
+            self._renderer = SceneRenderer(self._env.model, size, size)
+        return self._rgb(self.observation_config.camera or DEFAULT_CAMERA)
+
+    # ---------------------------------------------------------------------------------------------
+    # Gymnasium API
+    # ---------------------------------------------------------------------------------------------
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        """Starts an episode; the same seed gives the same initial object and goal positions."""
+        if seed is None and self._pending_seed is not None:
+            seed = self._pending_seed
+        self._pending_seed = None
+        super().reset(seed=seed)
+        if seed is not None:
+            self._env.seed(int(seed))
+            self._point_rng = np.random.default_rng(int(seed))
+        raw, _ = self._env.reset()
+        self._elapsed = 0
+        self._needs_reset = False
+        info = {"success": False, "is_success": False, "privileged_state": raw.copy(), "task": self.task_name}
+        return self._observation(raw), info
+
+    def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        """Applies one action (clipped to [-1, 1]).
+
+        Raises:
+            RuntimeError: If the episode ended and ``reset`` was not called.
+            ValueError: If the action does not have 4 finite entries.
+        """
+        if self._needs_reset:
+            raise RuntimeError(
+                f"{self.task_name}: the episode is over (or never started); call reset() first."
+            )
+        action = np.asarray(action, dtype=np.float32).reshape(-1)
+        if action.shape != (ACTION_DIM,) or not np.all(np.isfinite(action)):
+            raise ValueError(f"{self.task_name}: actions are 4 finite numbers in [-1, 1], got {action}.")
+        raw, reward, _, _, raw_info = self._env.step(np.clip(action, -1.0, 1.0))
+        self._elapsed += 1
+        truncated = self._elapsed >= self.max_episode_steps
+        self._needs_reset = truncated
+        success = bool(raw_info["success"])
+        info = {
+            "success": success,
+            "is_success": success,
+            "privileged_state": raw.copy(),
+            "task": self.task_name,
+        }
+        return self._observation(raw), float(reward), False, truncated, info
+
+    def close(self) -> None:
+        """Frees the renderer and the MuJoCo model."""
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+        self._env.close()
+
+
+class MetaWorldSuite(TaskSuite):
+    """MetaWorld v3 tasks: MT10, MT25, MT50 or any explicit list."""
+
+    name = "metaworld"
+
+    def __init__(
+        self,
+        task_names: Sequence[str],
+        observation: ObservationConfig,
+        max_episode_steps: int | None = None,
+        name: str = "metaworld",
+    ) -> None:
+        """Checks the task names against MetaWorld's v3 environments.
+
+        Raises:
+            ValueError: On an unknown task.
+        """
+        unknown = [t for t in task_names if t not in ALL_V3_ENVIRONMENTS]
+        if unknown:
+            raise ValueError(f"Unknown MetaWorld v3 task(s) {unknown}; known tasks: {list(ALL_TASKS)}.")
+        self.name = name
+        super().__init__(task_names, observation)
+        self.max_episode_steps = max_episode_steps
+        self._experts: dict[str, Expert] = {}
+
+    @property
+    def action_dim(self) -> int:
+        """MetaWorld's 4-d action: end-effector displacement xyz and gripper effort."""
+        return ACTION_DIM
+
+    def make_env(self, task_name: str, seed: int | None = None) -> MetaWorldTaskEnv:
+        """Builds the env of ``task_name``."""
+        self.task_index(task_name)
+        return MetaWorldTaskEnv(
+            task_name, self.observation, seed=seed, max_episode_steps=self.max_episode_steps
+        )
+
+    def with_experts(self, experts: dict[str, Expert]) -> MetaWorldSuite:
+        """Replaces the scripted expert of some tasks (for example by RL-trained policies).
+
+        Raises:
+            ValueError: On a task not in the suite.
+            TypeError: On an object that is not an ``Expert``.
+        """
+        for task_name, expert in experts.items():
+            self.task_index(task_name)
+            ActionCheckedExpert(expert, task_name, self.action_dim)
+        clone = self.with_observation()
+        clone._experts = {**self._experts, **experts}
+        return clone
+
+    def make_expert(self, task_name: str) -> Expert:
+        """The task's expert (scripted unless replaced by ``with_experts``), action-size checked."""
+        self.task_index(task_name)
+        expert = self._experts.get(task_name) or MetaWorldScriptedExpert(task_name)
+        return ActionCheckedExpert(expert, task_name, self.action_dim)
+
+    @property
+    def features(self) -> dict[str, dict[str, Any]]:
+        """LeRobot features of the observations of the current mode, plus ``action``."""
+        config = self.observation
+        features = {STATE_KEY: state_feature(observation_state_names(config))}
+        if config.obs_mode == "rgb":
+            features[IMAGE_KEY] = image_feature(config.image_size)
+        elif config.obs_mode == "pointcloud":
+            features[POINTCLOUD_KEY] = pointcloud_feature(
+                config.num_points, 6 if config.pointcloud_color else 3
+            )
+        features["action"] = state_feature(ACTION_NAMES)
+        return features

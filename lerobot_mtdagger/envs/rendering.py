@@ -1,0 +1,259 @@
+"""Offscreen MuJoCo observations: RGB frames and point clouds from depth cameras.
+
+Rendering goes through MuJoCo's EGL backend (``MUJOCO_GL=egl``, set by ``lerobot_mtdagger.envs``
+unless the user chose a backend; Mesa renders on the CPU). ``MUJOCO_GL=osmesa`` is the fallback
+where EGL is missing (slower). Observation cameras render without shadows and reflections: with
+MetaWorld's 4096-pixel shadow map a CPU frame costs about four times more, and neither helps a
+policy.
+
+Point clouds (the paper crops the background and feeds a PointNet):
+
+1. Render a depth image per camera. MuJoCo returns metric depth along the camera's optical axis.
+2. Back-project each pixel with the pinhole intrinsics of the camera (``fovy`` from the model,
+   square pixels, principal point at the image centre) into the camera frame (MuJoCo cameras look
+   along -z with +y up), then into the WORLD frame with the camera pose ``cam_xpos``/``cam_xmat``.
+3. Keep the points inside an axis-aligned crop box in world coordinates (``CropBox``); the box of a
+   suite removes the table surface, the floor and the background.
+4. Sample exactly ``num_points`` of them uniformly with the env's seeded generator (with replacement
+   only when fewer points survive the crop).
+
+Optional per-point colour comes from an RGB render of the same camera (values in [0, 1]).
+"""
+
+from __future__ import annotations
+
+import atexit
+import logging
+import weakref
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+logger = logging.getLogger(__name__)
+
+# Renderers still open at interpreter exit are closed while OpenGL is still loaded; otherwise
+# MuJoCo's own finalisers run after PyOpenGL is torn down and print EGL errors.
+_OPEN_RENDERERS: weakref.WeakSet[SceneRenderer] = weakref.WeakSet()
+
+
+@atexit.register
+def _close_open_renderers() -> None:
+    for renderer in list(_OPEN_RENDERERS):
+        renderer.close()
+
+
+@dataclass(frozen=True)
+class CropBox:
+    """Axis-aligned box in world coordinates (metres) that keeps the workspace.
+
+    Attributes:
+        low: (x, y, z) lower corner.
+        high: (x, y, z) upper corner.
+    """
+
+    low: tuple[float, float, float]
+    high: tuple[float, float, float]
+
+    def __post_init__(self) -> None:
+        if len(self.low) != 3 or len(self.high) != 3:
+            raise ValueError(
+                f"CropBox corners need 3 coordinates each, got low={self.low}, high={self.high}."
+            )
+        if any(lo >= hi for lo, hi in zip(self.low, self.high, strict=True)):
+            raise ValueError(f"CropBox low={self.low} must be below high={self.high} on every axis.")
+
+    def contains(self, points: np.ndarray) -> np.ndarray:
+        """Boolean mask of the rows of ``points`` (..., 3) inside the box."""
+        return np.all((points >= np.asarray(self.low)) & (points <= np.asarray(self.high)), axis=-1)
+
+    @property
+    def center(self) -> np.ndarray:
+        """The box centre, shape (3,)."""
+        return (np.asarray(self.low) + np.asarray(self.high)) / 2.0
+
+
+class SceneRenderer:
+    """RGB and depth rendering of one MuJoCo model with shadows and reflections turned off.
+
+    Creates its OpenGL context lazily, on first use, so an env can be built in one process and
+    stepped in another (vectorised collection).
+    """
+
+    def __init__(self, model: mujoco.MjModel, height: int, width: int) -> None:
+        """Prepares a renderer for ``model`` at ``height`` x ``width`` pixels.
+
+        Raises:
+            ValueError: If the size exceeds the model's offscreen buffer.
+        """
+        if height <= 0 or width <= 0:
+            raise ValueError(f"Render size must be positive, got {height}x{width}.")
+        offwidth, offheight = model.vis.global_.offwidth, model.vis.global_.offheight
+        if width > offwidth or height > offheight:
+            raise ValueError(
+                f"Render size {height}x{width} exceeds the model's offscreen buffer {offheight}x{offwidth}; "
+                "choose a smaller image_size."
+            )
+        self.model = model
+        self.height, self.width = height, width
+        self._renderer: mujoco.Renderer | None = None
+
+    def _get(self) -> mujoco.Renderer:
+        if self._renderer is None:
+            self._renderer = mujoco.Renderer(self.model, self.height, self.width)
+            _OPEN_RENDERERS.add(self)
+        return self._renderer
+
+    def _update(self, data: mujoco.MjData, camera: str) -> mujoco.Renderer:
+        renderer = self._get()
+        renderer.update_scene(data, camera=camera)
+        renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
+        renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+        return renderer
+
+    def rgb(self, data: mujoco.MjData, camera: str) -> np.ndarray:
+        """Renders an RGB frame, (H, W, 3) uint8."""
+        return self._update(data, camera).render().copy()
+
+    def depth(self, data: mujoco.MjData, camera: str) -> np.ndarray:
+        """Renders metric depth along the optical axis, (H, W) float32 metres."""
+        renderer = self._get()
+        renderer.enable_depth_rendering()
+        try:
+            return self._update(data, camera).render().copy()
+        finally:
+            renderer.disable_depth_rendering()
+
+    def close(self) -> None:
+        """Frees the OpenGL context (safe to call twice)."""
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+        _OPEN_RENDERERS.discard(self)
+
+
+def camera_rays(model: mujoco.MjModel, camera: str, height: int, width: int) -> np.ndarray:
+    """Per-pixel ray directions in the camera frame, scaled so that a depth d gives the point.
+
+    A pixel (row v, column u) at depth d is at ``d * ray[v, u]`` in the camera frame, where
+    ``ray = ((u + 0.5 - W/2) / f, -(v + 0.5 - H/2) / f, -1)`` and ``f = (H / 2) / tan(fovy / 2)``.
+    Row 0 of a MuJoCo render is the top of the image.
+
+    Returns:
+        (H, W, 3) float64 array.
+
+    Raises:
+        ValueError: If the model has no camera of that name.
+    """
+    camera_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
+    if camera_id < 0:
+        names = [model.camera(i).name for i in range(model.ncam)]
+        raise ValueError(f"Unknown camera {camera!r}; the model has cameras {names}.")
+    fovy = np.deg2rad(model.cam_fovy[camera_id])
+    focal = (height / 2.0) / np.tan(fovy / 2.0)
+    u = (np.arange(width) + 0.5 - width / 2.0) / focal
+    v = -(np.arange(height) + 0.5 - height / 2.0) / focal
+    rays = np.empty((height, width, 3))
+    rays[..., 0] = u[None, :]
+    rays[..., 1] = v[:, None]
+    rays[..., 2] = -1.0
+    return rays
+
+
+def depth_to_world(
+    depth: np.ndarray, rays: np.ndarray, position: np.ndarray, rotation: np.ndarray
+) -> np.ndarray:
+    """Back-projects a depth image to world coordinates.
+
+    Args:
+        depth: (H, W) metric depth along the optical axis.
+        rays: (H, W, 3) from ``camera_rays``.
+        position: Camera position in the world, (3,) (``data.cam_xpos[id]``).
+        rotation: Camera-to-world rotation, (3, 3) (``data.cam_xmat[id].reshape(3, 3)``).
+
+    Returns:
+        (H * W, 3) world-frame points.
+    """
+    camera_points = (rays * depth[..., None]).reshape(-1, 3)  # (H*W, 3) in the camera frame
+    return camera_points @ rotation.T + position
+
+
+def sample_points(
+    points: np.ndarray, num_points: int, rng: np.random.Generator, fallback: np.ndarray
+) -> np.ndarray:
+    """Samples exactly ``num_points`` rows of ``points``.
+
+    Uniform without replacement when enough points exist, with replacement otherwise. When no point
+    is left at all (the crop removed everything), returns ``num_points`` copies of ``fallback`` so
+    the observation keeps its shape, and logs a warning.
+
+    Args:
+        points: (M, C) candidate points.
+        num_points: Number to return (> 0).
+        rng: The seeded generator of the env.
+        fallback: (C,) row used when M == 0.
+
+    Returns:
+        (num_points, C) array of the same dtype as ``points``.
+    """
+    count = points.shape[0]
+    if count == 0:
+        logger.warning("No point inside the crop box: returning %d copies of the box centre.", num_points)
+        return np.repeat(fallback[None, :].astype(points.dtype), num_points, axis=0)
+    index = rng.choice(count, size=num_points, replace=count < num_points)
+    return points[index]
+
+
+class PointCloudCamera:
+    """Turns depth renders of several cameras into one cropped, sampled world-frame point cloud."""
+
+    def __init__(
+        self,
+        renderer: SceneRenderer,
+        cameras: tuple[str, ...],
+        crop: CropBox,
+        num_points: int,
+        with_color: bool = False,
+    ) -> None:
+        """Precomputes the rays of each camera.
+
+        Raises:
+            ValueError: On an unknown camera, no camera, or ``num_points <= 0``.
+        """
+        if num_points <= 0:
+            raise ValueError(f"num_points must be > 0, got {num_points}.")
+        if not cameras:
+            raise ValueError("A point cloud needs at least one camera.")
+        self.renderer = renderer
+        self.cameras = tuple(cameras)
+        self.crop = crop
+        self.num_points = num_points
+        self.with_color = with_color
+        model = renderer.model
+        self._rays = [camera_rays(model, c, renderer.height, renderer.width) for c in self.cameras]
+        self._ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, c) for c in self.cameras]
+
+    @property
+    def channels(self) -> int:
+        """3 (xyz) or 6 (xyz + rgb)."""
+        return 6 if self.with_color else 3
+
+    def capture(self, data: mujoco.MjData, rng: np.random.Generator) -> np.ndarray:
+        """Renders, back-projects, crops and samples the cloud.
+
+        Returns:
+            (num_points, 3) float32 world-frame xyz, or (num_points, 6) with rgb in [0, 1].
+        """
+        parts = []
+        for camera, camera_id, rays in zip(self.cameras, self._ids, self._rays, strict=True):
+            depth = self.renderer.depth(data, camera)
+            rotation = data.cam_xmat[camera_id].reshape(3, 3)
+            points = depth_to_world(depth, rays, data.cam_xpos[camera_id], rotation)
+            keep = self.crop.contains(points)
+            if self.with_color:
+                colors = self.renderer.rgb(data, camera).reshape(-1, 3) / 255.0
+                points = np.concatenate([points, colors], axis=1)
+            parts.append(points[keep])
+        cloud = np.concatenate(parts, axis=0)
+        fallback = np.concatenate([self.crop.center, np.zeros(self.channels - 3)])
+        return sample_points(cloud, self.num_points, rng, fallback).astype(np.float32)

@@ -1,0 +1,345 @@
+"""Tests of the MetaWorld suites on real MuJoCo environments (rendering through EGL)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, SUITE_NAMES, make_suite
+from lerobot_mtdagger.envs.metaworld import METAWORLD_CROP, MT10_TASKS, MT25_TASKS, MT50_TASKS
+from lerobot_mtdagger.experts import CallableExpert, LeRobotPolicyExpert
+
+MODES = ("state", "rgb", "pointcloud")
+
+
+def run_expert_episode(suite, task_name: str, seed: int) -> tuple[bool, int]:
+    """Runs the task's expert for one seeded episode; success if info["success"] at any step."""
+    env = suite.make_env(task_name, seed=seed)
+    expert = suite.make_expert(task_name)
+    try:
+        _, info = env.reset()
+        expert.reset()
+        for step in range(1, env.max_episode_steps + 1):
+            _, _, terminated, truncated, info = env.step(expert.act(info["privileged_state"]))
+            if info["success"]:
+                return True, step
+            if terminated or truncated:
+                break
+        return False, step
+    finally:
+        env.close()
+
+
+def test_suite_task_lists_are_metaworlds():
+    assert len(MT10_TASKS) == 10 and len(MT25_TASKS) == 25 and len(MT50_TASKS) == 50
+    assert make_suite("metaworld-mt10").task_names == list(MT10_TASKS)
+    assert make_suite("metaworld-mt50").task_names == list(MT50_TASKS)
+    subset = make_suite("metaworld-mt10", tasks=["push-v3", "reach-v3"])
+    assert subset.task_names == ["push-v3", "reach-v3"]
+    assert subset.task_index("reach-v3") == 1
+    custom = make_suite("metaworld", tasks=["hammer-v3", "reach-v3"])
+    assert custom.task_names == ["hammer-v3", "reach-v3"]
+
+
+@pytest.mark.parametrize("obs_mode", MODES)
+@pytest.mark.parametrize("task_name", MT10_TASKS)
+def test_observations_match_features(task_name, obs_mode):
+    suite = make_suite("metaworld-mt10", obs_mode=obs_mode, num_points=256, image_size=64)
+    env = suite.make_env(task_name, seed=0)
+    try:
+        observation, info = env.reset()
+        assert env.observation_space.contains(observation)
+        observation, _, _, _, info = env.step(env.action_space.sample())
+        features = {k: v for k, v in suite.features.items() if k != "action"}
+        assert set(observation) == set(features)
+        for key, feature in features.items():
+            assert observation[key].shape == tuple(feature["shape"]), key
+            expected = np.uint8 if feature["dtype"] == "image" else np.dtype(feature["dtype"])
+            assert observation[key].dtype == expected, key
+        assert isinstance(info["success"], bool)
+        assert info["privileged_state"].shape == (39,)
+        assert suite.features["action"]["shape"] == (4,)
+    finally:
+        env.close()
+
+
+def test_state_mode_shows_the_goal_and_matches_privileged_state():
+    suite = make_suite("metaworld-mt10", tasks=["reach-v3"])
+    env = suite.make_env("reach-v3", seed=3)
+    observation, info = env.reset()
+    np.testing.assert_allclose(observation[STATE_KEY], info["privileged_state"].astype(np.float32))
+    assert np.any(observation[STATE_KEY][36:39] != 0), "the goal must be visible in state mode"
+    env.close()
+
+
+def test_seeded_resets_are_reproducible():
+    suite = make_suite("metaworld-mt10")
+    first, second = suite.make_env("push-v3", seed=11), suite.make_env("push-v3")
+    _, info_a = first.reset()
+    _, info_b = second.reset(seed=11)
+    np.testing.assert_array_equal(info_a["privileged_state"], info_b["privileged_state"])
+    _, info_c = second.reset(seed=12)
+    assert not np.allclose(info_a["privileged_state"][36:39], info_c["privileged_state"][36:39])
+    # An unseeded reset continues the random stream: a new initial state.
+    _, info_d = first.reset()
+    assert not np.allclose(info_a["privileged_state"][4:7], info_d["privileged_state"][4:7])
+    first.close()
+    second.close()
+
+
+def test_episodes_truncate_at_max_episode_steps_and_require_reset():
+    suite = make_suite("metaworld-mt10", max_episode_steps=5)
+    env = suite.make_env("reach-v3", seed=0)
+    env.reset()
+    flags = [env.step(np.zeros(4))[3] for _ in range(5)]
+    assert flags == [False, False, False, False, True]
+    with pytest.raises(RuntimeError, match="call reset"):
+        env.step(np.zeros(4))
+    env.reset()
+    env.step(np.zeros(4))
+    env.close()
+
+
+@pytest.mark.parametrize("task_name", MT10_TASKS)
+def test_scripted_expert_succeeds(task_name):
+    suite = make_suite("metaworld-mt10")
+    results = [run_expert_episode(suite, task_name, seed)[0] for seed in (0, 1)]
+    # The expert succeeds on ~98% of episodes; door-open and peg-insert-side fail occasionally.
+    assert sum(results) >= 1, f"{task_name}: expert failed on both seeded episodes"
+
+
+@pytest.mark.slow
+def test_scripted_expert_success_rate_over_mt10():
+    suite = make_suite("metaworld-mt10")
+    rates = {}
+    for task_name in MT10_TASKS:
+        rates[task_name] = np.mean([run_expert_episode(suite, task_name, 100 + s)[0] for s in range(10)])
+    assert np.mean(list(rates.values())) >= 0.95, rates
+    assert min(rates.values()) >= 0.7, rates
+
+
+# ---------------------------------------------------------------------------------------------
+# Point clouds and images
+# ---------------------------------------------------------------------------------------------
+
+
+def test_point_cloud_is_exact_finite_and_inside_the_crop():
+    suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=512)
+    env = suite.make_env("push-v3", seed=0)
+    observation, _ = env.reset()
+    cloud = observation[POINTCLOUD_KEY]
+    assert cloud.shape == (512, 3) and cloud.dtype == np.float32
+    assert np.all(np.isfinite(cloud))
+    assert np.all(METAWORLD_CROP.contains(cloud.astype(np.float64) + 0.0))
+    assert cloud[:, 2].min() >= METAWORLD_CROP.low[2], "the table top must be cropped away"
+    env.close()
+
+
+def test_point_cloud_follows_the_arm():
+    suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=4096)
+    env = suite.make_env("reach-v3", seed=0)
+    observation, info = env.reset()
+    before = observation[POINTCLOUD_KEY]
+    hand_before = info["privileged_state"][:3]
+    for _ in range(25):
+        observation, _, _, _, info = env.step(np.array([1.0, 0.0, 0.0, 0.0]))
+    after = observation[POINTCLOUD_KEY]
+    hand_after = info["privileged_state"][:3]
+    assert hand_after[0] - hand_before[0] > 0.1, "the arm must have moved sideways"
+
+    def near(cloud, point, radius=0.06):
+        return int((np.linalg.norm(cloud - point, axis=1) < radius).sum())
+
+    assert near(after, hand_after) > 0, "points must cover the gripper at its new position"
+    assert near(after, hand_after) > 2 * near(before, hand_after)
+    assert near(before, hand_before) > 2 * near(after, hand_before)
+    env.close()
+
+
+def test_same_seed_gives_the_same_cloud():
+    suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=300)
+    clouds = []
+    for _ in range(2):
+        env = suite.make_env("drawer-open-v3", seed=5)
+        observation, _ = env.reset()
+        observation, *_ = env.step(np.array([0.1, 0.2, 0.0, 0.5]))
+        clouds.append(observation[POINTCLOUD_KEY])
+        env.close()
+    np.testing.assert_array_equal(clouds[0], clouds[1])
+
+
+def test_point_cloud_with_color():
+    suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=128, pointcloud_color=True)
+    env = suite.make_env("reach-v3", seed=0)
+    observation, _ = env.reset()
+    cloud = observation[POINTCLOUD_KEY]
+    assert cloud.shape == (128, 6) == suite.features[POINTCLOUD_KEY]["shape"]
+    assert np.all((cloud[:, 3:] >= 0) & (cloud[:, 3:] <= 1))
+    env.close()
+
+
+def test_rgb_image_is_upright_and_changes_with_the_arm():
+    suite = make_suite("metaworld-mt10", obs_mode="rgb", image_size=64)
+    env = suite.make_env("reach-v3", seed=0)
+    observation, _ = env.reset()
+    first = observation[IMAGE_KEY].copy()
+    for _ in range(20):
+        observation, *_ = env.step(np.array([1.0, 0.0, 0.0, 0.0]))
+    assert first.shape == (64, 64, 3) and first.dtype == np.uint8
+    assert np.abs(observation[IMAGE_KEY].astype(int) - first).mean() > 1.0
+    env.close()
+
+
+# ---------------------------------------------------------------------------------------------
+# Experts
+# ---------------------------------------------------------------------------------------------
+
+
+def test_plugged_in_callable_expert_is_used():
+    calls = []
+
+    def expert(state):
+        calls.append(state)
+        return np.zeros(4)
+
+    suite = make_suite("metaworld-mt10", tasks=["reach-v3"]).with_experts(
+        {"reach-v3": CallableExpert(expert)}
+    )
+    action = suite.make_expert("reach-v3").act(np.zeros(39))
+    assert action.tolist() == [0.0, 0.0, 0.0, 0.0] and len(calls) == 1
+
+
+class _TinyPolicy:
+    """Stands in for a LeRobot PreTrainedPolicy: select_action maps (1, 39) -> (1, 4)."""
+
+    def __init__(self):
+        self.resets = 0
+
+    def reset(self):
+        self.resets += 1
+
+    def select_action(self, batch):
+        return batch["observation.state"][:, :4] * 2
+
+
+def test_lerobot_policy_expert_adapter():
+    policy = _TinyPolicy()
+    expert = LeRobotPolicyExpert(policy, postprocessor=lambda a: torch.clamp(a, -1, 1))
+    expert.reset()
+    action = expert.act(np.array([0.1, -0.2, 0.9, 0.3] + [0.0] * 35))
+    np.testing.assert_allclose(action, [0.2, -0.4, 1.0, 0.6], rtol=1e-6)
+    assert policy.resets == 1
+
+
+# ---------------------------------------------------------------------------------------------
+# Vectorised collection and LeRobot datasets
+# ---------------------------------------------------------------------------------------------
+
+
+def test_vector_env_steps_several_tasks_in_parallel():
+    suite = make_suite("metaworld-mt10", tasks=["reach-v3", "button-press-topdown-v3"])
+    envs = suite.make_vector_env(suite.task_names, seeds=[0, 1])
+    experts = [suite.make_expert(t) for t in suite.task_names]
+    try:
+        observation, info = envs.reset()
+        assert observation[STATE_KEY].shape == (2, 39)
+        succeeded = np.zeros(2, dtype=bool)
+        for _ in range(200):
+            actions = np.stack([e.act(s) for e, s in zip(experts, info["privileged_state"], strict=True)])
+            observation, _, _, truncated, info = envs.step(actions)
+            succeeded |= info["success"]
+            if succeeded.all():
+                break
+        assert succeeded.all()
+        observation, info = envs.reset(options={"reset_mask": np.array([True, False])})
+    finally:
+        envs.close()
+
+
+@pytest.mark.parametrize("obs_mode", MODES)
+def test_features_create_a_lerobot_dataset(tmp_path, obs_mode):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    suite = make_suite("metaworld-mt10", tasks=["reach-v3"], obs_mode=obs_mode, num_points=64, image_size=32)
+    dataset = LeRobotDataset.create(
+        repo_id="local/test", fps=80, features=suite.features, root=tmp_path / "ds", use_videos=False
+    )
+    env = suite.make_env("reach-v3", seed=0)
+    expert = suite.make_expert("reach-v3")
+    observation, info = env.reset()
+    for _ in range(3):
+        action = expert.act(info["privileged_state"])
+        dataset.add_frame({**observation, "action": action, "task": "reach-v3"})
+        observation, _, _, _, info = env.step(action)
+    dataset.save_episode()
+    dataset.finalize()
+    env.close()
+    loaded = LeRobotDataset("local/test", root=tmp_path / "ds")
+    assert loaded.num_frames == 3
+    item = loaded[1]
+    for key, feature in suite.features.items():
+        shape = tuple(feature["shape"])
+        if feature["dtype"] == "image":
+            shape = (shape[2], shape[0], shape[1])  # LeRobot returns images channel-first
+        assert tuple(item[key].shape) == shape, key
+
+
+# ---------------------------------------------------------------------------------------------
+# Bad input
+# ---------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"name": "robosuite"}, "Unknown suite 'robosuite'; available suites"),
+        ({"name": "metaworld-mt10", "tasks": ["hammer-v3"]}, r"not in metaworld-mt10; its tasks"),
+        ({"name": "metaworld", "tasks": ["reach-v2"]}, r"Unknown MetaWorld v3 task\(s\) \['reach-v2'\]"),
+        ({"name": "metaworld"}, "needs an explicit tasks"),
+        ({"name": "metaworld-mt10", "obs_mode": "depth"}, r"Unknown obs_mode 'depth'; choose one of"),
+        ({"name": "metaworld-mt10", "obs_mode": "pointcloud", "num_points": 0}, "num_points must be > 0"),
+        ({"name": "metaworld-mt10", "tasks": ["reach-v3", "reach-v3"]}, "unique"),
+    ],
+)
+def test_make_suite_rejects_bad_input(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        make_suite(**kwargs)
+
+
+def test_suite_names_are_listed():
+    assert set(SUITE_NAMES) >= {"metaworld-mt10", "metaworld-mt25", "metaworld-mt50", "metaworld"}
+
+
+def test_unknown_task_and_camera_in_make_env():
+    suite = make_suite("metaworld-mt10", tasks=["reach-v3"])
+    with pytest.raises(ValueError, match="not in suite"):
+        suite.make_env("push-v3")
+    rgb = make_suite("metaworld-mt10", tasks=["reach-v3"], obs_mode="rgb", camera="frontview")
+    with pytest.raises(ValueError, match="Unknown camera 'frontview'; the model has cameras"):
+        rgb.make_env("reach-v3")
+
+
+def test_expert_with_wrong_action_size_is_a_clear_error():
+    suite = make_suite("metaworld-mt10", tasks=["reach-v3"]).with_experts(
+        {"reach-v3": CallableExpert(lambda state: np.zeros(3))}
+    )
+    with pytest.raises(
+        ValueError, match=r"returned an action of size 3, but the task's action space has size 4"
+    ):
+        suite.make_expert("reach-v3").act(np.zeros(39))
+
+
+def test_object_without_act_is_not_an_expert():
+    with pytest.raises(TypeError, match="wrap a function with CallableExpert"):
+        make_suite("metaworld-mt10", tasks=["reach-v3"]).with_experts({"reach-v3": lambda s: s})
+
+
+def test_bad_actions_are_rejected():
+    env = make_suite("metaworld-mt10", tasks=["reach-v3"]).make_env("reach-v3", seed=0)
+    env.reset()
+    with pytest.raises(ValueError, match="4 finite numbers"):
+        env.step(np.zeros(3))
+    with pytest.raises(ValueError, match="4 finite numbers"):
+        env.step(np.array([0.0, np.nan, 0.0, 0.0]))
+    env.close()
