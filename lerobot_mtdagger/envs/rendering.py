@@ -4,7 +4,8 @@ Rendering goes through MuJoCo's EGL backend (``MUJOCO_GL=egl``, set by ``lerobot
 unless the user chose a backend; Mesa renders on the CPU). ``MUJOCO_GL=osmesa`` is the fallback
 where EGL is missing (slower). Observation cameras render without shadows and reflections: with
 MetaWorld's 4096-pixel shadow map a CPU frame costs about four times more, and neither helps a
-policy.
+policy. They also render without multisample anti-aliasing (MuJoCo's default is 4 samples), which
+halves the cost of an RGB frame on the CPU (measured: 17.6 ms -> 7.9 ms at 84 px).
 
 Point clouds (the paper crops the background and feeds a PointNet):
 
@@ -80,8 +81,14 @@ class SceneRenderer:
     stepped in another (vectorised collection).
     """
 
-    def __init__(self, model: mujoco.MjModel, height: int, width: int) -> None:
+    def __init__(self, model: mujoco.MjModel, height: int, width: int, multisamples: int = 0) -> None:
         """Prepares a renderer for ``model`` at ``height`` x ``width`` pixels.
+
+        Args:
+            model: The MuJoCo model; its ``vis.quality.offsamples`` is set to ``multisamples``.
+            height: Image height in pixels.
+            width: Image width in pixels.
+            multisamples: Anti-aliasing samples of the offscreen buffer (0: none).
 
         Raises:
             ValueError: If the size exceeds the model's offscreen buffer.
@@ -94,6 +101,9 @@ class SceneRenderer:
                 f"Render size {height}x{width} exceeds the model's offscreen buffer {offheight}x{offwidth}; "
                 "choose a smaller image_size."
             )
+        if multisamples < 0:
+            raise ValueError(f"multisamples must be >= 0, got {multisamples}.")
+        model.vis.quality.offsamples = multisamples
         self.model = model
         self.height, self.width = height, width
         self._renderer: mujoco.Renderer | None = None
