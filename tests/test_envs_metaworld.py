@@ -9,24 +9,17 @@ import torch
 from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, SUITE_NAMES, make_suite
 from lerobot_mtdagger.envs.metaworld import METAWORLD_CROP, MT10_TASKS, MT25_TASKS, MT50_TASKS
 from lerobot_mtdagger.experts import CallableExpert, LeRobotPolicyExpert
+from lerobot_mtdagger.experts import run_expert_episode as expert_episode
 
 MODES = ("state", "rgb", "pointcloud")
 
 
 def run_expert_episode(suite, task_name: str, seed: int) -> tuple[bool, int]:
     """Runs the task's expert for one seeded episode; success if info["success"] at any step."""
-    env = suite.make_env(task_name, seed=seed)
-    expert = suite.make_expert(task_name)
+    env = suite.make_env(task_name)
     try:
-        _, info = env.reset()
-        expert.reset()
-        for step in range(1, env.max_episode_steps + 1):
-            _, _, terminated, truncated, info = env.step(expert.act(info["privileged_state"]))
-            if info["success"]:
-                return True, step
-            if terminated or truncated:
-                break
-        return False, step
+        episode = expert_episode(env, suite.make_expert(task_name), seed)
+        return episode.success, episode.steps
     finally:
         env.close()
 

@@ -17,6 +17,7 @@ wrong action size fails on its first action with a message naming the task and b
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -136,3 +137,35 @@ class ActionCheckedExpert:
         if not np.all(np.isfinite(action)):
             raise ValueError(f"The expert for task {self.task_name!r} returned a non-finite action {action}.")
         return action
+
+
+@dataclass
+class ExpertEpisode:
+    """Outcome of one expert episode: success at any step, and the step of the first success."""
+
+    seed: int
+    success: bool
+    steps: int
+
+
+def run_expert_episode(env: Any, expert: Expert, seed: int, stop_on_success: bool = True) -> ExpertEpisode:
+    """Runs ``expert`` for one seeded episode of ``env`` (the expert always acts).
+
+    Args:
+        env: A suite env (dict observations, ``info["privileged_state"]`` and ``info["success"]``).
+        expert: The task's expert.
+        seed: Reset seed.
+        stop_on_success: End at the first success (MetaWorld's success does not persist).
+
+    Returns:
+        The episode's outcome; ``steps`` is the episode length.
+    """
+    _, info = env.reset(seed=seed)
+    expert.reset()
+    success, steps = False, 0
+    while True:
+        _, _, terminated, truncated, info = env.step(expert.act(info["privileged_state"]))
+        steps += 1
+        success = success or bool(info["success"])
+        if terminated or truncated or (success and stop_on_success):
+            return ExpertEpisode(seed=seed, success=success, steps=steps)
