@@ -1,0 +1,231 @@
+"""The multitask DAgger policy: per-input encoders + learned task embedding -> MLP action head.
+
+Paper appendix "Multitask Policy Architecture": h_o = f_enc(o) (PointNet for point clouds, a CNN for
+images, an MLP for proprioception), z_i = Embedding(task index), h = [h_o, z_i], a = f_policy(h),
+trained with MSE on the experts' actions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import torch
+from lerobot.policies.pretrained import PreTrainedPolicy
+from lerobot.utils.constants import ACTION
+from torch import Tensor, nn
+
+from lerobot_mtdagger.policies.mtdagger.configuration_mtdagger import MTDAggerConfig
+
+TASK_KEY = "task"
+TASK_INDEX_KEY = "task_index"
+
+
+def mlp(input_dim: int, hidden_dims: Sequence[int], output_dim: int, dropout: float = 0.0) -> nn.Sequential:
+    """Linear-ReLU stack ending in a plain linear layer."""
+    layers: list[nn.Module] = []
+    previous = input_dim
+    for width in hidden_dims:
+        layers += [nn.Linear(previous, width), nn.ReLU()]
+        if dropout > 0:
+            layers.append(nn.Dropout(dropout))
+        previous = width
+    layers.append(nn.Linear(previous, output_dim))
+    return nn.Sequential(*layers)
+
+
+class ImageEncoder(nn.Module):
+    """Small CNN: stride-2 3x3 convolutions with ReLU, global average pool, linear projection."""
+
+    def __init__(self, in_channels: int, channels: Sequence[int], output_dim: int) -> None:
+        super().__init__()
+        layers: list[nn.Module] = []
+        previous = in_channels
+        for width in channels:
+            layers += [nn.Conv2d(previous, width, kernel_size=3, stride=2, padding=1), nn.ReLU()]
+            previous = width
+        self.convolutions = nn.Sequential(*layers)
+        self.projection = nn.Linear(previous, output_dim)
+
+    def forward(self, image: Tensor) -> Tensor:
+        """(B, C, H, W) -> (B, output_dim)."""
+        features = self.convolutions(image).mean(dim=(2, 3))  # (B, channels[-1])
+        return self.projection(features)
+
+
+class PointNetEncoder(nn.Module):
+    """PointNet: a per-point MLP shared by all points, max-pooled over points, then projected."""
+
+    def __init__(self, in_channels: int, dims: Sequence[int], output_dim: int) -> None:
+        super().__init__()
+        self.point_mlp = mlp(in_channels, dims[:-1], dims[-1])
+        self.projection = nn.Sequential(nn.ReLU(), nn.Linear(dims[-1], output_dim))
+
+    def forward(self, points: Tensor) -> Tensor:
+        """(B, N, C) -> (B, output_dim)."""
+        per_point = self.point_mlp(points)  # (B, N, dims[-1])
+        return self.projection(per_point.max(dim=1).values)
+
+
+class MTDAggerPolicy(PreTrainedPolicy):
+    """Multitask policy conditioned on a learned task embedding (LeRobot policy type ``mtdagger``)."""
+
+    config_class = MTDAggerConfig
+    name = "mtdagger"
+
+    def __init__(self, config: MTDAggerConfig, dataset_meta: Any = None, **kwargs: Any) -> None:
+        """Builds the encoders the input features call for.
+
+        Args:
+            config: The policy config; an empty ``task_names`` is filled from ``dataset_meta``.
+            dataset_meta: LeRobot dataset metadata (passed by ``make_policy``), for the task vocabulary.
+            **kwargs: Other ``make_policy`` arguments (``dataset_stats``), unused: normalisation lives in
+                the processors.
+
+        Raises:
+            ValueError: On a config without usable inputs, action or task vocabulary.
+        """
+        super().__init__(config)
+        if not config.task_names and dataset_meta is not None:
+            tasks = dataset_meta.tasks  # DataFrame indexed by task string, column task_index
+            config.task_names = [str(t) for t in tasks.sort_values("task_index").index]
+        config.validate_features()
+        self.config = config
+        self._task_lookup = {name: i for i, name in enumerate(config.task_names)}
+        self.task_embedding = nn.Embedding(len(config.task_names), config.task_embedding_dim)
+        fused = config.task_embedding_dim
+
+        self.vector_keys = sorted(config.vector_features)
+        self.state_encoder: nn.Module | None = None
+        if self.vector_keys:
+            state_dim = sum(config.vector_features[k].shape[0] for k in self.vector_keys)
+            self.state_encoder = mlp(state_dim, config.state_hidden_dims, config.state_embedding_dim)
+            fused += config.state_embedding_dim
+
+        self.image_keys = sorted(config.image_features)
+        self.image_encoder: nn.Module | None = None
+        if self.image_keys:
+            in_channels = config.image_features[self.image_keys[0]].shape[0]
+            self.image_encoder = ImageEncoder(in_channels, config.image_channels, config.image_embedding_dim)
+            fused += config.image_embedding_dim * len(self.image_keys)
+
+        self.pointcloud_keys = sorted(config.pointcloud_features)
+        self.pointcloud_encoders = nn.ModuleDict()
+        for index, key in enumerate(self.pointcloud_keys):
+            channels = config.pointcloud_features[key].shape[1]
+            self.pointcloud_encoders[str(index)] = PointNetEncoder(
+                channels, config.pointnet_dims, config.pointcloud_embedding_dim
+            )
+            fused += config.pointcloud_embedding_dim
+
+        action_dim = config.output_features[ACTION].shape[0]
+        self.head = mlp(fused, config.head_hidden_dims, action_dim, dropout=config.dropout)
+
+    # ---------------------------------------------------------------------------------------------
+    # Task conditioning
+    # ---------------------------------------------------------------------------------------------
+
+    def task_indices(self, batch: dict[str, Any]) -> Tensor:
+        """Task index per sample: from the ``task`` strings when present, else ``task_index``.
+
+        The strings are authoritative: a dataset's own ``task_index`` is numbered in first-seen order
+        and may differ from the policy's vocabulary.
+
+        Raises:
+            ValueError: On a task string not in ``config.task_names`` or no task information at all.
+        """
+        device = self.task_embedding.weight.device
+        tasks = batch.get(TASK_KEY)
+        if tasks is not None:
+            if isinstance(tasks, str):
+                tasks = [tasks]
+            unknown = sorted({t for t in tasks if t not in self._task_lookup})
+            if unknown:
+                raise ValueError(
+                    f"Unknown task(s) {unknown}: this policy was trained on {self.config.task_names}."
+                )
+            return torch.tensor([self._task_lookup[t] for t in tasks], device=device, dtype=torch.long)
+        if TASK_INDEX_KEY in batch:
+            index = torch.as_tensor(batch[TASK_INDEX_KEY], device=device).long().reshape(-1)
+            if index.numel() and (index.min() < 0 or index.max() >= len(self.config.task_names)):
+                raise ValueError(
+                    f"task_index out of range [0, {len(self.config.task_names)}): {index.tolist()}."
+                )
+            return index
+        raise ValueError("The batch has neither 'task' strings nor 'task_index': the policy needs the task.")
+
+    # ---------------------------------------------------------------------------------------------
+    # Network
+    # ---------------------------------------------------------------------------------------------
+
+    def predict(self, batch: dict[str, Any]) -> Tensor:
+        """Normalised action for a normalised observation batch, (B, action_dim)."""
+        features = [self.task_embedding(self.task_indices(batch))]
+        if self.state_encoder is not None:
+            state = torch.cat([batch[k].flatten(start_dim=1) for k in self.vector_keys], dim=1)
+            features.append(self.state_encoder(state))
+        if self.image_encoder is not None:
+            features += [self.image_encoder(batch[k]) for k in self.image_keys]
+        for index, key in enumerate(self.pointcloud_keys):
+            features.append(self.pointcloud_encoders[str(index)](batch[key]))
+        batch_size = features[0].shape[0]
+        for feature in features[1:]:
+            if feature.shape[0] != batch_size:
+                raise ValueError(f"Batch has {feature.shape[0]} observations but {batch_size} task entries.")
+        return self.head(torch.cat(features, dim=1))
+
+    def forward(self, batch: dict[str, Any]) -> tuple[Tensor, dict[str, Any]]:
+        """MSE to the expert action, overall and per task.
+
+        Returns:
+            The mean loss over the batch, and ``{"loss": float, "per_task_loss": {task: mean loss},
+            "per_task_count": {task: samples}}`` for the tasks present in the batch.
+        """
+        prediction = self.predict(batch)
+        per_sample = ((prediction - batch[ACTION]) ** 2).mean(dim=1)  # (B,)
+        loss = per_sample.mean()
+        indices = self.task_indices(batch)
+        per_task, counts = per_task_means(per_sample.detach(), indices, len(self.config.task_names))
+        present = torch.nonzero(counts).flatten().tolist()
+        names = self.config.task_names
+        return loss, {
+            "loss": loss.item(),
+            "per_task_loss": {names[i]: per_task[i].item() for i in present},
+            "per_task_count": {names[i]: int(counts[i].item()) for i in present},
+        }
+
+    @torch.no_grad()
+    def predict_action_chunk(self, batch: dict[str, Any], **kwargs: Any) -> Tensor:
+        """A one-step chunk, (B, 1, action_dim)."""
+        return self.predict(batch).unsqueeze(1)
+
+    @torch.no_grad()
+    def select_action(self, batch: dict[str, Any], **kwargs: Any) -> Tensor:
+        """The action for each observation of the batch, (B, action_dim)."""
+        self.eval()
+        return self.predict(batch)
+
+    def reset(self) -> None:
+        """The policy has no per-episode state."""
+
+    def get_optim_params(self) -> dict:
+        """All parameters, one group."""
+        return self.parameters()
+
+
+def per_task_means(values: Tensor, task_index: Tensor, num_tasks: int) -> tuple[Tensor, Tensor]:
+    """Mean of ``values`` per task and the sample count per task (0 where absent).
+
+    Args:
+        values: (B,) per-sample values.
+        task_index: (B,) task index per sample.
+        num_tasks: Size of the vocabulary.
+
+    Returns:
+        ``(means, counts)``, each (num_tasks,).
+    """
+    sums = torch.zeros(num_tasks, device=values.device, dtype=values.dtype).index_add_(0, task_index, values)
+    counts = torch.zeros(num_tasks, device=values.device, dtype=values.dtype).index_add_(
+        0, task_index, torch.ones_like(values)
+    )
+    return sums / counts.clamp(min=1), counts
