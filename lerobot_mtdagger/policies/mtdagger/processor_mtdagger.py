@@ -3,12 +3,14 @@
 As LeRobot's own policies: rename, add a batch dimension, move to the device, normalise inputs and
 the action; unnormalise the predicted action and move it to the CPU.
 
-Point clouds: LeRobot types an (N, C) feature as STATE and computes its statistics per point, as if
-point k of one frame were the same quantity as point k of the next. Points are unordered samples, so
-``pool_pointcloud_stats`` replaces those per-point statistics by per-channel ones pooled over all
-points (mean, pooled std, min, max; quantiles averaged), broadcast back to (N, C): every point is
-normalised by the same per-channel transform, and the pooled statistics are saved with the
-processor like any other.
+Point clouds: LeRobot types an (N, C) feature as STATE, so its normaliser applies the feature's
+statistics elementwise. Points are unordered samples: point k of one frame is not the same quantity
+as point k of the next, so per-point statistics would be meaningless. LeRobot 0.4.4's
+``compute_episode_stats`` already reduces an (N, C) feature to per-channel (C,) statistics (checked on
+a recorded point-cloud dataset); statistics that arrive per point, (N, C) (other writers, hand-made
+stats), are pooled by ``pool_pointcloud_stats`` into per-channel ones (mean, pooled std, min, max;
+quantiles averaged) broadcast back to (N, C). Either way every point is normalised by the same
+per-channel transform, saved with the processor like any other statistics.
 """
 
 from __future__ import annotations

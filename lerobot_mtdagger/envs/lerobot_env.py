@@ -1,0 +1,167 @@
+r"""Our suites as a LeRobot env plugin, so stock ``lerobot-eval`` can evaluate a policy on one task.
+
+Usage::
+
+    lerobot-eval --policy.path=<checkpoint>/pretrained_model \
+        --env.discover_packages_path=lerobot_mtdagger.envs --env.type=mtdagger_suite \
+        --env.suite=metaworld-mt10 --env.task=reach-v3 --eval.n_episodes=10 --eval.batch_size=1
+
+The type name avoids "metaworld": LeRobot 0.4.4 routes any env type containing it to its own
+MetaWorld code. The gym env emits the raw keys LeRobot's ``preprocess_observation`` keeps:
+``agent_pos`` (-> ``observation.state``), ``pixels`` (-> ``observation.image``) and
+``environment_state`` for the point cloud (-> ``observation.environment_state``; LeRobot 0.4.4 drops
+any other key). A point-cloud policy reads ``observation.pointcloud``, so evaluate it with
+``--rename_map='{"observation.environment_state": "observation.pointcloud"}'``: lerobot-eval hands the
+map to the policy's rename step, which runs before normalisation.
+
+The env reports the task string (its unique task name) as ``task_description``, which LeRobot passes
+to the policy as ``observation["task"]``; episodes terminate at the first success (MetaWorld's
+success does not persist, and lerobot-eval reads ``is_success`` only at an episode's last step).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.envs.registration import register, registry
+from lerobot.configs.types import FeatureType, PolicyFeature
+from lerobot.envs.configs import EnvConfig
+
+# Importing the policies registers the ``mtdagger`` policy type: lerobot-eval decodes the checkpoint's
+# config before it could honour a --policy.discover_packages_path (LeRobot 0.4.4 passes that flag on
+# to the config as an unknown field when --policy.path is given), so the env plugin brings it along.
+import lerobot_mtdagger.policies  # noqa: F401
+from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, make_suite
+
+GYM_ID = "MTDAgger/Suite-v0"
+RAW_KEYS = {STATE_KEY: "agent_pos", IMAGE_KEY: "pixels", POINTCLOUD_KEY: "environment_state"}
+
+
+class LeRobotSuiteEnv(gym.Env):
+    """One task of a suite with LeRobot's raw observation keys; terminates at the first success."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 80}
+
+    def __init__(
+        self,
+        suite: str = "metaworld-mt10",
+        task: str = "reach-v3",
+        obs_mode: str = "state",
+        image_size: int = 84,
+        num_points: int = 1024,
+        episode_length: int | None = None,
+        render_mode: str | None = "rgb_array",
+    ) -> None:
+        """Builds the suite env of ``task``."""
+        kwargs = {"obs_mode": obs_mode, "image_size": image_size, "num_points": num_points}
+        self._suite = make_suite(suite, tasks=[task], max_episode_steps=episode_length, **kwargs)
+        self._env = self._suite.make_env(task)
+        self.task_description = task
+        self.render_mode = render_mode
+        self._max_episode_steps = self._env.max_episode_steps
+        self.action_space = self._env.action_space
+        self.observation_space = gym.spaces.Dict(
+            {RAW_KEYS[k]: space for k, space in self._env.observation_space.spaces.items()}
+        )
+
+    @staticmethod
+    def _raw(observation: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        return {RAW_KEYS[k]: v for k, v in observation.items()}
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None) -> tuple[dict, dict]:
+        """Resets the task env."""
+        observation, info = self._env.reset(seed=seed)
+        return self._raw(observation), {"is_success": False}
+
+    def step(self, action: np.ndarray) -> tuple[dict, float, bool, bool, dict]:
+        """Steps the task env; ``terminated`` at the first success."""
+        observation, reward, _, truncated, info = self._env.step(action)
+        success = bool(info["success"])
+        return self._raw(observation), reward, success, truncated, {"is_success": success}
+
+    def render(self) -> np.ndarray:
+        """An RGB frame for LeRobot's eval videos."""
+        return self._env.render()
+
+    def close(self) -> None:
+        """Closes the task env."""
+        self._env.close()
+
+
+if GYM_ID not in registry:
+    # No order-enforcing wrapper: lerobot-eval reads task_description off the env itself.
+    register(
+        id=GYM_ID, entry_point=f"{__name__}:LeRobotSuiteEnv", order_enforce=False, disable_env_checker=True
+    )
+
+
+@EnvConfig.register_subclass("mtdagger_suite")
+@dataclass
+class MTDAggerSuiteEnvConfig(EnvConfig):
+    """``--env.type=mtdagger_suite``: one task of a lerobot-mtdagger suite for ``lerobot-eval``.
+
+    Attributes:
+        suite: Suite name (``make_suite``).
+        task: Task name within the suite (also the task string handed to the policy).
+        obs_mode: ``state``, ``rgb`` or ``pointcloud``; must match what the policy was trained on.
+        image_size: RGB side in pixels.
+        num_points: Points per cloud.
+        episode_length: Truncation length (the task's default when None).
+    """
+
+    suite: str = "metaworld-mt10"
+    task: str | None = "reach-v3"
+    obs_mode: str = "state"
+    image_size: int = 84
+    num_points: int = 1024
+    episode_length: int | None = None
+    fps: int = 80
+    features: dict[str, PolicyFeature] = field(default_factory=dict)
+    features_map: dict[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        suite = make_suite(
+            self.suite,
+            tasks=[self.task] if self.task else None,
+            obs_mode=self.obs_mode,
+            image_size=self.image_size,
+            num_points=self.num_points,
+        )
+        self.features, self.features_map = {}, {}
+        for key, feature in suite.features.items():
+            if key == "action":
+                self.features["action"] = PolicyFeature(
+                    type=FeatureType.ACTION, shape=tuple(feature["shape"])
+                )
+                self.features_map["action"] = "action"
+                continue
+            raw = RAW_KEYS[key]
+            shape = tuple(feature["shape"])
+            feature_type = FeatureType.VISUAL if feature["dtype"] == "image" else FeatureType.STATE
+            self.features[raw] = PolicyFeature(type=feature_type, shape=shape)
+            self.features_map[raw] = key if key != POINTCLOUD_KEY else "observation.environment_state"
+
+    @property
+    def package_name(self) -> str:
+        """The module that registers the gym id."""
+        return __name__
+
+    @property
+    def gym_id(self) -> str:
+        """One gym id for every suite and task; ``gym_kwargs`` select them."""
+        return GYM_ID
+
+    @property
+    def gym_kwargs(self) -> dict[str, Any]:
+        """Arguments of ``LeRobotSuiteEnv``."""
+        return {
+            "suite": self.suite,
+            "task": self.task,
+            "obs_mode": self.obs_mode,
+            "image_size": self.image_size,
+            "num_points": self.num_points,
+            "episode_length": self.episode_length,
+        }

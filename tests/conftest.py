@@ -1,0 +1,48 @@
+"""Shared test factories."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+
+def record_expert_dataset(
+    root: Path, suite, episodes_per_task: int = 2, steps: int = 40, repo_id: str = "local/tiny"
+):
+    """Records expert episodes of every task of ``suite`` into a new LeRobotDataset at ``root``.
+
+    The task vocabulary is fixed to ``suite.task_names`` right after creation, so task_index i is
+    ``suite.task_names[i]``.
+    """
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    dataset = LeRobotDataset.create(
+        repo_id=repo_id, fps=80, features=suite.features, root=root, use_videos=False
+    )
+    dataset.meta.save_episode_tasks(suite.task_names)
+    for task_name in suite.task_names:
+        env, expert = suite.make_env(task_name), suite.make_expert(task_name)
+        for seed in range(episodes_per_task):
+            observation, info = env.reset(seed=seed)
+            expert.reset()
+            for _ in range(steps):
+                action = expert.act(info["privileged_state"])
+                dataset.add_frame({**observation, "action": action, "task": task_name})
+                observation, _, _, _, info = env.step(action)
+            dataset.save_episode()
+        env.close()
+    dataset.finalize()
+    return dataset
+
+
+@pytest.fixture
+def expert_dataset_factory(tmp_path):
+    """Builds small expert datasets under the test's tmp dir: ``factory(suite, name) -> root``."""
+
+    def factory(suite, name: str = "dataset", **kwargs) -> Path:
+        root = tmp_path / name
+        record_expert_dataset(root, suite, **kwargs)
+        return root
+
+    return factory
