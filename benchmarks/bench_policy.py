@@ -1,0 +1,109 @@
+"""Training throughput and batch-1 inference latency of the ``mtdagger`` policy on the CPU.
+
+Run: ``.venv/bin/python benchmarks/bench_policy.py``. Default model sizes; inputs as the suites emit
+them: state (39-d), RGB 84 px + 7-d state, point cloud 1024 x 3 + 7-d state. The modes are measured
+in interleaved rounds in one run, so their ratios are side by side. The DAgger loop queries the
+policy every step, so the batch-1 latency bounds the collection rate.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import torch
+from lerobot.configs.types import FeatureType, PolicyFeature
+
+from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
+
+TASKS = [f"task-{i}" for i in range(10)]
+PROPRIO = PolicyFeature(type=FeatureType.STATE, shape=(7,))
+MODES = {
+    "state": {"observation.state": PolicyFeature(type=FeatureType.STATE, shape=(39,))},
+    "rgb 84 px": {
+        "observation.state": PROPRIO,
+        "observation.image": PolicyFeature(FeatureType.VISUAL, (3, 84, 84)),
+    },
+    "pointcloud 1024": {
+        "observation.state": PROPRIO,
+        "observation.pointcloud": PolicyFeature(type=FeatureType.STATE, shape=(1024, 3)),
+    },
+}
+
+
+def make_policy(inputs) -> MTDAggerPolicy:
+    config = MTDAggerConfig(
+        device="cpu",
+        task_names=TASKS,
+        input_features=inputs,
+        output_features={"action": PolicyFeature(type=FeatureType.ACTION, shape=(4,))},
+    )
+    return MTDAggerPolicy(config)
+
+
+def make_batch(inputs, batch_size: int) -> dict:
+    batch = {k: torch.randn(batch_size, *ft.shape) for k, ft in inputs.items()}
+    batch["action"] = torch.randn(batch_size, 4)
+    batch["task"] = [TASKS[i % len(TASKS)] for i in range(batch_size)]
+    return batch
+
+
+def train_rate(policy, optimizer, batch, steps: int) -> float:
+    start = time.perf_counter()
+    for _ in range(steps):
+        loss, _ = policy.forward(batch)
+        optimizer.zero_grad()
+        loss.backward()
+        optimizer.step()
+    return steps * len(batch["task"]) / (time.perf_counter() - start)
+
+
+def latency_ms(policy, batch, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        policy.select_action(batch)
+        times.append(time.perf_counter() - start)
+    return statistics.median(times) * 1e3
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--batch-size", type=int, default=256)
+    parser.add_argument("--steps", type=int, default=10)
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--threads", type=int, default=torch.get_num_threads())
+    args = parser.parse_args()
+    torch.manual_seed(0)
+    torch.set_num_threads(args.threads)
+    setups = {}
+    for name, inputs in MODES.items():
+        policy = make_policy(inputs)
+        optimizer = torch.optim.AdamW(policy.parameters(), lr=3e-4)
+        setups[name] = (policy, optimizer, make_batch(inputs, args.batch_size), make_batch(inputs, 1))
+        train_rate(policy, optimizer, setups[name][2], 1)  # warm-up
+    rates = {name: [] for name in MODES}
+    latencies = {name: [] for name in MODES}
+    for _ in range(args.rounds):
+        for name, (policy, optimizer, batch, single) in setups.items():
+            policy.train()
+            rates[name].append(train_rate(policy, optimizer, batch, args.steps))
+            latencies[name].append(latency_ms(policy, single, 50))
+    print(
+        f"torch {torch.__version__}, {args.threads} threads, batch {args.batch_size}, "
+        f"median of {args.rounds} rounds"
+    )
+    header = ["input", "params", "train samples/s", "vs state", "batch-1 latency ms"]
+    print("| " + " | ".join(header) + " |")
+    print("|" + "|".join("---" for _ in header) + "|")
+    reference = statistics.median(rates["state"])
+    for name, (policy, *_rest) in setups.items():
+        params = sum(p.numel() for p in policy.parameters())
+        rate = statistics.median(rates[name])
+        latency = statistics.median(latencies[name])
+        print(f"| {name:<16} | {params:>8} | {rate:>15.0f} | {rate / reference:>8.3f} | {latency:>18.3f} |")
+
+
+if __name__ == "__main__":
+    main()
