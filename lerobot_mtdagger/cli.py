@@ -4,6 +4,13 @@ Usage: ``lerobot-mtdagger <command> [--option=value ...]``. Options are parsed b
 configs are set with dots, for example ``--scheduler.type=need --scheduler.temperature=0.5``.
 
 Commands:
+    run: one Multitask DAgger experiment (``--preset``, ``--suite``, ``--tasks``, ``--scheduler.type``,
+        ``--rounds``, ``--budget``, ``--output_dir``, ``--resume``, ...; see ``RunConfig``).
+    eval: success per task of a pretrained policy (``--policy_path``, ``--suite``, ``--episodes``).
+    verify: recompute every round's allocation from its record (``--experiment_dir``).
+    merge: rounds 0..k as one LeRobotDataset (``--experiment_dir``, ``--output``).
+    push: round datasets (tag ``round-{k:03d}`` each) and round policies to the Hub
+        (``--experiment_dir``, ``--repo_id``, ``--policy_repo_id``).
     demo: run the performance-aware scheduler on synthetic tasks and print each round's allocation
         (no simulator, no policy; shows how the methods split a budget).
 """
@@ -20,6 +27,8 @@ from pathlib import Path
 import draccus
 import numpy as np
 
+from lerobot_mtdagger.configs import RunConfig
+from lerobot_mtdagger.hub import PushConfig, push_command
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig, scheduler_from_config
 from lerobot_mtdagger.simulate import SyntheticTasks, simulate
 
@@ -87,7 +96,153 @@ def run_demo(config: DemoConfig) -> list[dict]:
     return records
 
 
-COMMANDS: dict[str, tuple[type, Callable]] = {"demo": (DemoConfig, run_demo)}
+def run_experiment(config: RunConfig) -> list[str]:
+    """Runs ``lerobot-mtdagger run`` and prints the per-round summary."""
+    import datasets
+
+    from lerobot_mtdagger.dagger import run
+
+    datasets.disable_progress_bars()  # one "Map" bar per episode otherwise
+    lines = run(config)
+    print(f"experiment {config.output_dir} ({config.method}, seed {config.seed}):")
+    for line in lines:
+        print(line)
+    return lines
+
+
+@dataclass
+class VerifyConfig:
+    """Options of ``lerobot-mtdagger verify``.
+
+    Attributes:
+        experiment_dir: The experiment's output directory.
+    """
+
+    experiment_dir: Path | None = None
+
+    def __post_init__(self) -> None:
+        if self.experiment_dir is None:
+            raise ValueError("--experiment_dir is required (the output_dir of a run).")
+
+
+def verify_command(config: VerifyConfig) -> list[str]:
+    """Recomputes every round's allocation from its record and checks it against the data."""
+    from lerobot_mtdagger.rounds import ExperimentDir, verify_experiment
+
+    experiment = ExperimentDir(config.experiment_dir)
+    problems = verify_experiment(experiment)
+    rounds = experiment.committed_rounds()
+    for problem in problems:
+        print(f"MISMATCH {problem}")
+    print(f"verified {len(rounds)} round(s) in {config.experiment_dir}: {len(problems)} problem(s)")
+    if problems:
+        raise SystemExit(1)
+    return problems
+
+
+@dataclass
+class MergeConfig:
+    """Options of ``lerobot-mtdagger merge``: D(k) = rounds 0..k as ONE LeRobotDataset.
+
+    Attributes:
+        experiment_dir: The experiment's output directory.
+        output: Folder of the merged dataset (must not exist).
+        up_to_round: Last round to merge (None: the last committed one).
+        repo_id: Repo id written into the merged dataset's metadata.
+    """
+
+    experiment_dir: Path | None = None
+    output: Path | None = None
+    up_to_round: int | None = None
+    repo_id: str = "local/merged"
+
+    def __post_init__(self) -> None:
+        if self.experiment_dir is None or self.output is None:
+            raise ValueError("--experiment_dir and --output are required.")
+
+
+def merge_command(config: MergeConfig) -> Path:
+    """Merges rounds 0..k with LeRobot's aggregation; the result trains with stock lerobot-train."""
+    from lerobot_mtdagger.rounds import ExperimentDir, merge_rounds
+
+    experiment = ExperimentDir(config.experiment_dir)
+    rounds = experiment.committed_rounds()
+    last = rounds[-1] if config.up_to_round is None else config.up_to_round
+    if last not in rounds:
+        raise ValueError(f"Round {last} is not committed in {config.experiment_dir}; committed: {rounds}.")
+    output = merge_rounds(experiment, list(range(last + 1)), config.output, config.repo_id)
+    print(f"merged rounds 0..{last} into {output}")
+    return output
+
+
+@dataclass
+class EvalConfig:
+    """Options of ``lerobot-mtdagger eval``: success per task of a pretrained ``mtdagger`` policy.
+
+    Attributes:
+        policy_path: Pretrained model folder or Hub id (with its processors).
+        suite: Task suite.
+        tasks: Tasks to evaluate (all the suite's when empty).
+        obs_mode: Observation mode the policy was trained on.
+        episodes: Episodes per task.
+        seed: Seed of the evaluation episodes.
+        num_points: Points per cloud.
+        image_size: Image side.
+        output: Optional JSON file for the results.
+    """
+
+    policy_path: str | None = None
+    suite: str = "metaworld-mt10"
+    tasks: list[str] = field(default_factory=list)
+    obs_mode: str = "state"
+    episodes: int = 10
+    seed: int = 0
+    num_points: int = 1024
+    image_size: int = 84
+    output: Path | None = None
+
+    def __post_init__(self) -> None:
+        if self.policy_path is None:
+            raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
+        if self.episodes <= 0:
+            raise ValueError(f"episodes must be > 0, got {self.episodes}.")
+
+
+def eval_command(config: EvalConfig) -> dict:
+    """Evaluates a pretrained policy per task with the pure policy acting."""
+    from lerobot_mtdagger.envs import make_suite
+    from lerobot_mtdagger.evaluate import PolicyRunner, evaluate
+
+    suite = make_suite(
+        config.suite,
+        tasks=config.tasks or None,
+        obs_mode=config.obs_mode,
+        num_points=config.num_points,
+        image_size=config.image_size,
+    )
+    runner = PolicyRunner.from_pretrained(config.policy_path)
+    envs = [suite.make_env(task) for task in suite.task_names]
+    try:
+        result, _ = evaluate(suite, envs, runner, config.episodes, config.seed)
+    finally:
+        for env in envs:
+            env.close()
+    for task, success in zip(result.task_names, result.success, strict=True):
+        print(f"{task:<32} {success:.3f}")
+    print(f"{'mean':<32} {result.mean:.3f}")
+    if config.output is not None:
+        config.output.write_text(json.dumps(result.to_dict(), indent=2))
+    return result.to_dict()
+
+
+COMMANDS: dict[str, tuple[type, Callable]] = {
+    "run": (RunConfig, run_experiment),
+    "eval": (EvalConfig, eval_command),
+    "verify": (VerifyConfig, verify_command),
+    "merge": (MergeConfig, merge_command),
+    "push": (PushConfig, push_command),
+    "demo": (DemoConfig, run_demo),
+}
 
 
 def _usage() -> str:

@@ -1,0 +1,238 @@
+"""Command-line configs of ``lerobot-mtdagger run`` (draccus dataclasses) and the paper's presets.
+
+Every field left at None is filled from the selected preset (``--preset``), then from the small
+default (``small``: MT10 state, a few rounds, minutes on a 2-core CPU). Presets follow the paper's
+"Setup" and hyperparameter table:
+
+=====================  =========  =============  ===================  =====  ==========  ======
+preset                 obs_mode   initial demos  budget per round      n_min  lr          batch
+=====================  =========  =============  ===================  =====  ==========  ======
+small                  state      3 per task     3 per task            1      3e-4        256
+metaworld-state        state      3 per task     3 per task            1      3e-4        1024
+metaworld-pixels       rgb        40 per task    20 per task           1      3e-4        1024
+drawers-pointcloud     pointcloud 30 per task    30 per task           5      1e-4        256
+=====================  =========  =============  ===================  =====  ==========  ======
+
+The DAgger mixing coefficient ``beta`` is the probability that the EXPERT's action is executed at
+a step (classic DAgger; the paper's text is ambiguous): 0.5 in the first DAgger round, decayed by
+0.5 per round to 0.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
+
+
+@SchedulerConfig.register_subclass("bc")
+@dataclass
+class BCSchedulerConfig(SchedulerConfig):
+    """Behaviour-cloning baseline: ONE round of expert demonstrations with the same total budget.
+
+    ``initial_demos + rounds * budget / num_tasks`` expert episodes per task in round 0, then
+    ``(rounds + 1) * steps_per_round`` training steps: the data and compute of the DAgger run.
+    """
+
+
+@dataclass
+class PolicyOptions:
+    """Options of the ``mtdagger`` policy and its training (None: from the preset).
+
+    Attributes:
+        batch_size: Training batch size.
+        lr: AdamW learning rate.
+        state_hidden_dims: Hidden sizes of the state MLP.
+        head_hidden_dims: Hidden sizes of the action head.
+        pointnet_dims: PointNet per-point MLP sizes.
+        task_embedding_dim: Task embedding size.
+        device: Torch device.
+    """
+
+    batch_size: int | None = None
+    lr: float | None = None
+    state_hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
+    head_hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
+    pointnet_dims: list[int] = field(default_factory=lambda: [64, 128, 256])
+    task_embedding_dim: int = 32
+    device: str = "cpu"
+
+
+PRESETS: dict[str, dict[str, Any]] = {
+    "small": {
+        "suite": "metaworld-mt10",
+        "obs_mode": "state",
+        "rounds": 3,
+        "initial_demos": 3,
+        "budget_per_task": 3,
+        "steps_per_round": 1500,
+        "eval_episodes": 5,
+        "n_min": 1,
+        "lr": 3e-4,
+        "batch_size": 256,
+    },
+    "metaworld-state": {
+        "suite": "metaworld-mt50",
+        "obs_mode": "state",
+        "rounds": 10,
+        "initial_demos": 3,
+        "budget_per_task": 3,
+        "steps_per_round": 3000,
+        "eval_episodes": 10,
+        "n_min": 1,
+        "lr": 3e-4,
+        "batch_size": 1024,
+    },
+    "metaworld-pixels": {
+        "suite": "metaworld-mt10",
+        "obs_mode": "rgb",
+        "rounds": 5,
+        "initial_demos": 40,
+        "budget_per_task": 20,
+        "steps_per_round": 3000,
+        "eval_episodes": 10,
+        "n_min": 1,
+        "lr": 3e-4,
+        "batch_size": 1024,
+    },
+    "drawers-pointcloud": {
+        "suite": "drawers",
+        "obs_mode": "pointcloud",
+        "rounds": 10,
+        "initial_demos": 30,
+        "budget_per_task": 30,
+        "steps_per_round": 3000,
+        "eval_episodes": 10,
+        "n_min": 5,
+        "lr": 1e-4,
+        "batch_size": 256,
+    },
+}
+
+
+@dataclass
+class RunConfig:
+    """Options of ``lerobot-mtdagger run`` (one Multitask DAgger experiment).
+
+    Attributes:
+        preset: One of ``PRESETS``; fills every option left unset.
+        suite: Task suite (``make_suite`` name).
+        tasks: Subset of the suite's tasks (all when empty).
+        obs_mode: ``state``, ``rgb`` or ``pointcloud``.
+        scheduler: ``--scheduler.type=uniform|need|need_raw|gain|bc`` and its hyperparameters.
+        rounds: DAgger rounds after round 0.
+        budget: Expert episodes per DAgger round over all tasks (None: budget_per_task * tasks).
+        budget_per_task: Used when ``budget`` is None.
+        initial_demos: Round-0 expert episodes per task.
+        steps_per_round: Training steps after each round.
+        eval_episodes: Evaluation episodes per task after each training phase.
+        beta: Probability of executing the expert's action in the first DAgger round.
+        beta_decay: Subtracted from beta after every DAgger round.
+        beta_min: Floor of beta.
+        warm_start: Continue from the previous round's weights (else retrain from scratch).
+        gain_split: ``train`` (per-task loss on the training data) or ``heldout`` (on held-out episodes).
+        heldout_fraction: Fraction of each task's episodes held out when ``gain_split=heldout``.
+        max_rollout_steps: Steps after which a DAgger rollout is cut (failed rollouts of 500 steps
+            flood the data with far-off states).
+        steps_after_success: Steps recorded after the first success before an episode ends.
+        num_points: Points per cloud (pointcloud mode).
+        image_size: Image side (rgb mode).
+        policy: Policy and optimiser options.
+        output_dir: Experiment directory (refused if it exists, unless ``resume``); default
+            ``outputs/mtdagger/<preset>-<method>-seed<seed>``.
+        seed: Seed of everything (collection, evaluation, training).
+        resume: Continue the experiment in ``output_dir`` from its last committed round.
+        progress: Show progress bars (only on a terminal).
+        n_min: Minimum episodes per task per round (None: from the preset; overrides scheduler.n_min).
+    """
+
+    preset: str = "small"
+    suite: str | None = None
+    tasks: list[str] = field(default_factory=list)
+    obs_mode: str | None = None
+    scheduler: SchedulerConfig = field(default_factory=NeedSchedulerConfig)
+    rounds: int | None = None
+    budget: int | None = None
+    budget_per_task: int | None = None
+    initial_demos: int | None = None
+    steps_per_round: int | None = None
+    eval_episodes: int | None = None
+    beta: float = 0.5
+    beta_decay: float = 0.5
+    beta_min: float = 0.0
+    warm_start: bool = True
+    gain_split: str = "train"
+    heldout_fraction: float = 0.2
+    max_rollout_steps: int = 200
+    steps_after_success: int = 10
+    num_points: int = 1024
+    image_size: int = 84
+    policy: PolicyOptions = field(default_factory=PolicyOptions)
+    output_dir: Path | None = None
+    seed: int = 0
+    resume: bool = False
+    progress: bool = True
+    n_min: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.preset not in PRESETS:
+            raise ValueError(f"Unknown preset {self.preset!r}; presets: {list(PRESETS)}.")
+        preset = PRESETS[self.preset]
+        for name in ("suite", "obs_mode", "rounds", "initial_demos", "budget_per_task", "steps_per_round"):
+            if getattr(self, name) is None:
+                setattr(self, name, preset[name])
+        if self.eval_episodes is None:
+            self.eval_episodes = preset["eval_episodes"]
+        if self.n_min is None:
+            self.n_min = preset["n_min"]
+        self.scheduler.n_min = self.n_min
+        if self.policy.lr is None:
+            self.policy.lr = preset["lr"]
+        if self.policy.batch_size is None:
+            self.policy.batch_size = preset["batch_size"]
+        if self.output_dir is None:
+            self.output_dir = Path("outputs") / "mtdagger" / f"{self.preset}-{self.method}-seed{self.seed}"
+        self._check()
+
+    def _check(self) -> None:
+        for name in ("rounds", "initial_demos", "eval_episodes", "steps_after_success"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}.")
+        for name in ("steps_per_round", "budget_per_task", "max_rollout_steps"):
+            if getattr(self, name) <= 0:
+                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}.")
+        if self.initial_demos == 0:
+            raise ValueError("initial_demos must be > 0: round 0 trains the first policy on expert demos.")
+        if not 0.0 <= self.beta_min <= self.beta <= 1.0 or self.beta_decay < 0:
+            raise ValueError(
+                f"Need 0 <= beta_min <= beta <= 1 and beta_decay >= 0, got beta={self.beta}, "
+                f"beta_min={self.beta_min}, beta_decay={self.beta_decay}."
+            )
+        if self.gain_split not in ("train", "heldout"):
+            raise ValueError(f"gain_split must be 'train' or 'heldout', got {self.gain_split!r}.")
+        if not 0.0 < self.heldout_fraction < 1.0:
+            raise ValueError(f"heldout_fraction must be in (0, 1), got {self.heldout_fraction}.")
+        if self.policy.batch_size <= 0 or self.policy.lr <= 0:
+            raise ValueError(
+                f"policy.batch_size and policy.lr must be > 0, "
+                f"got {self.policy.batch_size}, {self.policy.lr}."
+            )
+
+    @property
+    def method(self) -> str:
+        """The experiment's method: ``bc`` or a scheduling method."""
+        return self.scheduler.type
+
+    def budget_for(self, num_tasks: int) -> int:
+        """Expert episodes per DAgger round."""
+        return self.budget if self.budget is not None else self.budget_per_task * num_tasks
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form (stored in every round's record)."""
+        record = dataclasses.asdict(self)
+        record["output_dir"] = str(self.output_dir)
+        record["scheduler"] = {"type": self.scheduler.type, **self.scheduler.hyperparameters()}
+        return record

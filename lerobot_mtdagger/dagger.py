@@ -1,0 +1,406 @@
+"""Algorithm 1 of the paper (appendix "Algorithm Details"): Multitask DAgger, end to end, resumable.
+
+The loop, with round k's dataset committed before the policy trained on it::
+
+    round 0       n0 expert demonstrations per task (the expert acts)         -> rounds/round-000
+    phase 0       train pi_1 on D(0); per-task losses; evaluate pi_1           -> policies/round-000
+    round k >= 1  scheduler.update(success of round k-1's rollouts, gain of phase k-1)
+                  allocate the budget B; roll out pi_k n_i times on task i, executing the expert's
+                  action with probability beta_k and always storing its label -> rounds/round-k
+    phase k       train pi_{k+1} on D(k) (warm start from pi_k); losses; evaluate -> policies/round-k
+                  beta_{k+1} = max(beta_k - delta, beta_min)
+
+This is the paper's ordering ("round k: train on D(k-1), then schedule and collect") with the
+training of round k+1 stored beside round k. ``bc`` runs round 0 only, with the whole budget
+``n0 + rounds * B / N`` per task, and trains ``rounds + 1`` phases' worth of steps.
+
+Resuming: committed rounds and phases are immutable; a run restarts at the first uncommitted step.
+Every random choice derives from the seed and the round, and the scheduler's state after each round
+is stored in the round's record, so a resumed run makes the same allocations as an uninterrupted one.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from lerobot_mtdagger.collect import COLLECT_STREAM, Episode, run_episodes, success_by_task
+from lerobot_mtdagger.configs import RunConfig
+from lerobot_mtdagger.envs import IMAGE_KEY, make_suite
+from lerobot_mtdagger.envs.base import TaskSuite
+from lerobot_mtdagger.evaluate import EvalResult, PolicyRunner, evaluate
+from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.rounds import ExperimentDir, round_features
+from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities, make_scheduler
+from lerobot_mtdagger.train import (
+    NormalisedData,
+    build_processors,
+    compute_stats,
+    load_rounds,
+    loss_split,
+    policy_config,
+    save_policy,
+    train_phase,
+)
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass
+class RunContext:
+    """Everything one experiment run holds open."""
+
+    config: RunConfig
+    suite: TaskSuite
+    experiment: ExperimentDir
+    envs: list[Any]
+    show_progress: bool
+    timings: dict[int, dict[str, float]] = field(default_factory=dict)
+
+    @property
+    def task_names(self) -> list[str]:
+        """The experiment's task vocabulary."""
+        return self.suite.task_names
+
+    @property
+    def is_bc(self) -> bool:
+        """Whether this is the one-round BC baseline."""
+        return self.config.method == "bc"
+
+    @property
+    def last_round(self) -> int:
+        """Index of the last round of the experiment."""
+        return 0 if self.is_bc else self.config.rounds
+
+
+def beta_for_round(config: RunConfig, round_index: int) -> float:
+    """Probability of executing the expert's action in a round (1 in round 0)."""
+    if round_index == 0:
+        return 1.0
+    return max(config.beta - (round_index - 1) * config.beta_decay, config.beta_min)
+
+
+def make_run_suite(config: RunConfig) -> TaskSuite:
+    """The suite of a run config."""
+    return make_suite(
+        config.suite,
+        tasks=config.tasks or None,
+        obs_mode=config.obs_mode,
+        num_points=config.num_points,
+        image_size=config.image_size,
+    )
+
+
+def new_scheduler(config: RunConfig, num_tasks: int) -> Scheduler:
+    """A fresh scheduler for the run's method (BC allocates uniformly)."""
+    method = "uniform" if config.method == "bc" else config.method
+    return make_scheduler(method, num_tasks, **config.scheduler.hyperparameters())
+
+
+# -------------------------------------------------------------------------------------------------
+# Rounds
+# -------------------------------------------------------------------------------------------------
+
+
+def initial_allocation(ctx: RunContext) -> list[int]:
+    """Round-0 episodes per task: n0, plus the DAgger rounds' budget for BC (split uniformly)."""
+    num_tasks = len(ctx.task_names)
+    if not ctx.is_bc:
+        return [ctx.config.initial_demos] * num_tasks
+    extra = ctx.config.rounds * ctx.config.budget_for(num_tasks)
+    uniform = allocate_probabilities(np.full(num_tasks, 1.0 / num_tasks), extra, 0)
+    return [ctx.config.initial_demos + int(n) for n in uniform]
+
+
+def schedule_round(ctx: RunContext, round_index: int) -> tuple[Scheduler, Allocation]:
+    """Feeds the scheduler round k-1's rollout success and phase k-1's gain, then allocates."""
+    experiment = ctx.experiment
+    previous = experiment.read_round_record(round_index - 1)
+    scheduler = new_scheduler(ctx.config, len(ctx.task_names))
+    if previous.get("scheduler_state") is not None:
+        scheduler.load_state_dict(previous["scheduler_state"])
+    phase = experiment.read_phase_record(round_index - 1)
+    measurements: dict[str, Any] = {"gain": phase["gain"]}
+    if previous["rollout_success"] is not None and round_index - 1 > 0:
+        rates = [np.nan if r is None else r for r in previous["rollout_success"]]
+        measurements |= {"success_rate": rates, "episodes": previous["rollout_episodes"]}
+    scheduler.update(**measurements)
+    allocation = scheduler.allocate(ctx.config.budget_for(len(ctx.task_names)))
+    if round_index == 1:
+        allocation.notes.append("round 1: no policy rollouts measured yet, the prior decides")
+    return scheduler, allocation
+
+
+def collect_round(ctx: RunContext, round_index: int) -> None:
+    """Collects, records and commits one round."""
+    start = time.perf_counter()
+    config = ctx.config
+    if round_index == 0:
+        scheduler, allocation = None, None
+        counts, runner, beta, max_steps = initial_allocation(ctx), None, 1.0, 10**9
+    else:
+        scheduler, allocation = schedule_round(ctx, round_index)
+        counts = allocation.episodes_per_task
+        runner = PolicyRunner.from_pretrained(
+            ctx.experiment.policy_root(round_index - 1), config.policy.device
+        )
+        beta, max_steps = beta_for_round(config, round_index), config.max_rollout_steps
+    with tqdm(
+        total=sum(counts), desc=f"round {round_index} collect", leave=False, disable=not ctx.show_progress
+    ) as bar:
+        episodes = run_episodes(
+            ctx.suite,
+            ctx.envs,
+            counts,
+            policy=runner,
+            beta=beta,
+            seed=config.seed,
+            round_index=round_index,
+            stream=COLLECT_STREAM,
+            record=True,
+            max_steps=max_steps,
+            steps_after_success=config.steps_after_success,
+            progress=lambda _: bar.update(1),
+        )
+    collected = time.perf_counter()
+    dataset = ctx.experiment.create_round(round_index, round_features(ctx.suite.features), ctx.task_names)
+    write_episodes(dataset, episodes, ctx.task_names)
+    record = round_record(ctx, round_index, counts, beta, episodes, scheduler, allocation)
+    ctx.experiment.commit_round(round_index, dataset, record)
+    ctx.timings.setdefault(round_index, {}).update(
+        collect_s=collected - start, write_s=time.perf_counter() - collected
+    )
+
+
+def write_episodes(dataset: Any, episodes: list[Episode], task_names: list[str]) -> None:
+    """Adds the recorded episodes to a round dataset, in (task, episode) order."""
+    for episode in episodes:
+        task = task_names[episode.task_index]
+        for frame in episode.frames:
+            dataset.add_frame({**frame, "task": task})
+        dataset.save_episode()
+
+
+def round_record(
+    ctx: RunContext,
+    round_index: int,
+    counts: list[int],
+    beta: float,
+    episodes: list[Episode],
+    scheduler: Scheduler | None,
+    allocation: Allocation | None,
+) -> dict[str, Any]:
+    """The round's ``mtdagger`` record for meta/info.json (lists aligned with task_names)."""
+    config = ctx.config
+    num_tasks = len(ctx.task_names)
+    rollout_success, rollout_episodes = success_by_task(episodes, num_tasks)
+    previous_demos = (
+        [0] * num_tasks
+        if round_index == 0
+        else ctx.experiment.read_round_record(round_index - 1)["demos_so_far"]
+    )
+    record: dict[str, Any] = {
+        "task_names": ctx.task_names,
+        "round": round_index,
+        "method": config.method,
+        "beta": beta,
+        "seed": config.seed,
+        "budget": int(sum(counts)),
+        "temperature": config.scheduler.temperature,
+        "n_min": config.scheduler.n_min,
+        "episodes_per_task": [int(n) for n in counts],
+        "demos_so_far": [int(a + b) for a, b in zip(previous_demos, counts, strict=True)],
+        "rollout_success": rollout_success if round_index > 0 else None,
+        "rollout_episodes": rollout_episodes,
+        "expert_success": rollout_success if round_index == 0 else None,
+        "learner_steps": int(sum(e.learner_steps for e in episodes)),
+        "frames": int(sum(e.steps for e in episodes)),
+        "config": config.to_dict(),
+    }
+    if allocation is None:
+        notes = ["round 0: expert demonstrations only, no scheduling and no policy yet"]
+        if ctx.is_bc:
+            notes.append("bc: the whole data budget in one round of expert demonstrations")
+        blank = {"p": None, "P": None}
+        record |= {
+            "success_rate": None,
+            "episodes": None,
+            "gain": None,
+            "kalman_prior": blank,
+            "kalman_posterior": blank,
+            "metric": None,
+            "score": None,
+            "probability": None,
+            "eval_success": None,
+            "allocation": None,
+            "scheduler_state": None,
+            "notes": notes,
+        }
+        return record
+    phase = ctx.experiment.read_phase_record(round_index - 1)
+    alloc = allocation.to_dict()
+    record |= {
+        key: alloc[key] for key in ("success_rate", "episodes", "gain", "kalman_prior", "kalman_posterior")
+    }
+    record |= {key: alloc[key] for key in ("metric", "score", "probability")}
+    record |= {
+        "eval_success": phase["eval"]["success"] if phase.get("eval") else None,
+        "allocation": alloc,
+        "scheduler_state": scheduler.state_dict(),
+        "notes": alloc["notes"],
+    }
+    return record
+
+
+# -------------------------------------------------------------------------------------------------
+# Training phases
+# -------------------------------------------------------------------------------------------------
+
+
+def train_round(ctx: RunContext, round_index: int) -> None:
+    """Trains on D(round_index), evaluates and commits the phase."""
+    config = ctx.config
+    start = time.perf_counter()
+    roots = [ctx.experiment.round_root(i) for i in range(round_index + 1)]
+    policy_cfg = policy_config(ctx.suite.features, ctx.task_names, config.policy, config.policy.device)
+    input_keys = list(policy_cfg.input_features)
+    image_keys = [k for k in input_keys if k.startswith(IMAGE_KEY)]
+    data = load_rounds(roots, input_keys)
+    phase_seed = int(np.random.SeedSequence([config.seed, 3, round_index]).generate_state(1)[0])
+    train_index, loss_index = loss_split(data, config.gain_split, config.heldout_fraction, phase_seed)
+    stats = compute_stats(data.subset(train_index), image_keys)
+    torch.manual_seed(phase_seed)
+    policy = MTDAggerPolicy(policy_cfg)
+    if config.warm_start and round_index > 0:
+        previous = MTDAggerPolicy.from_pretrained(str(ctx.experiment.policy_root(round_index - 1)))
+        policy.load_state_dict(previous.state_dict())
+    preprocessor, postprocessor = build_processors(policy_cfg, stats)
+    normalised = NormalisedData(data, preprocessor, image_keys, ctx.task_names)
+    steps = config.steps_per_round * ((config.rounds + 1) if ctx.is_bc else 1)
+    loaded = time.perf_counter()
+    with tqdm(
+        total=steps, desc=f"round {round_index} train", leave=False, disable=not ctx.show_progress
+    ) as bar:
+        result = train_phase(
+            policy,
+            normalised,
+            train_index,
+            loss_index,
+            steps=steps,
+            batch_size=config.policy.batch_size,
+            lr=config.policy.lr,
+            seed=phase_seed,
+            on_step=lambda step, loss: bar.update(1),
+        )
+    trained = time.perf_counter()
+    staging = ctx.experiment.staging_policy_root(round_index)
+    save_policy(policy, preprocessor, postprocessor, staging)
+    eval_result = evaluate_phase(ctx, PolicyRunner(policy, preprocessor, postprocessor))
+    evaluated = time.perf_counter()
+    demos = ctx.experiment.read_round_record(round_index)["demos_so_far"]
+    timing = {"load_s": loaded - start, "train_s": trained - loaded, "eval_s": evaluated - trained}
+    ctx.timings.setdefault(round_index, {}).update(timing)
+    record = {
+        "round": round_index,
+        "trained_on_rounds": list(range(round_index + 1)),
+        "frames": len(data),
+        "steps": steps,
+        "gain_split": config.gain_split,
+        "loss_start": result.loss_start,
+        "loss_end": result.loss_end,
+        "gain": result.gain,
+        "loss_samples": result.loss_samples,
+        "final_train_loss": result.train_loss,
+        "eval": None if eval_result is None else eval_result.to_dict(),
+        "demos_per_task": demos,
+        "timings": ctx.timings[round_index],
+    }
+    ctx.experiment.commit_phase(round_index, staging, record)
+
+
+def evaluate_phase(ctx: RunContext, runner: PolicyRunner) -> EvalResult | None:
+    """Evaluates the freshly trained policy (None when eval_episodes is 0)."""
+    if ctx.config.eval_episodes == 0:
+        return None
+    result, _ = evaluate(ctx.suite, ctx.envs, runner, ctx.config.eval_episodes, ctx.config.seed)
+    return result
+
+
+# -------------------------------------------------------------------------------------------------
+# The experiment
+# -------------------------------------------------------------------------------------------------
+
+
+def summary_line(ctx: RunContext, round_index: int) -> str:
+    """One line per round: demos so far, average success, allocation, time spent."""
+    record = ctx.experiment.read_round_record(round_index)
+    phase = ctx.experiment.read_phase_record(round_index)
+    success = "n/a" if phase["eval"] is None else f"{phase['eval']['mean']:.3f}"
+    demos = np.mean(record["demos_so_far"])
+    timing = " ".join(f"{k}={v:.1f}" for k, v in phase.get("timings", {}).items())
+    return (
+        f"round {round_index}: demos/task {demos:.1f} | eval success {success} | "
+        f"allocation {record['episodes_per_task']} | beta {record['beta']:.2f} | {timing}"
+    )
+
+
+def check_budget(config: RunConfig, num_tasks: int) -> None:
+    """Refuses a round budget that cannot give every task n_min episodes, before anything runs.
+
+    Raises:
+        ValueError: With the numbers and the fix.
+    """
+    budget = config.budget_for(num_tasks)
+    floor = config.scheduler.n_min * num_tasks
+    if config.method != "bc" and budget < floor:
+        raise ValueError(
+            f"budget={budget} is smaller than n_min * num_tasks = {config.scheduler.n_min} * {num_tasks} = "
+            f"{floor}: raise --budget to at least {floor} or lower --n_min."
+        )
+
+
+def run(config: RunConfig) -> list[str]:
+    """Runs (or resumes) one experiment; returns the per-round summary lines.
+
+    Raises:
+        FileExistsError: If the output directory exists and ``resume`` is false.
+        ValueError: On a bad config or a foreign/corrupt output directory (left untouched).
+        FloatingPointError: If training diverges.
+    """
+    suite = make_run_suite(config)
+    check_budget(config, len(suite.task_names))
+    experiment = ExperimentDir(config.output_dir)
+    if config.resume:
+        experiment.check_resumable(config.to_dict())
+        experiment.committed_rounds()  # refuses foreign or corrupt round folders before touching anything
+        experiment.clear_staging()
+    else:
+        experiment.initialise(config.to_dict())
+    handler = logging.FileHandler(experiment.root / "run.log")
+    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    logging.getLogger("lerobot_mtdagger").addHandler(handler)
+    envs = [suite.make_env(task) for task in suite.task_names]
+    show = config.progress and sys.stderr.isatty()
+    ctx = RunContext(config=config, suite=suite, experiment=experiment, envs=envs, show_progress=show)
+    lines = []
+    try:
+        for round_index in tqdm(range(ctx.last_round + 1), desc="rounds", disable=not show):
+            if round_index not in experiment.committed_rounds():
+                collect_round(ctx, round_index)
+            if round_index not in experiment.committed_phases():
+                train_round(ctx, round_index)
+            lines.append(summary_line(ctx, round_index))
+            logger.info(lines[-1])
+    finally:
+        for env in envs:
+            env.close()
+        logging.getLogger("lerobot_mtdagger").removeHandler(handler)
+        handler.close()
+    return lines

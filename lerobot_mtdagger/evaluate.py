@@ -1,0 +1,117 @@
+"""Success per task of a policy, with the pure policy acting (no expert), on evaluation seeds.
+
+``PolicyRunner`` turns a LeRobot pretrained ``mtdagger`` policy and its processors into the batched
+``PolicyFn`` the rollouts use; observations are converted exactly as LeRobot's
+``preprocess_observation`` does (images to float CHW in [0, 1]).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from lerobot.policies.factory import make_pre_post_processors
+
+from lerobot_mtdagger.collect import EVAL_STREAM, Episode, run_episodes, success_by_task
+from lerobot_mtdagger.envs.base import TaskSuite
+from lerobot_mtdagger.policies import MTDAggerPolicy
+
+
+class PolicyRunner:
+    """Batched inference: observations + task names -> unnormalised actions (B, action_dim)."""
+
+    def __init__(self, policy: MTDAggerPolicy, preprocessor: Any, postprocessor: Any) -> None:
+        """Wraps a policy in eval mode with its processors."""
+        self.policy = policy.eval()
+        self.preprocessor = preprocessor
+        self.postprocessor = postprocessor
+        self.input_keys = list(policy.config.input_features)
+        self.image_keys = set(policy.config.image_features)
+
+    @classmethod
+    def from_pretrained(cls, path: str | Path, device: str = "cpu") -> PolicyRunner:
+        """Loads a pretrained model folder or Hub id with its saved processors."""
+        policy = MTDAggerPolicy.from_pretrained(str(path))
+        policy.config.device = device
+        policy.to(device)
+        overrides = {"device_processor": {"device": device}}
+        pre, post = make_pre_post_processors(
+            policy.config, pretrained_path=str(path), preprocessor_overrides=overrides
+        )
+        return cls(policy, pre, post)
+
+    def __call__(self, observations: list[dict[str, np.ndarray]], tasks: list[str]) -> np.ndarray:
+        """Actions for a batch of observations of the given tasks.
+
+        Raises:
+            KeyError: If an observation lacks an input the policy was trained on.
+        """
+        batch: dict[str, Any] = {}
+        for key in self.input_keys:
+            stacked = torch.from_numpy(np.stack([observation[key] for observation in observations]))
+            if key in self.image_keys:
+                stacked = stacked.permute(0, 3, 1, 2).float() / 255.0
+            batch[key] = stacked.float()
+        batch["task"] = list(tasks)
+        with torch.inference_mode():
+            action = self.postprocessor(self.policy.select_action(self.preprocessor(batch)))
+        return action.cpu().numpy()
+
+
+@dataclass
+class EvalResult:
+    """Success of the pure policy per task."""
+
+    task_names: list[str]
+    success: list[float]
+    episodes: list[int]
+
+    @property
+    def mean(self) -> float:
+        """Average success over tasks."""
+        return float(np.mean(self.success))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form."""
+        return {
+            "task_names": self.task_names,
+            "success": self.success,
+            "episodes": self.episodes,
+            "mean": self.mean,
+        }
+
+
+def evaluate(
+    suite: TaskSuite,
+    envs: Sequence[Any],
+    runner: PolicyRunner,
+    episodes_per_task: int,
+    seed: int,
+    steps_after_success: int = 0,
+) -> tuple[EvalResult, list[Episode]]:
+    """Runs ``episodes_per_task`` pure-policy episodes per task on the evaluation seeds.
+
+    Episodes end at the first success or when the env truncates (its max episode length). The
+    evaluation seeds do not depend on the round, so every round is evaluated on the same episodes.
+    """
+    max_steps = max(getattr(env, "max_episode_steps", 500) for env in envs)
+    episodes = run_episodes(
+        suite,
+        envs,
+        [episodes_per_task] * len(envs),
+        policy=runner,
+        beta=0.0,
+        seed=seed,
+        round_index=0,
+        stream=EVAL_STREAM,
+        record=False,
+        max_steps=max_steps,
+        steps_after_success=steps_after_success,
+    )
+    rates, counts = success_by_task(episodes, len(envs))
+    result = EvalResult(list(suite.task_names), [r if r is not None else 0.0 for r in rates], counts)
+    return result, episodes

@@ -1,0 +1,405 @@
+"""Pushing a Multitask DAgger experiment to the Hugging Face Hub, one git revision per round.
+
+Every committed round ``DIR/rounds/round-XXX`` is a standalone LeRobotDataset. Round k is uploaded to the
+dataset repo as one commit that holds exactly round k's dataset files plus a dataset card (``README.md``)
+covering rounds 0..k, and that commit is tagged ``round-{k:03d}``: ``LeRobotDataset(repo_id,
+revision="round-002")`` loads round 2, and ``main`` ends at the last pushed round. Every committed training
+phase ``DIR/policies/round-XXX`` (a LeRobot pretrained model) is pushed to an optional model repo and tagged
+the same way, so ``revision="round-002"`` there is the policy trained on rounds 0..2.
+
+Uploads use ``HfApi.upload_folder`` with ``delete_patterns`` scoped to the dataset (``data/``, ``meta/``,
+``videos/``) or to the model files (``*.json``, ``*.safetensors``), so files of an earlier round that the
+next round does not have vanish from the next commit; other files a user added to the repo (and the Hub's
+``.gitattributes``, which ``delete_patterns`` never removes) are kept. The round folders themselves are never
+written to: committed rounds are immutable, and the card is added through a temporary folder of symlinks.
+
+Re-pushing an experiment (for example after resuming it with more rounds) is allowed: every round is uploaded
+again in order and new rounds get their tags. ``create_tag(..., exist_ok=True)`` leaves an existing tag where
+it is (the Hub does not move it), so the tag of an already pushed round keeps pointing at its first commit,
+which holds the same files since committed rounds are immutable and the card of round k only depends on
+rounds 0..k. The Hub skips an upload that changes nothing and returns the current head instead.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from huggingface_hub import DatasetCardData, HfApi
+
+from lerobot_mtdagger.datasets_cards import card_template
+from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir, round_name
+
+logger = logging.getLogger(__name__)
+
+CARD_FILE = "README.md"
+CARD_TAGS = ("LeRobot", "mtdagger", "dagger", "multitask")
+DATASET_DELETE_PATTERNS = ("data/**", "meta/**", "videos/**")
+POLICY_DELETE_PATTERNS = ("*.json", "*.safetensors")
+NOT_AVAILABLE = "n/a"
+
+
+# -------------------------------------------------------------------------------------------------
+# Dataset card
+# -------------------------------------------------------------------------------------------------
+
+
+def card_metadata_yaml() -> str:
+    """The card's YAML front matter (without the ``---`` fences), as LeRobot writes it for datasets."""
+    card_data = DatasetCardData(
+        license="apache-2.0",
+        task_categories=["robotics"],
+        tags=list(CARD_TAGS),
+        configs=[{"config_name": "default", "data_files": "data/*/*.parquet"}],
+    )
+    return card_data.to_yaml()
+
+
+def _cell(value: Any) -> str:
+    """A markdown table cell: pipes escaped, floats with three decimals, None as ``n/a``."""
+    if value is None:
+        return NOT_AVAILABLE
+    if isinstance(value, float):
+        return f"{value:.3f}"
+    return str(value).replace("|", "\\|")
+
+
+def markdown_table(header: Sequence[Any], rows: Sequence[Sequence[Any]]) -> str:
+    """A GitHub-flavoured markdown table."""
+    lines = [
+        "| " + " | ".join(_cell(h) for h in header) + " |",
+        "|" + "|".join("---" for _ in header) + "|",
+    ]
+    lines += ["| " + " | ".join(_cell(v) for v in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def task_table(task_names: Sequence[str]) -> str:
+    """Table of the task vocabulary: task_index and name."""
+    return markdown_table(["task_index", "task"], [[i, name] for i, name in enumerate(task_names)])
+
+
+def revision_table(records: Sequence[dict[str, Any]]) -> str:
+    """Table of the rounds and their revisions: episodes, frames and the mixing coefficient beta."""
+    rows = [
+        [
+            r["round"],
+            f"`{round_name(r['round'])}`",
+            sum(r["episodes_per_task"]),
+            r.get("frames"),
+            r.get("beta"),
+        ]
+        for r in records
+    ]
+    return markdown_table(["round", "revision", "episodes", "frames", "beta"], rows)
+
+
+def allocation_table(task_names: Sequence[str], records: Sequence[dict[str, Any]]) -> str:
+    """Expert-labelled episodes per task (rows) and round (columns), with a total row."""
+    header = ["task", *(f"round {r['round']}" for r in records)]
+    rows = [[name, *(r["episodes_per_task"][i] for r in records)] for i, name in enumerate(task_names)]
+    rows.append(["**total**", *(sum(r["episodes_per_task"]) for r in records)])
+    return markdown_table(header, rows)
+
+
+def eval_table(task_names: Sequence[str], evals: dict[int, dict[str, Any] | None]) -> str:
+    """Success per task (rows) of the policy trained on rounds 0..k (columns), with a mean row.
+
+    Args:
+        task_names: The task vocabulary.
+        evals: Round index -> the ``eval`` entry of that training phase's record (None where the phase is
+            missing or was not evaluated).
+    """
+    if not any(evals.values()):
+        return "No evaluation was recorded for these rounds."
+    rounds = sorted(evals)
+    header = ["task", *(f"round {k}" for k in rounds)]
+
+    def success(k: int, i: int) -> float | None:
+        entry = evals[k]
+        return None if entry is None else float(entry["success"][i])
+
+    rows = [[name, *(success(k, i) for k in rounds)] for i, name in enumerate(task_names)]
+    rows.append(["**mean**", *(None if evals[k] is None else float(evals[k]["mean"]) for k in rounds)])
+    episodes = sorted({e for entry in evals.values() if entry for e in entry.get("episodes", [])})
+    note = (
+        "Column `round k` is the success rate of the policy trained on rounds 0..k (revision `round-{k:03d}` "
+        "of the policy repo, if pushed)"
+    )
+    if episodes:
+        note += f", over {'/'.join(map(str, episodes))} evaluation episode(s) per task"
+    return f"{note}.\n\n{markdown_table(header, rows)}"
+
+
+def _phase_eval(experiment: ExperimentDir, round_index: int) -> dict[str, Any] | None:
+    """The ``eval`` entry of a committed training phase (None if not committed or not evaluated)."""
+    if round_index not in experiment.committed_phases():
+        return None
+    return experiment.read_phase_record(round_index).get("eval")
+
+
+def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: int | None = None) -> str:
+    """Fills the dataset-card template for the experiment's rounds 0..``up_to_round``.
+
+    Args:
+        experiment: The experiment directory.
+        repo_id: The Hub dataset repo the card is for.
+        up_to_round: Last round the card describes, i.e. the round held by the revision the card is
+            pushed with (None: the last committed round).
+
+    Returns:
+        The card's markdown, with YAML front matter.
+
+    Raises:
+        ValueError: If the experiment has no committed round or ``up_to_round`` is not committed.
+    """
+    committed = experiment.committed_rounds()
+    if not committed:
+        raise ValueError(f"{experiment.root} has no committed round to describe.")
+    last = committed[-1] if up_to_round is None else up_to_round
+    if last not in committed:
+        raise ValueError(f"Round {last} is not committed in {experiment.root}; committed: {committed}.")
+    records = [experiment.read_round_record(k) for k in range(last + 1)]
+    latest = records[-1]
+    config = latest.get("config") or {}
+    task_names = list(latest["task_names"])
+    values = {
+        "card_data": card_metadata_yaml(),
+        "repo_id": repo_id,
+        "round": str(last),
+        "revision": round_name(last),
+        "suite": str(config.get("suite", NOT_AVAILABLE)),
+        "obs_mode": str(config.get("obs_mode", NOT_AVAILABLE)),
+        "method": str(latest.get("method", NOT_AVAILABLE)),
+        "temperature": str(latest.get("temperature", NOT_AVAILABLE)),
+        "n_min": str(latest.get("n_min", NOT_AVAILABLE)),
+        "seed": str(latest.get("seed", NOT_AVAILABLE)),
+        "revision_table": revision_table(records),
+        "task_table": task_table(task_names),
+        "allocation_table": allocation_table(task_names, records),
+        "eval_table": eval_table(task_names, {k: _phase_eval(experiment, k) for k in range(last + 1)}),
+    }
+    text = card_template()
+    for key, value in values.items():
+        text = text.replace("{{ " + key + " }}", value)
+    return text
+
+
+# -------------------------------------------------------------------------------------------------
+# Pushing
+# -------------------------------------------------------------------------------------------------
+
+
+@contextlib.contextmanager
+def folder_with_card(folder: Path, card: str) -> Iterator[Path]:
+    """A temporary folder mirroring ``folder`` through file symlinks, plus ``README.md`` holding ``card``.
+
+    ``folder`` is never written to. Files are symlinked one by one (``upload_folder`` lists files with
+    ``Path.glob("**/*")``, which does not descend into symlinked directories) and copied where symlinks are
+    not available. A ``README.md`` of ``folder`` itself is replaced by ``card``.
+
+    Yields:
+        The temporary folder, deleted on exit.
+    """
+    with tempfile.TemporaryDirectory(prefix="mtdagger-push-") as tmp:
+        staged = Path(tmp) / folder.name
+        staged.mkdir()
+        for source in sorted(folder.rglob("*")):
+            relative = source.relative_to(folder)
+            if not source.is_file() or relative.as_posix() == CARD_FILE:
+                continue
+            target = staged / relative
+            target.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                os.symlink(source.absolute(), target)
+            except OSError:
+                shutil.copy2(source, target)
+        (staged / CARD_FILE).write_text(card, encoding="utf-8")
+        yield staged
+
+
+def upload_and_tag(
+    api: HfApi,
+    repo_id: str,
+    repo_type: str,
+    folder: Path,
+    tag: str,
+    commit_message: str,
+    delete_patterns: Sequence[str],
+) -> str:
+    """Uploads ``folder`` as one commit (deleting remote files matching ``delete_patterns``) and tags it.
+
+    Returns:
+        The commit id that ``tag`` names (or would name, if the tag already existed: it is left as it is).
+    """
+    info = api.upload_folder(
+        repo_id=repo_id,
+        repo_type=repo_type,
+        folder_path=folder,
+        commit_message=commit_message,
+        delete_patterns=list(delete_patterns),
+    )
+    api.create_tag(repo_id, tag=tag, revision=info.oid, repo_type=repo_type, exist_ok=True)
+    logger.info("Pushed %s to %s %s at commit %s", tag, repo_type, repo_id, info.oid)
+    return info.oid
+
+
+def round_commit_message(record: dict[str, Any]) -> str:
+    """Commit message of a round: its episodes, frames and allocation."""
+    episodes = record["episodes_per_task"]
+    return (
+        f"round {record['round']}: {sum(episodes)} episodes, {record.get('frames')} frames, "
+        f"allocation {episodes} ({record.get('method')})"
+    )
+
+
+def phase_commit_message(round_index: int, record: dict[str, Any]) -> str:
+    """Commit message of a training phase: the rounds it was trained on and its evaluation."""
+    evaluation = record.get("eval")
+    success = NOT_AVAILABLE if not evaluation else f"{evaluation['mean']:.3f}"
+    return f"round {round_index}: policy trained on rounds 0..{round_index}, eval success {success}"
+
+
+def push_rounds(api: HfApi, experiment: ExperimentDir, repo_id: str, rounds: Sequence[int]) -> dict[str, str]:
+    """Pushes rounds in order, one tagged commit each (dataset files plus card); returns tag -> commit."""
+    pushed = {}
+    for k in rounds:
+        card = render_dataset_card(experiment, repo_id, up_to_round=k)
+        message = round_commit_message(experiment.read_round_record(k))
+        with folder_with_card(experiment.round_root(k), card) as folder:
+            pushed[round_name(k)] = upload_and_tag(
+                api, repo_id, "dataset", folder, round_name(k), message, DATASET_DELETE_PATTERNS
+            )
+    return pushed
+
+
+def push_phases(api: HfApi, experiment: ExperimentDir, repo_id: str, phases: Sequence[int]) -> dict[str, str]:
+    """Pushes training phases in order, one tagged commit each; returns tag -> commit."""
+    return {
+        round_name(k): upload_and_tag(
+            api,
+            repo_id,
+            "model",
+            experiment.policy_root(k),
+            round_name(k),
+            phase_commit_message(k, experiment.read_phase_record(k)),
+            POLICY_DELETE_PATTERNS,
+        )
+        for k in phases
+    }
+
+
+def _pushable(experiment: ExperimentDir, with_policies: bool) -> tuple[list[int], list[int]]:
+    """The committed rounds (and phases, if wanted) to push, checked before anything is sent.
+
+    Raises:
+        FileNotFoundError: If the directory is not an experiment.
+        ValueError: If there is no committed round, or no committed phase while policies are wanted.
+    """
+    if not (experiment.root / CONFIG_FILE).exists():
+        raise FileNotFoundError(
+            f"{experiment.root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}): pass the "
+            "--output_dir of a `lerobot-mtdagger run`."
+        )
+    rounds = experiment.committed_rounds()
+    if not rounds:
+        raise ValueError(f"{experiment.root} has no committed round to push yet.")
+    phases = experiment.committed_phases() if with_policies else []
+    if with_policies and not phases:
+        raise ValueError(
+            f"{experiment.root} has no committed training phase to push: drop the policy repo option."
+        )
+    return rounds, phases
+
+
+def push_experiment(
+    experiment_dir: Path | str,
+    dataset_repo_id: str,
+    policy_repo_id: str | None = None,
+    *,
+    private: bool = False,
+    api: HfApi | None = None,
+) -> dict[str, dict[str, str]]:
+    """Pushes every committed round (and optionally every training phase) to the Hub, one tag per round.
+
+    Creates the dataset repo (and the model repo) if needed, then uploads round k, in increasing k, as one
+    commit holding exactly round k's dataset files and the card of rounds 0..k, tagged ``round-{k:03d}``.
+    Training phase k goes to ``policy_repo_id`` tagged ``round-{k:03d}`` likewise. Re-pushing is allowed;
+    see the module docstring for what happens to existing tags.
+
+    Args:
+        experiment_dir: Output directory of a ``lerobot-mtdagger run``.
+        dataset_repo_id: Hub dataset repo, ``owner/name``.
+        policy_repo_id: Hub model repo for the trained policies (None: policies are not pushed).
+        private: Whether repos created by this call are private (an existing repo's visibility is
+            left as it is).
+        api: The Hub client (default: a new ``HfApi()``, authenticated as usual, e.g. by ``HF_TOKEN``).
+
+    Returns:
+        ``{"dataset": {tag: commit_id}, "policy": {tag: commit_id}}`` (``policy`` empty when not pushed).
+
+    Raises:
+        FileNotFoundError: If ``experiment_dir`` is not an experiment.
+        ValueError: If there is nothing to push; nothing is sent then.
+    """
+    experiment = ExperimentDir(Path(experiment_dir))
+    rounds, phases = _pushable(experiment, with_policies=policy_repo_id is not None)
+    api = api or HfApi()
+    url = api.create_repo(dataset_repo_id, repo_type="dataset", private=private, exist_ok=True)
+    dataset_repo_id = url.repo_id or dataset_repo_id
+    logger.info("Pushing rounds %s of %s to dataset %s", rounds, experiment.root, dataset_repo_id)
+    pushed = {"dataset": push_rounds(api, experiment, dataset_repo_id, rounds), "policy": {}}
+    if policy_repo_id is not None:
+        url = api.create_repo(policy_repo_id, repo_type="model", private=private, exist_ok=True)
+        policy_repo_id = url.repo_id or policy_repo_id
+        logger.info("Pushing training phases %s of %s to model %s", phases, experiment.root, policy_repo_id)
+        pushed["policy"] = push_phases(api, experiment, policy_repo_id, phases)
+    return pushed
+
+
+# -------------------------------------------------------------------------------------------------
+# Command
+# -------------------------------------------------------------------------------------------------
+
+
+@dataclass
+class PushConfig:
+    """Options of ``lerobot-mtdagger push``: an experiment to the Hub, round k as revision ``round-{k:03d}``.
+
+    Attributes:
+        experiment_dir: The experiment's output directory.
+        repo_id: Hub dataset repo for the rounds, ``owner/name``.
+        policy_repo_id: Hub model repo for the trained policies (None: policies are not pushed).
+        private: Whether repos created by the push are private.
+    """
+
+    experiment_dir: Path | None = None
+    repo_id: str | None = None
+    policy_repo_id: str | None = None
+    private: bool = False
+
+    def __post_init__(self) -> None:
+        if self.experiment_dir is None:
+            raise ValueError(
+                "--experiment_dir is required: pass the --output_dir of a `lerobot-mtdagger run`, "
+                "e.g. --experiment_dir=outputs/mt10."
+            )
+        if self.repo_id is None:
+            raise ValueError(
+                "--repo_id is required: the Hub dataset repo to push the rounds to, "
+                "e.g. --repo_id=<user>/mtdagger-mt10."
+            )
+
+
+def push_command(config: PushConfig) -> dict[str, dict[str, str]]:
+    """Pushes the experiment as configured; returns what was pushed (see ``push_experiment``)."""
+    return push_experiment(
+        config.experiment_dir, config.repo_id, config.policy_repo_id, private=config.private
+    )

@@ -1,0 +1,254 @@
+"""The Multitask DAgger runner end to end on real MetaWorld tasks (tiny configurations)."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.configs import RunConfig
+from lerobot_mtdagger.dagger import run
+from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.rounds import ExperimentDir, merge_rounds, verify_experiment
+
+TASKS = ["reach-v3", "button-press-topdown-v3", "push-v3"]
+TINY = [
+    "--tasks=[reach-v3,button-press-topdown-v3,push-v3]",
+    "--rounds=2",
+    "--steps_per_round=60",
+    "--eval_episodes=1",
+    "--max_rollout_steps=60",
+    "--policy.batch_size=64",
+    "--progress=false",
+]
+ISSUE_KEYS = [
+    "format_version", "task_names", "round", "method", "beta", "seed", "budget", "temperature", "n_min",
+    "success_rate", "episodes", "gain", "kalman_prior", "kalman_posterior", "metric", "score",
+    "probability", "episodes_per_task", "eval_success", "config",
+]  # fmt: skip
+
+
+def tiny_config(output_dir: Path, *extra: str) -> RunConfig:
+    import draccus
+
+    return draccus.parse(RunConfig, args=[*TINY, f"--output_dir={output_dir}", *extra])
+
+
+@pytest.fixture(scope="module")
+def experiment(tmp_path_factory) -> ExperimentDir:
+    root = tmp_path_factory.mktemp("dagger") / "need"
+    lines = run(tiny_config(root, "--scheduler.type=need"))
+    assert len(lines) == 3 and lines[0].startswith("round 0:")
+    return ExperimentDir(root)
+
+
+def test_every_round_is_committed_with_its_record(experiment):
+    assert experiment.committed_rounds() == [0, 1, 2]
+    assert experiment.committed_phases() == [0, 1, 2]
+    for k in range(3):
+        record = experiment.read_round_record(k)
+        assert all(key in record for key in ISSUE_KEYS), [key for key in ISSUE_KEYS if key not in record]
+        assert record["task_names"] == TASKS and record["round"] == k and record["method"] == "need"
+        assert sum(record["episodes_per_task"]) == record["budget"]
+    round0, round1, round2 = (experiment.read_round_record(k) for k in range(3))
+    assert round0["episodes_per_task"] == [3, 3, 3] and round0["beta"] == 1.0
+    assert round0["success_rate"] is None and round0["allocation"] is None and "round 0" in round0["notes"][0]
+    assert round1["success_rate"] is None and any("prior decides" in n for n in round1["notes"])
+    assert round1["episodes_per_task"] == [3, 3, 3], "the prior decides: uniform"
+    assert round1["beta"] == 0.5 and round2["beta"] == 0.0
+    assert round2["success_rate"] == round1["rollout_success"]
+    assert round2["gain"] == experiment.read_phase_record(1)["gain"]
+    assert round2["eval_success"] == experiment.read_phase_record(1)["eval"]["success"]
+    assert round2["demos_so_far"] == [
+        a + b for a, b in zip(round1["demos_so_far"], round2["episodes_per_task"], strict=True)
+    ]
+
+
+def test_verify_recomputes_every_allocation(experiment):
+    assert verify_experiment(experiment) == []
+
+
+def test_verify_detects_a_tampered_round(experiment, tmp_path):
+    copy = tmp_path / "copy"
+    shutil.copytree(experiment.root, copy)
+    info_path = copy / "rounds" / "round-002" / "meta" / "info.json"
+    info = json.loads(info_path.read_text())
+    info["mtdagger"]["allocation"]["metric"][0] += 0.5
+    info["mtdagger"]["episodes_per_task"] = [9, 0, 0]
+    info_path.write_text(json.dumps(info))
+    problems = verify_experiment(ExperimentDir(copy))
+    assert any("dataset holds" in p for p in problems)
+    assert any("metric" in p for p in problems)
+    with pytest.raises(SystemExit):
+        main(["verify", f"--experiment_dir={copy}"])
+
+
+def test_frames_store_expert_labels_and_what_was_executed(experiment):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    dataset = LeRobotDataset("local/round-001", root=experiment.round_root(1))
+    table = dataset.hf_dataset.with_format("numpy")
+    learner = np.asarray(table["learner_acted"]).reshape(-1).astype(bool)
+    assert learner.any() and (~learner).any(), "beta=0.5 mixes expert and learner steps"
+    executed, label = np.asarray(table["executed_action"]), np.asarray(table["action"])
+    np.testing.assert_array_equal(executed[~learner], label[~learner])
+    assert not np.allclose(executed[learner], label[learner])
+    assert set(np.asarray(table["dagger_round"]).reshape(-1).tolist()) == {1}
+    assert dataset.meta.tasks.sort_values("task_index").index.tolist() == TASKS
+
+
+def test_merged_rounds_load_as_one_dataset_with_the_same_task_indices(experiment, tmp_path):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    merged_root = merge_rounds(experiment, [0, 1, 2], tmp_path / "merged")
+    merged = LeRobotDataset("local/merged", root=merged_root)
+    episodes = sum(sum(experiment.read_round_record(k)["episodes_per_task"]) for k in range(3))
+    assert merged.num_episodes == episodes
+    assert merged.meta.tasks.sort_values("task_index").index.tolist() == TASKS
+    item = merged[len(merged) - 1]
+    assert TASKS[int(item["task_index"])] == item["task"]
+
+
+def test_round_policies_are_lerobot_pretrained_models(experiment):
+    policy = MTDAggerPolicy.from_pretrained(str(experiment.policy_root(2)))
+    assert policy.config.task_names == TASKS
+    assert (experiment.policy_root(2) / "policy_preprocessor.json").exists()
+
+
+def test_output_dir_collision_is_refused_and_nothing_is_touched(experiment):
+    before = sorted(p.name for p in experiment.rounds.iterdir())
+    with pytest.raises(FileExistsError, match="pass --resume=true"):
+        run(tiny_config(experiment.root))
+    assert sorted(p.name for p in experiment.rounds.iterdir()) == before
+
+
+def test_resume_of_a_finished_run_changes_nothing(experiment):
+    info = (experiment.round_root(2) / "meta" / "info.json").read_text()
+    run(tiny_config(experiment.root, "--scheduler.type=need", "--resume=true"))
+    assert (experiment.round_root(2) / "meta" / "info.json").read_text() == info
+
+
+def test_resume_with_another_config_is_refused(experiment):
+    with pytest.raises(ValueError, match="Cannot resume .* different config"):
+        run(tiny_config(experiment.root, "--scheduler.type=gain", "--resume=true"))
+
+
+@pytest.mark.parametrize(
+    ("args", "error", "match"),
+    [
+        (["--suite=robosuite"], ValueError, "Unknown suite"),
+        (["--tasks=[reach-v3,jump-v3]"], ValueError, "not in metaworld-mt10"),
+        (["--budget=2"], ValueError, r"budget=2 is smaller than n_min \* num_tasks = 1 \* 3 = 3"),
+    ],
+)
+def test_bad_runs_are_refused_before_anything_is_written(tmp_path, args, error, match):
+    with pytest.raises(error, match=match):
+        run(tiny_config(tmp_path / "out", *args))
+    assert not (tmp_path / "out").exists()
+
+
+def test_unknown_method_and_missing_output_dir_are_clear_cli_errors(capsys, tmp_path):
+    with pytest.raises(SystemExit) as exit_info:  # argparse exits with status 2 and the choices
+        main(["run", "--scheduler.type=greedy", f"--output_dir={tmp_path}"])
+    assert exit_info.value.code == 2
+    assert "invalid choice: 'greedy'" in capsys.readouterr().err
+    assert main(["run", "--rounds=-1"]) == 2
+    assert "rounds must be >= 0, got -1" in capsys.readouterr().err
+
+
+def test_foreign_dataset_in_the_output_dir_is_refused(tmp_path):
+    root = tmp_path / "exp"
+    (root / "rounds" / "round-000" / "meta").mkdir(parents=True)
+    (root / "rounds" / "round-000" / "meta" / "info.json").write_text(
+        json.dumps({"codebase_version": "v3.0"})
+    )
+    (root / "config.json").write_text(json.dumps(tiny_config(root).to_dict()))
+    with pytest.raises(ValueError, match="is not a lerobot-mtdagger round"):
+        run(tiny_config(root, "--resume=true"))
+    assert (root / "rounds" / "round-000" / "meta" / "info.json").exists()
+
+
+def test_nan_loss_is_an_error_and_committed_rounds_survive(tmp_path, monkeypatch):
+    def nan_forward(self, batch):
+        loss = self.predict(batch).sum() * math.nan
+        return loss, {}
+
+    monkeypatch.setattr(MTDAggerPolicy, "forward", nan_forward)
+    with pytest.raises(FloatingPointError, match="Training loss became nan"):
+        run(tiny_config(tmp_path / "exp", "--rounds=1"))
+    experiment = ExperimentDir(tmp_path / "exp")
+    assert experiment.committed_rounds() == [0]
+    assert experiment.committed_phases() == []
+    monkeypatch.undo()
+    run(tiny_config(tmp_path / "exp", "--rounds=1", "--resume=true"))
+    assert experiment.committed_phases() == [0, 1]
+
+
+def test_bc_collects_the_whole_budget_in_one_round(tmp_path):
+    lines = run(tiny_config(tmp_path / "bc", "--scheduler.type=bc", "--rounds=2", "--budget=6"))
+    experiment = ExperimentDir(tmp_path / "bc")
+    assert experiment.committed_rounds() == [0] and len(lines) == 1
+    record = experiment.read_round_record(0)
+    assert record["episodes_per_task"] == [3 + 4, 3 + 4, 3 + 4]
+    assert experiment.read_phase_record(0)["steps"] == 3 * 60
+
+
+def _cli(output_dir: Path, *extra: str) -> list[str]:
+    return [
+        str(Path(sys.executable).parent / "lerobot-mtdagger"),
+        "run",
+        *TINY,
+        f"--output_dir={output_dir}",
+        *extra,
+    ]
+
+
+def _allocations(root: Path) -> list:
+    experiment = ExperimentDir(root)
+    return [
+        (r["episodes_per_task"], r["metric"], r["rollout_success"], r["eval_success"])
+        for r in (experiment.read_round_record(k) for k in experiment.committed_rounds())
+    ]
+
+
+@pytest.mark.parametrize(
+    "kill_when",
+    [
+        "policies/.staging/round-001",  # during training phase 1
+        pytest.param("rounds/round-001", marks=pytest.mark.slow),  # right after round 1's commit
+    ],
+)
+def test_kill_9_and_resume_gives_the_same_allocations(tmp_path, kill_when):
+    reference = tmp_path / "reference"
+    subprocess.run(_cli(reference, "--scheduler.type=need"), check=True, capture_output=True)
+    killed = tmp_path / "killed"
+    process = subprocess.Popen(
+        _cli(killed, "--scheduler.type=need"), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    deadline = time.time() + 300
+    while not (killed / kill_when).exists() and process.poll() is None and time.time() < deadline:
+        time.sleep(0.05)
+    assert process.poll() is None, "the run finished before it could be killed"
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    subprocess.run(_cli(killed, "--scheduler.type=need", "--resume=true"), check=True, capture_output=True)
+    assert _allocations(killed) == _allocations(reference)
+    assert verify_experiment(ExperimentDir(killed)) == []
+    for k in range(3):
+        weights = [
+            MTDAggerPolicy.from_pretrained(str(ExperimentDir(r).policy_root(k))).state_dict()
+            for r in (reference, killed)
+        ]
+        for name, tensor in weights[0].items():
+            torch.testing.assert_close(tensor, weights[1][name], rtol=0, atol=0)
