@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -46,3 +48,25 @@ def expert_dataset_factory(tmp_path):
         return root
 
     return factory
+
+
+def lerobot_train(dataset_root: Path, output_dir: Path, steps: int = 20, repo_id: str = "local/tiny") -> Path:
+    """Runs stock ``lerobot-train`` on a local dataset; returns the last checkpoint's model folder."""
+    command = [
+        str(Path(sys.executable).parent / "lerobot-train"),
+        "--policy.type=mtdagger",
+        "--policy.discover_packages_path=lerobot_mtdagger.policies",
+        "--policy.device=cpu",
+        "--policy.push_to_hub=false",
+        f"--dataset.repo_id={repo_id}",
+        f"--dataset.root={dataset_root}",
+        f"--steps={steps}",
+        "--batch_size=16",
+        "--num_workers=0",
+        f"--save_freq={steps}",
+        "--eval_freq=0",
+        "--wandb.enable=false",
+        f"--output_dir={output_dir}",
+    ]
+    subprocess.run(command, check=True, capture_output=True, text=True)
+    return output_dir / "checkpoints" / "last" / "pretrained_model"

@@ -21,6 +21,7 @@ from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.rounds import ExperimentDir, merge_rounds, verify_experiment
+from tests.conftest import lerobot_train
 
 TASKS = ["reach-v3", "button-press-topdown-v3", "push-v3"]
 TINY = [
@@ -118,6 +119,8 @@ def test_merged_rounds_load_as_one_dataset_with_the_same_task_indices(experiment
     assert merged.meta.tasks.sort_values("task_index").index.tolist() == TASKS
     item = merged[len(merged) - 1]
     assert TASKS[int(item["task_index"])] == item["task"]
+    checkpoint = lerobot_train(merged_root, tmp_path / "train", steps=4, repo_id="local/merged")
+    assert MTDAggerPolicy.from_pretrained(str(checkpoint)).config.task_names == TASKS
 
 
 def test_round_policies_are_lerobot_pretrained_models(experiment):
@@ -252,3 +255,27 @@ def test_kill_9_and_resume_gives_the_same_allocations(tmp_path, kill_when):
         ]
         for name, tensor in weights[0].items():
             torch.testing.assert_close(tensor, weights[1][name], rtol=0, atol=0)
+
+
+@pytest.mark.slow
+def test_dagger_improves_a_weak_bc_policy(tmp_path):
+    """One demo per task gives a weak BC policy; three DAgger rounds lift it on the same eval seeds."""
+    import draccus
+
+    config = draccus.parse(
+        RunConfig,
+        args=[
+            "--tasks=[reach-v3,push-v3,pick-place-v3,peg-insert-side-v3]",
+            "--initial_demos=1",
+            "--rounds=3",
+            "--budget_per_task=5",
+            "--steps_per_round=2000",
+            "--eval_episodes=10",
+            "--progress=false",
+            f"--output_dir={tmp_path / 'run'}",
+        ],
+    )
+    run(config)
+    experiment = ExperimentDir(tmp_path / "run")
+    means = [experiment.read_phase_record(k)["eval"]["mean"] for k in range(4)]
+    assert means[-1] >= means[0] + 0.15, means

@@ -14,30 +14,10 @@ from safetensors.torch import load_file
 
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.policies import MTDAggerPolicy
+from tests.conftest import lerobot_train
 
 BIN = Path(sys.executable).parent
 TASKS = ["reach-v3", "button-press-topdown-v3"]
-
-
-def lerobot_train(dataset_root: Path, output_dir: Path, steps: int = 20) -> Path:
-    command = [
-        str(BIN / "lerobot-train"),
-        "--policy.type=mtdagger",
-        "--policy.discover_packages_path=lerobot_mtdagger.policies",
-        "--policy.device=cpu",
-        "--policy.push_to_hub=false",
-        "--dataset.repo_id=local/tiny",
-        f"--dataset.root={dataset_root}",
-        f"--steps={steps}",
-        "--batch_size=16",
-        "--num_workers=0",
-        f"--save_freq={steps}",
-        "--eval_freq=0",
-        "--wandb.enable=false",
-        f"--output_dir={output_dir}",
-    ]
-    subprocess.run(command, check=True, capture_output=True, text=True)
-    return output_dir / "checkpoints" / "last" / "pretrained_model"
 
 
 def lerobot_eval(checkpoint: Path, output_dir: Path, obs_mode: str, extra: list[str]) -> dict:
