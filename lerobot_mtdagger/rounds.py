@@ -104,7 +104,9 @@ class ExperimentDir:
         self.policies.mkdir(parents=True, exist_ok=True)
         write_json_atomic(self.root / CONFIG_FILE, config)
 
-    def check_resumable(self, config: dict[str, Any], ignore: Sequence[str] = ("resume", "progress")) -> None:
+    def check_resumable(
+        self, config: dict[str, Any], ignore: Sequence[str] = ("resume", "progress", "output_dir")
+    ) -> None:
         """Checks that ``root`` holds an experiment started with the same config.
 
         Raises:
