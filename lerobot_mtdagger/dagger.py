@@ -144,7 +144,9 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
     config = ctx.config
     if round_index == 0:
         scheduler, allocation = None, None
-        counts, runner, beta, max_steps = initial_allocation(ctx), None, 1.0, 10**9
+        # Expert demonstrations run to the env's own truncation (they end soon after success).
+        max_steps = max(env.max_episode_steps for env in ctx.envs)
+        counts, runner, beta = initial_allocation(ctx), None, 1.0
     else:
         scheduler, allocation = schedule_round(ctx, round_index)
         counts = allocation.episodes_per_task
