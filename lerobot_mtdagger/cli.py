@@ -9,6 +9,7 @@ Commands:
     eval: success per task of a pretrained policy (``--policy_path``, ``--suite``, ``--episodes``).
     verify: recompute every round's allocation from its record (``--experiment_dir``).
     merge: rounds 0..k as one LeRobotDataset (``--experiment_dir``, ``--output``).
+    report: eval success against expert demos per method, mean and std over seeds (``--experiments``).
     push: round datasets (tag ``round-{k:03d}`` each) and round policies to the Hub
         (``--experiment_dir``, ``--repo_id``, ``--policy_repo_id``).
     demo: run the performance-aware scheduler on synthetic tasks and print each round's allocation
@@ -235,12 +236,43 @@ def eval_command(config: EvalConfig) -> dict:
     return result.to_dict()
 
 
+@dataclass
+class ReportConfig:
+    """Options of ``lerobot-mtdagger report``: success against expert demos, method by method.
+
+    Attributes:
+        experiments: Experiment directories (several seeds of several methods).
+        output: Optional markdown file for the table.
+    """
+
+    experiments: list[Path] = field(default_factory=list)
+    output: Path | None = None
+
+    def __post_init__(self) -> None:
+        if not self.experiments:
+            raise ValueError(
+                "--experiments is required, e.g. --experiments='[outputs/need-s0,outputs/bc-s0]'."
+            )
+
+
+def report_command(config: ReportConfig) -> str:
+    """Prints the learning curves (mean and std over seeds) of the given experiments."""
+    from lerobot_mtdagger.report import learning_curves, markdown_table
+
+    table = markdown_table(learning_curves(config.experiments))
+    print(table)
+    if config.output is not None:
+        config.output.write_text(table + "\n")
+    return table
+
+
 COMMANDS: dict[str, tuple[type, Callable]] = {
     "run": (RunConfig, run_experiment),
     "eval": (EvalConfig, eval_command),
     "verify": (VerifyConfig, verify_command),
     "merge": (MergeConfig, merge_command),
     "push": (PushConfig, push_command),
+    "report": (ReportConfig, report_command),
     "demo": (DemoConfig, run_demo),
 }
 

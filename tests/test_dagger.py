@@ -123,6 +123,21 @@ def test_merged_rounds_load_as_one_dataset_with_the_same_task_indices(experiment
     assert MTDAggerPolicy.from_pretrained(str(checkpoint)).config.task_names == TASKS
 
 
+def test_report_gives_success_against_demos(experiment, tmp_path, capsys):
+    from lerobot_mtdagger.report import learning_curves
+
+    curves = learning_curves([experiment.root])
+    assert [(p.method, p.round, p.demos_per_task, p.seeds) for p in curves][:2] == [
+        ("need", 0, 3.0, 1),
+        ("need", 1, 6.0, 1),
+    ]
+    assert curves[2].mean == experiment.read_phase_record(2)["eval"]["mean"]
+    with pytest.raises(ValueError, match="Two need experiments with seed 0"):
+        learning_curves([experiment.root, experiment.root])
+    main(["report", f"--experiments=[{experiment.root}]", f"--output={tmp_path / 'r.md'}"])
+    assert "| need | 2 |" in (tmp_path / "r.md").read_text()
+
+
 def test_round_policies_are_lerobot_pretrained_models(experiment):
     policy = MTDAggerPolicy.from_pretrained(str(experiment.policy_root(2)))
     assert policy.config.task_names == TASKS

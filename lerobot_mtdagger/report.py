@@ -1,0 +1,91 @@
+"""Learning curves of experiments: evaluation success against expert demonstrations, method by method.
+
+Reads only committed training phases (``policies/round-XXX/training.json``): after phase k the policy
+was trained on rounds 0..k, which hold ``demos_per_task`` expert-labelled episodes per task. Runs of the
+same method with different seeds are grouped; a curve point is the mean and the sample standard
+deviation over seeds at the same round (the same number of demos for every seed of a method).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from lerobot_mtdagger.rounds import ExperimentDir
+
+
+@dataclass
+class CurvePoint:
+    """Evaluation success of one method after one round, over seeds."""
+
+    method: str
+    round: int
+    demos_per_task: float
+    mean: float
+    std: float
+    seeds: int
+
+
+def experiment_curve(root: Path) -> tuple[str, int, list[tuple[int, float, float]]]:
+    """``(method, seed, [(round, mean demos per task, mean eval success), ...])`` of one experiment."""
+    experiment = ExperimentDir(root)
+    record = experiment.read_round_record(0)
+    points = []
+    for round_index in experiment.committed_phases():
+        phase = experiment.read_phase_record(round_index)
+        if phase.get("eval") is not None:
+            points.append(
+                (round_index, float(np.mean(phase["demos_per_task"])), float(phase["eval"]["mean"]))
+            )
+    return record["method"], int(record["seed"]), points
+
+
+def learning_curves(roots: Sequence[Path]) -> list[CurvePoint]:
+    """Groups experiments by method and averages their curves over seeds, round by round.
+
+    Raises:
+        ValueError: If two runs of one method used the same seed (a duplicate would bias the mean).
+    """
+    grouped: dict[str, dict[int, list[tuple[int, float, float]]]] = defaultdict(dict)
+    for root in roots:
+        method, seed, points = experiment_curve(Path(root))
+        if seed in grouped[method]:
+            raise ValueError(f"Two {method} experiments with seed {seed}; give each run its own seed.")
+        grouped[method][seed] = points
+    curves = []
+    for method, runs in sorted(grouped.items()):
+        by_round: dict[int, list[tuple[float, float]]] = defaultdict(list)
+        for points in runs.values():
+            for round_index, demos, success in points:
+                by_round[round_index].append((demos, success))
+        for round_index, values in sorted(by_round.items()):
+            demos = float(np.mean([d for d, _ in values]))
+            successes = [s for _, s in values]
+            std = float(np.std(successes, ddof=1)) if len(successes) > 1 else math.nan
+            curves.append(
+                CurvePoint(method, round_index, demos, float(np.mean(successes)), std, len(successes))
+            )
+    return curves
+
+
+def markdown_table(curves: Sequence[CurvePoint]) -> str:
+    """The curves as a markdown table (one row per method and round)."""
+    lines = ["| method | round | expert demos per task | eval success (mean) | std over seeds | seeds |"]
+    lines.append("|---|---:|---:|---:|---:|---:|")
+    for point in curves:
+        std = "n/a" if math.isnan(point.std) else f"{point.std:.3f}"
+        cells = [
+            point.method,
+            point.round,
+            f"{point.demos_per_task:.1f}",
+            f"{point.mean:.3f}",
+            std,
+            point.seeds,
+        ]
+        lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+    return "\n".join(lines)
