@@ -392,11 +392,12 @@ def run(config: RunConfig) -> list[str]:
     show = config.progress and sys.stderr.isatty()
     ctx = RunContext(config=config, suite=suite, experiment=experiment, envs=envs, show_progress=show)
     lines = []
+    rounds_done, phases_done = set(experiment.committed_rounds()), set(experiment.committed_phases())
     try:
         for round_index in tqdm(range(ctx.last_round + 1), desc="rounds", disable=not show):
-            if round_index not in experiment.committed_rounds():
+            if round_index not in rounds_done:
                 collect_round(ctx, round_index)
-            if round_index not in experiment.committed_phases():
+            if round_index not in phases_done:
                 train_round(ctx, round_index)
             lines.append(summary_line(ctx, round_index))
             logger.info(lines[-1])

@@ -297,25 +297,17 @@ def merge_rounds(
     return output
 
 
-def _episodes_per_task(root: Path, num_tasks: int) -> list[int]:
-    """Episodes per task index in a round dataset, from its episode metadata."""
+def _stored_tasks(root: Path, num_tasks: int) -> tuple[list[str], list[int]]:
+    """The task vocabulary (in task_index order) and the episodes per task index of a round dataset."""
     from lerobot.datasets.lerobot_dataset import LeRobotDatasetMetadata
 
     meta = LeRobotDatasetMetadata(f"local/{root.name}", root=root)
-    lookup = {
-        str(task): int(index) for task, index in zip(meta.tasks.index, meta.tasks["task_index"], strict=True)
-    }
+    order = [str(t) for t in meta.tasks.sort_values("task_index").index]
+    lookup = {task: index for index, task in enumerate(order)}
     counts = [0] * num_tasks
     for tasks in meta.episodes["tasks"]:
         counts[lookup[tasks[0]]] += 1
-    return counts
-
-
-def _task_order(root: Path) -> list[str]:
-    from lerobot.datasets.lerobot_dataset import LeRobotDatasetMetadata
-
-    meta = LeRobotDatasetMetadata(f"local/{root.name}", root=root)
-    return [str(t) for t in meta.tasks.sort_values("task_index").index]
+    return order, counts
 
 
 def verify_round(experiment: ExperimentDir, round_index: int) -> list[str]:
@@ -333,9 +325,9 @@ def verify_round(experiment: ExperimentDir, round_index: int) -> list[str]:
     record = experiment.read_round_record(round_index)
     root = experiment.round_root(round_index)
     task_names = record["task_names"]
-    if _task_order(root) != task_names:
-        problems.append(f"{name}: task vocabulary {_task_order(root)} != record {task_names}")
-    stored = _episodes_per_task(root, len(task_names))
+    order, stored = _stored_tasks(root, len(task_names))
+    if order != task_names:
+        problems.append(f"{name}: task vocabulary {order} != record {task_names}")
     if stored != record["episodes_per_task"]:
         problems.append(
             f"{name}: dataset holds {stored} episodes per task, record says {record['episodes_per_task']}"

@@ -124,7 +124,7 @@ def test_point_cloud_is_exact_finite_and_inside_the_crop():
     cloud = observation[POINTCLOUD_KEY]
     assert cloud.shape == (512, 3) and cloud.dtype == np.float32
     assert np.all(np.isfinite(cloud))
-    assert np.all(METAWORLD_CROP.contains(cloud.astype(np.float64) + 0.0))
+    assert np.all(METAWORLD_CROP.contains(cloud.astype(np.float64)))
     assert cloud[:, 2].min() >= METAWORLD_CROP.low[2], "the table top must be cropped away"
     env.close()
 
