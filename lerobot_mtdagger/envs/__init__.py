@@ -9,6 +9,8 @@ metaworld-mt10      MetaWorld's MT10 list (v3 envs)
 metaworld-mt25      MetaWorld's MT25 list
 metaworld-mt50      MetaWorld's MT50 list (all v3 tasks)
 metaworld           any explicit ``tasks=[...]`` list of v3 task names
+drawers             the 11 procedurally generated training drawers (``envs/drawers.py``);
+                    ``suite.heldout_task_names`` are unseen drawers the suite also builds
 ==================  =====================================================================
 
 ``tasks=[...]`` with a named list selects a subset in the given order. Rendering uses MuJoCo's EGL
@@ -34,7 +36,7 @@ from lerobot_mtdagger.envs.base import (  # noqa: E402
 )
 from lerobot_mtdagger.envs.rendering import CropBox  # noqa: E402
 
-SUITE_NAMES: tuple[str, ...] = ("metaworld-mt10", "metaworld-mt25", "metaworld-mt50", "metaworld")
+SUITE_NAMES: tuple[str, ...] = ("metaworld-mt10", "metaworld-mt25", "metaworld-mt50", "metaworld", "drawers")
 
 __all__ = [
     "IMAGE_KEY",
@@ -99,6 +101,11 @@ def make_suite(
     )
     if name not in SUITE_NAMES:
         raise ValueError(f"Unknown suite {name!r}; available suites: {list(SUITE_NAMES)}.")
+    if name == "drawers":
+        from lerobot_mtdagger.envs.drawers import DRAWER_TASKS, DrawerSuite
+
+        task_names = list(tasks) if tasks else list(DRAWER_TASKS)
+        return DrawerSuite(task_names, observation, max_episode_steps=max_episode_steps)
     from lerobot_mtdagger.envs.metaworld import MT10_TASKS, MT25_TASKS, MT50_TASKS, MetaWorldSuite
 
     named_lists = {"metaworld-mt10": MT10_TASKS, "metaworld-mt25": MT25_TASKS, "metaworld-mt50": MT50_TASKS}

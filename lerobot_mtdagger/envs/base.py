@@ -7,7 +7,8 @@ policy config, scheduler), plus:
   feature names (``observation.state`` always, ``observation.image`` in ``rgb`` mode,
   ``observation.pointcloud`` in ``pointcloud`` mode); ``info["success"]`` at every step and
   ``info["privileged_state"]``, the low-dimensional state the expert acts on;
-- ``make_expert(task_name)``: an ``Expert`` for that task;
+- ``make_expert(task_name)``: an ``Expert`` for that task (the suite's scripted expert unless
+  ``with_experts`` replaced it);
 - ``features``: the LeRobot feature dict of what the suite emits plus ``action``;
 - ``make_vector_env(task_names, seeds)``: several tasks' envs stepped in parallel processes.
 """
@@ -24,7 +25,7 @@ from typing import Any
 import gymnasium as gym
 
 from lerobot_mtdagger.envs.rendering import CropBox
-from lerobot_mtdagger.experts import Expert
+from lerobot_mtdagger.experts import ActionCheckedExpert, Expert
 
 OBS_MODES: tuple[str, ...] = ("state", "rgb", "pointcloud")
 
@@ -92,6 +93,7 @@ class TaskSuite(abc.ABC):
             raise ValueError(f"Task names must be unique; repeated: {duplicates}.")
         self.task_names = task_names
         self.observation = observation
+        self._experts: dict[str, Expert] = {}
 
     @property
     def obs_mode(self) -> str:
@@ -115,8 +117,32 @@ class TaskSuite(abc.ABC):
         """Builds the env of one task; ``seed`` seeds its first reset."""
 
     @abc.abstractmethod
+    def _scripted_expert(self, task_name: str) -> Expert:
+        """The suite's own expert of one task."""
+
     def make_expert(self, task_name: str) -> Expert:
-        """Builds the expert of one task."""
+        """The task's expert (scripted unless replaced by ``with_experts``), action-size checked.
+
+        Raises:
+            ValueError: If the task is not in the suite.
+        """
+        self.task_index(task_name)
+        expert = self._experts.get(task_name) or self._scripted_expert(task_name)
+        return ActionCheckedExpert(expert, task_name, self.action_dim)
+
+    def with_experts(self, experts: dict[str, Expert]) -> TaskSuite:
+        """A copy of the suite with the expert of some tasks replaced (for example by RL policies).
+
+        Raises:
+            ValueError: On a task not in the suite.
+            TypeError: On an object that is not an ``Expert``.
+        """
+        for task_name, expert in experts.items():
+            self.task_index(task_name)
+            ActionCheckedExpert(expert, task_name, self.action_dim)
+        clone = self.with_observation()
+        clone._experts = {**self._experts, **experts}
+        return clone
 
     @property
     @abc.abstractmethod
@@ -169,6 +195,19 @@ class TaskSuite(abc.ABC):
     def __repr__(self) -> str:
         name = self.__class__.__name__
         return f"{name}(name={self.name!r}, tasks={len(self.task_names)}, obs_mode={self.obs_mode!r})"
+
+
+def observation_features(
+    config: ObservationConfig, state_names: Sequence[str], action_names: Sequence[str]
+) -> dict[str, dict[str, Any]]:
+    """LeRobot features of what a suite emits in the mode of ``config``, plus ``action``."""
+    features = {STATE_KEY: state_feature(state_names)}
+    if config.obs_mode == "rgb":
+        features[IMAGE_KEY] = image_feature(config.image_size)
+    elif config.obs_mode == "pointcloud":
+        features[POINTCLOUD_KEY] = pointcloud_feature(config.num_points, 6 if config.pointcloud_color else 3)
+    features["action"] = state_feature(action_names)
+    return features
 
 
 def state_feature(names: Sequence[str]) -> dict[str, Any]:

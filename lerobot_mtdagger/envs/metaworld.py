@@ -35,12 +35,10 @@ from lerobot_mtdagger.envs.base import (
     STATE_KEY,
     ObservationConfig,
     TaskSuite,
-    image_feature,
-    pointcloud_feature,
-    state_feature,
+    observation_features,
 )
 from lerobot_mtdagger.envs.rendering import CropBox, PointCloudCamera, SceneRenderer, camera_rays
-from lerobot_mtdagger.experts import ActionCheckedExpert, Expert
+from lerobot_mtdagger.experts import Expert
 from lerobot_mtdagger.experts.metaworld import MetaWorldScriptedExpert
 
 logger = logging.getLogger(__name__)
@@ -90,9 +88,17 @@ def _make_raw_env(task_name: str) -> Any:
 
 
 class MetaWorldTaskEnv(gym.Env):
-    """One MetaWorld v3 task with LeRobot-keyed dict observations."""
+    """One MetaWorld v3 task with LeRobot-keyed dict observations.
+
+    Subclasses for other scenes of MetaWorld's Sawyer arena (the drawer suite) override the
+    hooks ``_build_raw_env``, ``state_names``, ``_proprio_state`` and ``_step_info`` and the
+    class-level camera and crop defaults.
+    """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 80}
+    default_camera: str = DEFAULT_CAMERA
+    default_pointcloud_cameras: tuple[str, ...] = DEFAULT_POINTCLOUD_CAMERAS
+    default_crop: CropBox = METAWORLD_CROP
 
     def __init__(
         self,
@@ -111,7 +117,7 @@ class MetaWorldTaskEnv(gym.Env):
         """
         self.task_name = task_name
         self.observation_config = observation
-        self._env = _make_raw_env(task_name)
+        self._env = self._build_raw_env()
         self.max_episode_steps = int(max_episode_steps or self._env.max_path_length)
         limit = self._env.max_path_length
         if not 0 < self.max_episode_steps <= limit:
@@ -127,6 +133,34 @@ class MetaWorldTaskEnv(gym.Env):
         self.observation_space = self._make_observation_space()
 
     # ---------------------------------------------------------------------------------------------
+    # Hooks of subclasses
+    # ---------------------------------------------------------------------------------------------
+
+    def _build_raw_env(self) -> Any:
+        """The underlying MetaWorld (``SawyerXYZEnv``) env of ``self.task_name``."""
+        return _make_raw_env(self.task_name)
+
+    def state_names(self) -> list[str]:
+        """Names of the entries of ``observation.state``."""
+        return observation_state_names(self.observation_config)
+
+    def _proprio_state(self, raw: np.ndarray) -> np.ndarray:
+        """``observation.state`` in the rgb and point-cloud modes, from the raw MetaWorld state."""
+        if self.observation_config.include_goal:
+            return np.concatenate([raw[:4], raw[36:39]])
+        return raw[:4]
+
+    def _step_info(self, raw: np.ndarray, raw_info: dict[str, Any]) -> dict[str, Any]:
+        """The info dict of a step (and, with an empty ``raw_info``, of a reset)."""
+        success = bool(raw_info.get("success", False))
+        return {
+            "success": success,
+            "is_success": success,
+            "privileged_state": raw.copy(),
+            "task": self.task_name,
+        }
+
+    # ---------------------------------------------------------------------------------------------
     # Spaces and rendering
     # ---------------------------------------------------------------------------------------------
 
@@ -135,14 +169,14 @@ class MetaWorldTaskEnv(gym.Env):
         model = self._env.model
         if config.obs_mode == "rgb":
             self._renderer = SceneRenderer(model, config.image_size, config.image_size)
-            self._camera = config.camera or DEFAULT_CAMERA
+            self._camera = config.camera or self.default_camera
             camera_rays(model, self._camera, 1, 1)  # fail now, not at the first frame, on a misspelt camera
         elif config.obs_mode == "pointcloud":
             self._renderer = SceneRenderer(model, config.depth_size, config.depth_size)
             self._cloud = PointCloudCamera(
                 self._renderer,
-                config.pointcloud_cameras or DEFAULT_POINTCLOUD_CAMERAS,
-                config.crop or METAWORLD_CROP,
+                config.pointcloud_cameras or self.default_pointcloud_cameras,
+                config.crop or self.default_crop,
                 config.num_points,
                 with_color=config.pointcloud_color,
             )
@@ -150,9 +184,7 @@ class MetaWorldTaskEnv(gym.Env):
     def _make_observation_space(self) -> gym.spaces.Dict:
         config = self.observation_config
         spaces: dict[str, gym.Space] = {
-            STATE_KEY: gym.spaces.Box(
-                -np.inf, np.inf, (len(observation_state_names(config)),), dtype=np.float32
-            )
+            STATE_KEY: gym.spaces.Box(-np.inf, np.inf, (len(self.state_names()),), dtype=np.float32)
         }
         if config.obs_mode == "rgb":
             spaces[IMAGE_KEY] = gym.spaces.Box(
@@ -168,8 +200,7 @@ class MetaWorldTaskEnv(gym.Env):
         config = self.observation_config
         if config.obs_mode == "state":
             return {STATE_KEY: raw.astype(np.float32)}
-        state = raw[:4] if not config.include_goal else np.concatenate([raw[:4], raw[36:39]])
-        observation = {STATE_KEY: state.astype(np.float32)}
+        observation = {STATE_KEY: self._proprio_state(raw).astype(np.float32)}
         if config.obs_mode == "rgb":
             assert self._renderer is not None
             observation[IMAGE_KEY] = self._rgb(self._camera)
@@ -190,7 +221,7 @@ class MetaWorldTaskEnv(gym.Env):
         if self._renderer is None:
             size = self.observation_config.image_size
             self._renderer = SceneRenderer(self._env.model, size, size)
-        return self._rgb(self.observation_config.camera or DEFAULT_CAMERA)
+        return self._rgb(self.observation_config.camera or self.default_camera)
 
     # ---------------------------------------------------------------------------------------------
     # Gymnasium API
@@ -210,8 +241,7 @@ class MetaWorldTaskEnv(gym.Env):
         raw, _ = self._env.reset()
         self._elapsed = 0
         self._needs_reset = False
-        info = {"success": False, "is_success": False, "privileged_state": raw.copy(), "task": self.task_name}
-        return self._observation(raw), info
+        return self._observation(raw), self._step_info(raw, {})
 
     def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         """Applies one action (clipped to [-1, 1]).
@@ -231,14 +261,7 @@ class MetaWorldTaskEnv(gym.Env):
         self._elapsed += 1
         truncated = self._elapsed >= self.max_episode_steps
         self._needs_reset = truncated
-        success = bool(raw_info["success"])
-        info = {
-            "success": success,
-            "is_success": success,
-            "privileged_state": raw.copy(),
-            "task": self.task_name,
-        }
-        return self._observation(raw), float(reward), False, truncated, info
+        return self._observation(raw), float(reward), False, truncated, self._step_info(raw, raw_info)
 
     def close(self) -> None:
         """Frees the renderer and the MuJoCo model."""
@@ -271,7 +294,6 @@ class MetaWorldSuite(TaskSuite):
         self.name = name
         super().__init__(task_names, observation)
         self.max_episode_steps = max_episode_steps
-        self._experts: dict[str, Expert] = {}
 
     @property
     def action_dim(self) -> int:
@@ -285,36 +307,11 @@ class MetaWorldSuite(TaskSuite):
             task_name, self.observation, seed=seed, max_episode_steps=self.max_episode_steps
         )
 
-    def with_experts(self, experts: dict[str, Expert]) -> MetaWorldSuite:
-        """Replaces the scripted expert of some tasks (for example by RL-trained policies).
-
-        Raises:
-            ValueError: On a task not in the suite.
-            TypeError: On an object that is not an ``Expert``.
-        """
-        for task_name, expert in experts.items():
-            self.task_index(task_name)
-            ActionCheckedExpert(expert, task_name, self.action_dim)
-        clone = self.with_observation()
-        clone._experts = {**self._experts, **experts}
-        return clone
-
-    def make_expert(self, task_name: str) -> Expert:
-        """The task's expert (scripted unless replaced by ``with_experts``), action-size checked."""
-        self.task_index(task_name)
-        expert = self._experts.get(task_name) or MetaWorldScriptedExpert(task_name)
-        return ActionCheckedExpert(expert, task_name, self.action_dim)
+    def _scripted_expert(self, task_name: str) -> Expert:
+        """MetaWorld's scripted policy of the task."""
+        return MetaWorldScriptedExpert(task_name)
 
     @property
     def features(self) -> dict[str, dict[str, Any]]:
         """LeRobot features of the observations of the current mode, plus ``action``."""
-        config = self.observation
-        features = {STATE_KEY: state_feature(observation_state_names(config))}
-        if config.obs_mode == "rgb":
-            features[IMAGE_KEY] = image_feature(config.image_size)
-        elif config.obs_mode == "pointcloud":
-            features[POINTCLOUD_KEY] = pointcloud_feature(
-                config.num_points, 6 if config.pointcloud_color else 3
-            )
-        features["action"] = state_feature(ACTION_NAMES)
-        return features
+        return observation_features(self.observation, observation_state_names(self.observation), ACTION_NAMES)

@@ -33,15 +33,24 @@ import numpy as np
 
 logger = logging.getLogger(__name__)
 
-# Renderers still open at interpreter exit are closed while OpenGL is still loaded; otherwise
-# MuJoCo's own finalisers run after PyOpenGL is torn down and print EGL errors.
+# Renderers still open at interpreter exit are closed while the EGL display is still up; otherwise
+# MuJoCo's own finalisers run after it is terminated and print EGL errors. MuJoCo registers the
+# display's ``eglTerminate`` at exit when it creates the first context, so this handler is
+# registered right after that (handlers run last-in, first-out).
 _OPEN_RENDERERS: weakref.WeakSet[SceneRenderer] = weakref.WeakSet()
+_EXIT_HANDLER_REGISTERED = False
 
 
-@atexit.register
 def _close_open_renderers() -> None:
     for renderer in list(_OPEN_RENDERERS):
         renderer.close()
+
+
+def _register_exit_handler() -> None:
+    global _EXIT_HANDLER_REGISTERED
+    if not _EXIT_HANDLER_REGISTERED:
+        atexit.register(_close_open_renderers)
+        _EXIT_HANDLER_REGISTERED = True
 
 
 @dataclass(frozen=True)
@@ -111,6 +120,7 @@ class SceneRenderer:
     def _get(self) -> mujoco.Renderer:
         if self._renderer is None:
             self._renderer = mujoco.Renderer(self.model, self.height, self.width)
+            _register_exit_handler()
             _OPEN_RENDERERS.add(self)
         return self._renderer
 
