@@ -1,10 +1,10 @@
-"""Times single-process MetaWorld env steps in every observation mode against raw MetaWorld.
+"""Times single-process env steps of a suite in every observation mode against its raw env.
 
-Run: ``.venv/bin/python benchmarks/bench_envs.py`` (options: ``--tasks``, ``--steps``,
-``--render-steps``, ``--rounds``). Modes, all fed the same pre-drawn random actions
-(``np.random.default_rng(0).uniform(-1, 1, (n, 4))``, float32):
+Run: ``.venv/bin/python benchmarks/bench_envs.py`` (options: ``--suite metaworld-mt10|drawers``,
+``--tasks``, ``--steps``, ``--render-steps``, ``--rounds``). Modes, all fed the same pre-drawn random
+actions (``np.random.default_rng(0).uniform(-1, 1, (n, 4))``, float32):
 
-- ``raw``: MetaWorld's own ``env.step`` (no wrapper);
+- ``raw``: the underlying ``SawyerXYZEnv.step`` (MetaWorld's env, or the drawer scene), no wrapper;
 - ``state``: our env in ``state`` mode;
 - ``rgb``: our env in ``rgb`` mode, 84 x 84 pixels;
 - ``pointcloud``: our env in ``pointcloud`` mode, 1024 points from the two default depth cameras;
@@ -32,18 +32,27 @@ from collections import defaultdict
 import numpy as np
 
 from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs.drawers import VARIANTS, DrawerSceneEnv
 from lerobot_mtdagger.envs.metaworld import _make_raw_env
 
-DEFAULT_TASKS = ["reach-v3", "push-v3", "door-open-v3", "drawer-open-v3"]
+DEFAULT_TASKS = {
+    "metaworld-mt10": ["reach-v3", "push-v3", "door-open-v3", "drawer-open-v3"],
+    "drawers": ["drawer-bar-wide", "drawer-knob-large", "drawer-lip-wide", "drawer-kitchen"],
+}
 MODES = ["raw", "state", "rgb", "pointcloud", "pointcloud-1cam"]
 RENDER_MODES = {"rgb", "pointcloud", "pointcloud-1cam"}
 STATE_TARGET_RATIO = 0.9
 POINTCLOUD_TARGET_RATE = 50.0
 
 
-def time_raw(task: str, actions: np.ndarray) -> float:
-    """Seconds spent in ``raw.step`` for all ``actions`` (resets before the 500-step limit, untimed)."""
-    raw = _make_raw_env(task)
+def make_raw_env(suite: str, task: str):
+    """The raw ``SawyerXYZEnv`` of a task of ``suite``."""
+    return DrawerSceneEnv(VARIANTS[task]) if suite == "drawers" else _make_raw_env(task)
+
+
+def time_raw(suite: str, task: str, actions: np.ndarray) -> float:
+    """Seconds spent in ``raw.step`` for all ``actions`` (resets before the step limit, untimed)."""
+    raw = make_raw_env(suite, task)
     try:
         raw.seed(0)
         raw.reset()
@@ -59,11 +68,11 @@ def time_raw(task: str, actions: np.ndarray) -> float:
         raw.close()
 
 
-def make_env(task: str, mode: str, num_points: int, image_size: int):
+def make_env(suite_name: str, task: str, mode: str, num_points: int, image_size: int):
     """Our env of ``task`` in ``mode`` (``pointcloud-1cam`` is point-cloud mode with one camera)."""
     obs_mode, cameras = ("pointcloud", ("corner",)) if mode == "pointcloud-1cam" else (mode, None)
     suite = make_suite(
-        "metaworld-mt10",
+        suite_name,
         obs_mode=obs_mode,
         num_points=num_points,
         image_size=image_size,
@@ -72,9 +81,9 @@ def make_env(task: str, mode: str, num_points: int, image_size: int):
     return suite.make_env(task, seed=0)
 
 
-def time_wrapped(task: str, mode: str, actions: np.ndarray, num_points: int, image_size: int) -> float:
+def time_wrapped(args, task: str, mode: str, actions: np.ndarray) -> float:
     """Seconds spent in ``env.step`` of our env for all ``actions`` (resets untimed)."""
-    env = make_env(task, mode, num_points, image_size)
+    env = make_env(args.suite, task, mode, args.num_points, args.image_size)
     try:
         env.reset()
         total = 0.0
@@ -98,10 +107,10 @@ def run_sweep(args, actions: np.ndarray):
             for mode in MODES:
                 n = args.render_steps if mode in RENDER_MODES else args.steps
                 if mode == "raw":
-                    seconds = time_raw(task, actions[: args.steps])
+                    seconds = time_raw(args.suite, task, actions[: args.steps])
                     raw_rate = args.steps / seconds
                 else:
-                    seconds = time_wrapped(task, mode, actions[:n], args.num_points, args.image_size)
+                    seconds = time_wrapped(args, task, mode, actions[:n])
                 samples[mode].append((n, seconds, n / seconds / raw_rate))
             print(f"  round {round_index + 1}/{args.rounds} {task}: done", flush=True)
     return samples
@@ -119,7 +128,7 @@ def summarize(samples) -> dict[str, tuple[int, float, float]]:
 
 def print_table(summary, num_points: int, image_size: int) -> None:
     labels = {
-        "raw": "raw MetaWorld step",
+        "raw": "raw step",
         "state": "state",
         "rgb": f"rgb {image_size} px",
         "pointcloud": f"pointcloud {num_points} pts, 2 cams",
@@ -156,7 +165,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    parser.add_argument("--tasks", nargs="+", default=DEFAULT_TASKS)
+    parser.add_argument("--suite", choices=sorted(DEFAULT_TASKS), default="metaworld-mt10")
+    parser.add_argument("--tasks", nargs="+", default=None, help="default: four tasks of the suite")
     parser.add_argument("--steps", type=int, default=300, help="steps per task per round, raw and state")
     parser.add_argument(
         "--render-steps", type=int, default=150, help="steps per task per round, rgb/pointcloud"
@@ -165,6 +175,7 @@ def main() -> None:
     parser.add_argument("--num-points", type=int, default=1024)
     parser.add_argument("--image-size", type=int, default=84)
     args = parser.parse_args()
+    args.tasks = args.tasks or DEFAULT_TASKS[args.suite]
     if args.steps <= 0 or args.render_steps <= 0 or args.rounds <= 0:
         parser.error("--steps, --render-steps and --rounds must be positive.")
     actions = (
@@ -173,7 +184,8 @@ def main() -> None:
     start = time.perf_counter()
     summary = summarize(run_sweep(args, actions))
     print(
-        f"tasks: {' '.join(args.tasks)}; rounds: {args.rounds}; wall time {time.perf_counter() - start:.0f} s"
+        f"suite: {args.suite}; tasks: {' '.join(args.tasks)}; rounds: {args.rounds}; "
+        f"wall time {time.perf_counter() - start:.0f} s"
     )
     print("steps/s = total steps / total step time; ratio to raw = median over (task, round) pairs")
     print_table(summary, args.num_points, args.image_size)

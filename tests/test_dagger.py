@@ -222,6 +222,35 @@ def test_bc_collects_the_whole_budget_in_one_round(tmp_path):
     assert experiment.read_phase_record(0)["steps"] == 3 * 60
 
 
+def test_drawer_suite_runs_with_point_clouds(tmp_path):
+    import draccus
+
+    args = [
+        "--preset=drawers-pointcloud",
+        "--tasks=[drawer-bar-wide,drawer-lip-shallow]",
+        "--rounds=1",
+        "--initial_demos=1",
+        "--budget_per_task=1",
+        "--n_min=1",
+        "--steps_per_round=20",
+        "--eval_episodes=1",
+        "--num_points=128",
+        "--max_rollout_steps=80",
+        "--progress=false",
+        f"--output_dir={tmp_path / 'drawers'}",
+    ]
+    run(draccus.parse(RunConfig, args=args))
+    experiment = ExperimentDir(tmp_path / "drawers")
+    assert experiment.committed_rounds() == [0, 1]
+    assert verify_experiment(experiment) == []
+    record = experiment.read_round_record(1)
+    assert record["task_names"] == ["drawer-bar-wide", "drawer-lip-shallow"]
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    dataset = LeRobotDataset("local/drawers", root=experiment.round_root(1))
+    assert tuple(dataset[0]["observation.pointcloud"].shape) == (128, 3)
+
+
 def _cli(output_dir: Path, *extra: str) -> list[str]:
     return [
         str(Path(sys.executable).parent / "lerobot-mtdagger"),
