@@ -129,7 +129,8 @@ class DrawerVariant:
         handle_size: Bar length (bar, vbar), cap radius (knob) or tab width (lip).
         handle_height: Height of the handle centre on the front, as a fraction of half the front
             height (-1 bottom edge, 0 centre, 1 top edge); must be 0 for ``lip``.
-        handle_clearance: Gap between the front panel and the back of the handle (finger room).
+        handle_clearance: Gap between the front panel and the back of the handle (finger room);
+            unused by ``lip`` (its tab stands flush on the top edge; the finger goes behind it).
         width: Outer width of the case.
         height: Outer height of the case.
         depth: Outer depth of the case.
