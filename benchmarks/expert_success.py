@@ -23,7 +23,7 @@ def main() -> None:
     args = parser.parse_args()
     suite = make_suite(args.suite)
     seeds = range(args.first_seed, args.first_seed + args.episodes)
-    heldout = list(getattr(suite, "heldout_task_names", []))
+    heldout = suite.heldout_task_names
     print("| task | success | mean steps (successful) |\n|---|---:|---:|")
     rates = []
     for task_name in suite.task_names + heldout:

@@ -94,6 +94,8 @@ class TaskSuite(abc.ABC):
         self.task_names = task_names
         self.observation = observation
         self._experts: dict[str, Expert] = {}
+        # Unseen tasks the suite builds envs and experts for (evaluation only; no task index).
+        self.heldout_task_names: list[str] = []
 
     @property
     def obs_mode(self) -> str:
@@ -120,13 +122,25 @@ class TaskSuite(abc.ABC):
     def _scripted_expert(self, task_name: str) -> Expert:
         """The suite's own expert of one task."""
 
+    def check_buildable(self, task_name: str) -> None:
+        """Checks that the suite builds ``task_name``: one of its tasks or of its held-out tasks.
+
+        Raises:
+            ValueError: Otherwise.
+        """
+        if task_name not in self.task_names and task_name not in self.heldout_task_names:
+            raise ValueError(
+                f"Task {task_name!r} is neither a task of suite {self.name!r} {self.task_names} nor held out "
+                f"{self.heldout_task_names}."
+            )
+
     def make_expert(self, task_name: str) -> Expert:
         """The task's expert (scripted unless replaced by ``with_experts``), action-size checked.
 
         Raises:
-            ValueError: If the task is not in the suite.
+            ValueError: If the suite does not build the task.
         """
-        self.task_index(task_name)
+        self.check_buildable(task_name)
         expert = self._experts.get(task_name) or self._scripted_expert(task_name)
         return ActionCheckedExpert(expert, task_name, self.action_dim)
 

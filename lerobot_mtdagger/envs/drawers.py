@@ -40,6 +40,7 @@ only: the drawer is in the image or cloud (``include_goal`` has no effect on thi
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import os
@@ -58,7 +59,7 @@ from metaworld.sawyer_xyz_env import SawyerXYZEnv
 from lerobot_mtdagger.envs.base import ObservationConfig, TaskSuite, observation_features
 from lerobot_mtdagger.envs.metaworld import ACTION_DIM, ACTION_NAMES, PROPRIO_NAMES, MetaWorldTaskEnv
 from lerobot_mtdagger.envs.rendering import CropBox
-from lerobot_mtdagger.experts import ActionCheckedExpert, Expert
+from lerobot_mtdagger.experts import Expert
 
 logger = logging.getLogger(__name__)
 
@@ -388,30 +389,22 @@ def _vec(values: Sequence[float]) -> str:
     return " ".join(f"{v:.5g}" for v in values)
 
 
-def _box(name: str, pos: Sequence[float], size: Sequence[float], rgba: Sequence[float], **extra: str) -> str:
-    attributes = "".join(f' {k}="{v}"' for k, v in extra.items())
-    return (
-        f'<geom name="{name}" type="box" pos="{_vec(pos)}" size="{_vec(size)}" '
-        f'rgba="{_vec(rgba)}"{attributes}/>'
-    )
+def _box(name: str, pos: Sequence[float], size: Sequence[float], rgba: Sequence[float]) -> str:
+    return f'<geom name="{name}" type="box" pos="{_vec(pos)}" size="{_vec(size)}" rgba="{_vec(rgba)}"/>'
 
 
-def _capsule(
-    name: str, start: Sequence[float], end: Sequence[float], radius: float, rgba: Sequence[float]
+def _round_geom(
+    kind: str, name: str, start: Sequence[float], end: Sequence[float], radius: float, rgba: Sequence[float]
 ) -> str:
+    """A ``capsule`` or ``cylinder`` handle part from ``start`` to ``end`` (grippy: friction 1.5)."""
     return (
-        f'<geom name="{name}" type="capsule" fromto="{_vec([*start, *end])}" size="{radius:.5g}" '
+        f'<geom name="{name}" type="{kind}" fromto="{_vec([*start, *end])}" size="{radius:.5g}" '
         f'rgba="{_vec(rgba)}" friction="1.5 0.05 0.001" condim="4"/>'
     )
 
 
-def _cylinder(
-    name: str, start: Sequence[float], end: Sequence[float], radius: float, rgba: Sequence[float]
-) -> str:
-    return (
-        f'<geom name="{name}" type="cylinder" fromto="{_vec([*start, *end])}" size="{radius:.5g}" '
-        f'rgba="{_vec(rgba)}" friction="1.5 0.05 0.001" condim="4"/>'
-    )
+_capsule = functools.partial(_round_geom, "capsule")
+_cylinder = functools.partial(_round_geom, "cylinder")
 
 
 def _case_geoms(v: DrawerVariant) -> list[str]:
@@ -744,8 +737,8 @@ class DrawerSceneEnv(SawyerXYZEnv):
         opening = self.opening
         success = opening >= SUCCESS_FRACTION * travel
         touched = self.fingers_touch_handle()
-        progress = int(touched or opening >= PULL_FRACTION * travel)
-        progress += int(opening >= PULL_FRACTION * travel) + int(success)
+        pulled = opening >= PULL_FRACTION * travel
+        progress = int(touched or pulled) + int(pulled) + int(success)
         self._progress = max(self._progress, progress)
         reach = float(np.linalg.norm(obs[0:3] - obs[7:10]))
         reward = (1.0 - math.tanh(5.0 * reach)) + 5.0 * min(opening / travel, 1.0)
@@ -756,6 +749,11 @@ class DrawerSceneEnv(SawyerXYZEnv):
             "touching_handle": float(touched),
         }
         return reward, info
+
+
+def drawer_state_names(config: ObservationConfig) -> list[str]:
+    """Names of ``observation.state``: privileged state in ``state`` mode, else hand xyz + gripper."""
+    return DRAWER_STATE_NAMES if config.obs_mode == "state" else PROPRIO_NAMES
 
 
 def render_drawer_picture(
@@ -819,7 +817,7 @@ class DrawerTaskEnv(MetaWorldTaskEnv):
 
     def state_names(self) -> list[str]:
         """Privileged state names in ``state`` mode, hand xyz + gripper otherwise."""
-        return DRAWER_STATE_NAMES if self.observation_config.obs_mode == "state" else PROPRIO_NAMES
+        return drawer_state_names(self.observation_config)
 
     def _proprio_state(self, raw: np.ndarray) -> np.ndarray:
         return raw[:4]
@@ -870,32 +868,18 @@ class DrawerSuite(TaskSuite):
         """MetaWorld's 4-d action: end-effector displacement xyz and gripper effort."""
         return ACTION_DIM
 
-    def _check_known(self, task_name: str) -> DrawerVariant:
-        if task_name in self.task_names or task_name in self.heldout_task_names:
-            return self.variants[task_name]
-        raise ValueError(
-            f"Drawer {task_name!r} is neither a task of this suite {self.task_names} nor held out "
-            f"{self.heldout_task_names}."
-        )
-
     def make_env(self, task_name: str, seed: int | None = None) -> DrawerTaskEnv:
         """Builds the env of a training or held-out drawer."""
-        variant = self._check_known(task_name)
+        self.check_buildable(task_name)
+        variant = self.variants[task_name]
         return DrawerTaskEnv(variant, self.observation, seed=seed, max_episode_steps=self.max_episode_steps)
-
-    def make_expert(self, task_name: str) -> Expert:
-        """The drawer's expert; held-out drawers get their scripted expert too."""
-        if task_name in self.heldout_task_names:
-            return ActionCheckedExpert(self._scripted_expert(task_name), task_name, self.action_dim)
-        return super().make_expert(task_name)
 
     def _scripted_expert(self, task_name: str) -> Expert:
         from lerobot_mtdagger.experts.drawers import DrawerScriptedExpert
 
-        return DrawerScriptedExpert(self._check_known(task_name))
+        return DrawerScriptedExpert(self.variants[task_name])
 
     @property
     def features(self) -> dict[str, dict[str, Any]]:
         """LeRobot features of the observations of the current mode, plus ``action``."""
-        names = DRAWER_STATE_NAMES if self.obs_mode == "state" else PROPRIO_NAMES
-        return observation_features(self.observation, names, ACTION_NAMES)
+        return observation_features(self.observation, drawer_state_names(self.observation), ACTION_NAMES)
