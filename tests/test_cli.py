@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import fnmatch
 import json
+import shutil
 import subprocess
 import sys
+import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -73,5 +77,20 @@ def test_simulation_is_reproducible_under_a_seed():
     assert np.all(np.asarray(run()).sum(axis=1) == 15)
 
 
-def test_dataset_card_template_ships_with_the_package():
-    assert "{{ allocation_table }}" in card_template()
+def test_dataset_card_template_ships_with_the_package(tmp_path):
+    assert "{{ allocation_table }}" in card_template()  # the importable package (here: the source tree)
+
+    # The built distribution: a wheel of a copy of the project (building in place would write build/ into
+    # the checkout and could package stale files from it). The copy skips what .gitignore ignores.
+    repo = Path(__file__).resolve().parents[1]
+    ignored = [line.rstrip("/") for line in (repo / ".gitignore").read_text().split() if line.strip()]
+    source = tmp_path / "source"
+    shutil.copytree(repo, source, ignore=shutil.ignore_patterns(".git", *ignored))
+    pip_wheel = [sys.executable, "-m", "pip", "wheel", str(source), "--no-deps", "--no-build-isolation"]
+    subprocess.run([*pip_wheel, "-w", str(tmp_path / "dist")], check=True, capture_output=True, text=True)
+    (wheel,) = (tmp_path / "dist").glob("lerobot_mtdagger-*.whl")
+    with zipfile.ZipFile(wheel) as archive:
+        cards = fnmatch.filter(archive.namelist(), "lerobot_mtdagger/datasets_cards/*.md")
+        assert "lerobot_mtdagger/datasets_cards/mtdagger_card.md" in cards, f"cards in the wheel: {cards}"
+        card = archive.read("lerobot_mtdagger/datasets_cards/mtdagger_card.md").decode("utf-8")
+    assert "{{ allocation_table }}" in card

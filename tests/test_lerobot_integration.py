@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.policies.factory import make_pre_post_processors
-from safetensors.torch import load_file
 
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.policies import MTDAggerPolicy
@@ -42,6 +42,14 @@ def lerobot_eval(checkpoint: Path, output_dir: Path, obs_mode: str, extra: list[
     return json.loads((output_dir / "eval_info.json").read_text())
 
 
+def imitation_loss(policy: MTDAggerPolicy, preprocessor, dataset_root: Path) -> float:
+    """The policy's loss (MSE to the expert actions, normalised) over every frame of the dataset."""
+    dataset = LeRobotDataset("local/tiny", root=dataset_root)
+    batch = next(iter(torch.utils.data.DataLoader(dataset, batch_size=len(dataset))))
+    with torch.no_grad():
+        return policy.forward(preprocessor(batch))[0].item()
+
+
 def test_stock_lerobot_train_and_eval_on_state(tmp_path, expert_dataset_factory):
     suite = make_suite("metaworld-mt10", tasks=TASKS)
     root = expert_dataset_factory(suite)
@@ -49,12 +57,19 @@ def test_stock_lerobot_train_and_eval_on_state(tmp_path, expert_dataset_factory)
 
     policy = MTDAggerPolicy.from_pretrained(checkpoint)
     assert policy.config.task_names == TASKS, "the vocabulary comes from the dataset and is saved"
-    saved = load_file(checkpoint / "model.safetensors")
-    for name, tensor in policy.state_dict().items():
-        torch.testing.assert_close(tensor, saved[name], rtol=0, atol=0)
+    pre, post = make_pre_post_processors(policy.config, pretrained_path=str(checkpoint))
+
+    # lerobot-train really trained the weights: the checkpoint imitates the experts clearly better than
+    # freshly initialised policies of the same config, which predict about 0 in normalised units (a
+    # loss near 1, the actions' variance). Measured: about 0.54 after 20 steps, 0.99-1.01 fresh.
+    fresh_losses = []
+    for seed in range(3):
+        torch.manual_seed(seed)
+        fresh_losses.append(imitation_loss(MTDAggerPolicy(policy.config), pre, root))
+    trained_loss = imitation_loss(policy, pre, root)
+    assert trained_loss < 0.8 * min(fresh_losses), f"trained {trained_loss:.3f}, fresh {fresh_losses}"
 
     # Identical actions through the saved processors, for two independent loads.
-    pre, post = make_pre_post_processors(policy.config, pretrained_path=str(checkpoint))
     env = suite.make_env("button-press-topdown-v3", seed=3)
     observation, _ = env.reset()
     env.close()

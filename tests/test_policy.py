@@ -62,8 +62,25 @@ def test_forward_backward_for_each_modality(modality):
     loss, info = policy.forward(batch)
     loss.backward()
     assert torch.isfinite(loss)
-    assert all(p.grad is not None for p in policy.head.parameters())
     assert set(info["per_task_loss"]) == {"reach-v3", "push-v3"}
+
+    # The modality builds exactly its encoders, and the loss trains every parameter of all of them.
+    encoders = {
+        "observation.state": "state_encoder",
+        "observation.image": "image_encoder",
+        "observation.pointcloud": "pointcloud_encoders",
+    }
+    expected_modules = {"task_embedding", "head"} | {encoders[key] for key in inputs}
+    parameters = dict(policy.named_parameters())
+    assert {name.split(".")[0] for name in parameters} == expected_modules
+    for name, parameter in parameters.items():
+        grad = parameter.grad
+        assert grad is not None, f"{name} gets no gradient"
+        finite, non_zero = bool(torch.isfinite(grad).all()), bool(grad.abs().sum() > 0)
+        assert finite and non_zero, f"{name}: finite gradient {finite}, non-zero gradient {non_zero}"
+    # Only the embeddings of the tasks in the batch move (door-open-v3 is absent).
+    embedding_grad_norms = policy.task_embedding.weight.grad.norm(dim=1)
+    assert embedding_grad_norms[0] > 0 and embedding_grad_norms[1] > 0 and embedding_grad_norms[2] == 0
     assert policy.select_action(batch).shape == (6, 4)
 
 
