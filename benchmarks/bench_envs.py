@@ -32,7 +32,8 @@ from collections import defaultdict
 import numpy as np
 
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.envs.drawers import VARIANTS, DrawerSceneEnv
+from lerobot_mtdagger.envs.drawers.catalogue import VARIANTS
+from lerobot_mtdagger.envs.drawers.scene import DrawerSceneEnv
 from lerobot_mtdagger.envs.metaworld import _make_raw_env
 
 DEFAULT_TASKS = {

@@ -12,7 +12,7 @@ import argparse
 import numpy as np
 
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.experts import run_expert_episode
+from lerobot_mtdagger.experts import make_expert, run_expert_episode
 
 
 def main() -> None:
@@ -28,7 +28,7 @@ def main() -> None:
     rates = []
     for task_name in suite.task_names + heldout:
         env = suite.make_env(task_name)
-        expert = suite.make_expert(task_name)
+        expert = make_expert(suite, task_name)
         episodes = [run_expert_episode(env, expert, seed) for seed in seeds]
         env.close()
         rate = np.mean([e.success for e in episodes])

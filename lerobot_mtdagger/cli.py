@@ -5,7 +5,8 @@ configs are set with dots, for example ``--scheduler.type=need --scheduler.tempe
 
 Commands:
     run: one Multitask DAgger experiment (``--preset``, ``--suite``, ``--tasks``, ``--scheduler.type``,
-        ``--rounds``, ``--budget``, ``--output_dir``, ``--resume``, ...; see ``RunConfig``).
+        ``--rounds``, ``--budget``, ``--output_dir``, ``--resume``, ...; see ``RunConfig``), or the
+        one-round behaviour-cloning baseline with ``--mode=bc``.
     eval: success per task of a pretrained policy (``--policy_path``, ``--suite``, ``--episodes``).
     verify: recompute every round's allocation from its record (``--experiment_dir``).
     merge: rounds 0..k as one LeRobotDataset (``--experiment_dir``, ``--output``).
@@ -28,9 +29,9 @@ from pathlib import Path
 import draccus
 import numpy as np
 
-from lerobot_mtdagger.configs import RunConfig
+from lerobot_mtdagger.configs import RunConfig, renamed_option_error
 from lerobot_mtdagger.hub import PushConfig, push_command
-from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig, scheduler_from_config
+from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
 from lerobot_mtdagger.simulate import SyntheticTasks, simulate
 
 logger = logging.getLogger(__name__)
@@ -76,12 +77,12 @@ def run_demo(config: DemoConfig) -> list[dict]:
     Returns:
         The JSON-ready round records.
     """
-    scheduler = scheduler_from_config(config.scheduler, config.num_tasks)
+    scheduler = Scheduler(config.scheduler, config.num_tasks)
     tasks = SyntheticTasks.spread(config.num_tasks)
     history = simulate(scheduler, tasks, config.rounds, config.budget, config.initial_demos, config.seed)
     print(
         f"scheduler={config.scheduler.type} tasks={config.num_tasks} budget={config.budget}/round "
-        f"T={config.scheduler.temperature} n_min={config.scheduler.n_min}"
+        f"T={config.scheduler.temperature} n_min={config.scheduler.min_episodes}"
     )
     print("task difficulty (easy -> hard):", np.round(tasks.difficulty, 1).tolist())
     for record in history:
@@ -128,14 +129,13 @@ class VerifyConfig:
 
 def verify_command(config: VerifyConfig) -> list[str]:
     """Recomputes every round's allocation from its record and checks it against the data."""
-    from lerobot_mtdagger.rounds import ExperimentDir, verify_experiment
+    from lerobot_mtdagger.rounds import ExperimentDir
+    from lerobot_mtdagger.verify import verify_experiment
 
-    experiment = ExperimentDir(config.experiment_dir)
-    problems = verify_experiment(experiment)
-    rounds = experiment.committed_rounds()
+    num_rounds, problems = verify_experiment(ExperimentDir(config.experiment_dir))
     for problem in problems:
         print(f"MISMATCH {problem}")
-    print(f"verified {len(rounds)} round(s) in {config.experiment_dir}: {len(problems)} problem(s)")
+    print(f"verified {num_rounds} round(s) in {config.experiment_dir}: {len(problems)} problem(s)")
     if problems:
         raise SystemExit(1)
     return problems
@@ -211,16 +211,10 @@ class EvalConfig:
 
 def eval_command(config: EvalConfig) -> dict:
     """Evaluates a pretrained policy per task with the pure policy acting."""
-    from lerobot_mtdagger.envs import make_suite
+    from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.evaluate import PolicyRunner, evaluate
 
-    suite = make_suite(
-        config.suite,
-        tasks=config.tasks or None,
-        obs_mode=config.obs_mode,
-        num_points=config.num_points,
-        image_size=config.image_size,
-    )
+    suite = suite_from_config(config)
     runner = PolicyRunner.from_pretrained(config.policy_path)
     envs = [suite.make_env(task) for task in suite.task_names]
     try:
@@ -298,6 +292,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     command, options = args[0], args[1:]
     if command not in COMMANDS:
         print(f"unknown command {command!r}\n{_usage()}", file=sys.stderr)
+        return 2
+    renamed = renamed_option_error(options)
+    if renamed is not None:
+        print(f"lerobot-mtdagger {command}: error: {renamed}", file=sys.stderr)
         return 2
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     config_class, function = COMMANDS[command]

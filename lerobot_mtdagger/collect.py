@@ -25,6 +25,8 @@ from typing import Any
 import numpy as np
 
 from lerobot_mtdagger.envs.base import TaskSuite
+from lerobot_mtdagger.experts import make_expert
+from lerobot_mtdagger.records import dagger_columns
 
 logger = logging.getLogger(__name__)
 
@@ -123,7 +125,7 @@ def run_episodes(
     need_expert = record or beta > 0.0
     slots = []
     for task_index, (env, count) in enumerate(zip(envs, episodes_per_task, strict=True)):
-        expert = suite.make_expert(suite.task_names[task_index]) if need_expert else None
+        expert = make_expert(suite, suite.task_names[task_index]) if need_expert else None
         slots.append(_Slot(task_index, env, expert, queue=list(range(int(count)))))
     finished: list[Episode] = []
     for slot in slots:
@@ -187,15 +189,8 @@ def _step(
     expert_acts = learner_actions is None or (beta > 0.0 and slot.rng.random() < beta)
     executed = expert_action if expert_acts else learner_actions[position]
     if record:
-        episode.frames.append(
-            {
-                **slot.observation,
-                "action": expert_action,
-                "executed_action": np.asarray(executed, dtype=np.float32),
-                "learner_acted": np.array([not expert_acts]),
-                "dagger_round": np.array([round_index], dtype=np.int64),
-            }
-        )
+        columns = dagger_columns(executed, learner_acted=not expert_acts, round_index=round_index)
+        episode.frames.append({**slot.observation, "action": expert_action, **columns})
     slot.observation, _, terminated, truncated, info = slot.env.step(executed)
     slot.privileged = info["privileged_state"]
     episode.steps += 1

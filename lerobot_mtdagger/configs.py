@@ -1,8 +1,10 @@
 """Command-line configs of ``lerobot-mtdagger run`` (draccus dataclasses) and the paper's presets.
 
-Every field left at None is filled from the selected preset (``--preset``), then from the small
-default (``small``: MT10 state, a few rounds, minutes on a 2-core CPU). Presets follow the paper's
-"Setup" and hyperparameter table:
+Every option a preset fills (``PRESET_FIELDS``) has one home, its own field; None there means "from
+the preset" (``--preset``, default ``small``: MT10 state, a few rounds, minutes on a 2-core CPU), so
+a value given on the command line always wins. Presets follow the paper's "Setup" and
+hyperparameter table (n_min is ``scheduler.n_min``; lr and batch are ``policy.lr`` and
+``policy.batch_size``):
 
 =====================  =========  =============  ===================  =====  ==========  ======
 preset                 obs_mode   initial demos  budget per round      n_min  lr          batch
@@ -15,7 +17,7 @@ drawers-pointcloud     pointcloud 30 per task    30 per task           5      1e
 
 The DAgger mixing coefficient ``beta`` is the probability that the EXPERT's action is executed at
 a step (classic DAgger; the paper's text is ambiguous): 0.5 in the first DAgger round, decayed by
-0.5 per round to 0.
+0.5 per round to 0. ``--mode=bc`` runs the one-round behaviour-cloning baseline instead.
 """
 
 from __future__ import annotations
@@ -26,16 +28,6 @@ from pathlib import Path
 from typing import Any
 
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
-
-
-@SchedulerConfig.register_subclass("bc")
-@dataclass
-class BCSchedulerConfig(SchedulerConfig):
-    """Behaviour-cloning baseline: ONE round of expert demonstrations with the same total budget.
-
-    ``initial_demos + rounds * budget / num_tasks`` expert episodes per task in round 0, then
-    ``(rounds + 1) * steps_per_round`` training steps: the data and compute of the DAgger run.
-    """
 
 
 @dataclass
@@ -61,6 +53,9 @@ class PolicyOptions:
     device: str = "cpu"
 
 
+RUN_MODES: tuple[str, ...] = ("dagger", "bc")
+"""``dagger``: Algorithm 1 with the chosen scheduler; ``bc``: the one-round behaviour-cloning baseline."""
+
 PRESETS: dict[str, dict[str, Any]] = {
     "small": {
         "suite": "metaworld-mt10",
@@ -70,9 +65,9 @@ PRESETS: dict[str, dict[str, Any]] = {
         "budget_per_task": 3,
         "steps_per_round": 1500,
         "eval_episodes": 5,
-        "n_min": 1,
-        "lr": 3e-4,
-        "batch_size": 256,
+        "scheduler.n_min": 1,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 256,
     },
     "metaworld-state": {
         "suite": "metaworld-mt50",
@@ -82,9 +77,9 @@ PRESETS: dict[str, dict[str, Any]] = {
         "budget_per_task": 3,
         "steps_per_round": 3000,
         "eval_episodes": 10,
-        "n_min": 1,
-        "lr": 3e-4,
-        "batch_size": 1024,
+        "scheduler.n_min": 1,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 1024,
     },
     "metaworld-pixels": {
         "suite": "metaworld-mt10",
@@ -94,9 +89,9 @@ PRESETS: dict[str, dict[str, Any]] = {
         "budget_per_task": 20,
         "steps_per_round": 3000,
         "eval_episodes": 10,
-        "n_min": 1,
-        "lr": 3e-4,
-        "batch_size": 1024,
+        "scheduler.n_min": 1,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 1024,
     },
     "drawers-pointcloud": {
         "suite": "drawers",
@@ -106,23 +101,34 @@ PRESETS: dict[str, dict[str, Any]] = {
         "budget_per_task": 30,
         "steps_per_round": 3000,
         "eval_episodes": 10,
-        "n_min": 5,
-        "lr": 1e-4,
-        "batch_size": 256,
+        "scheduler.n_min": 5,
+        "policy.lr": 1e-4,
+        "policy.batch_size": 256,
     },
 }
+"""Preset values by option path (the command-line spelling without ``--``). Each option filled by a
+preset has ONE home: its field (None there means "from the preset"); a value given on the command
+line or in Python always wins."""
+
+PRESET_FIELDS: tuple[str, ...] = tuple(PRESETS["small"])
+"""The options every preset fills."""
 
 
 @dataclass
 class RunConfig:
-    """Options of ``lerobot-mtdagger run`` (one Multitask DAgger experiment).
+    """Options of ``lerobot-mtdagger run`` (one Multitask DAgger experiment, or the BC baseline).
 
     Attributes:
-        preset: One of ``PRESETS``; fills every option left unset.
+        preset: One of ``PRESETS``; fills every option of ``PRESET_FIELDS`` left unset (None).
+        mode: ``dagger`` (Algorithm 1 with ``scheduler``) or ``bc``: ONE round of expert
+            demonstrations with the same data budget (``initial_demos + rounds * budget / num_tasks``
+            per task, split uniformly) and the same training compute (``(rounds + 1) *
+            steps_per_round`` steps); the scheduler is unused.
         suite: Task suite (``make_suite`` name).
         tasks: Subset of the suite's tasks (all when empty).
         obs_mode: ``state``, ``rgb`` or ``pointcloud``.
-        scheduler: ``--scheduler.type=uniform|need|need_raw|gain|bc`` and its hyperparameters.
+        scheduler: ``--scheduler.type=uniform|need|need_raw|gain`` and its hyperparameters
+            (``scheduler.n_min`` from the preset when unset).
         rounds: DAgger rounds after round 0.
         budget: Expert episodes per DAgger round over all tasks (None: budget_per_task * tasks).
         budget_per_task: Used when ``budget`` is None.
@@ -140,16 +146,17 @@ class RunConfig:
         steps_after_success: Steps recorded after the first success before an episode ends.
         num_points: Points per cloud (pointcloud mode).
         image_size: Image side (rgb mode).
-        policy: Policy and optimiser options.
+        policy: Policy and optimiser options (``policy.lr`` and ``policy.batch_size`` from the preset
+            when unset).
         output_dir: Experiment directory (refused if it exists, unless ``resume``); default
             ``outputs/mtdagger/<preset>-<method>-seed<seed>``.
         seed: Seed of everything (collection, evaluation, training).
         resume: Continue the experiment in ``output_dir`` from its last committed round.
         progress: Show progress bars (only on a terminal).
-        n_min: Minimum episodes per task per round (None: from the preset; overrides scheduler.n_min).
     """
 
     preset: str = "small"
+    mode: str = "dagger"
     suite: str | None = None
     tasks: list[str] = field(default_factory=list)
     obs_mode: str | None = None
@@ -175,27 +182,27 @@ class RunConfig:
     seed: int = 0
     resume: bool = False
     progress: bool = True
-    n_min: int | None = None
 
     def __post_init__(self) -> None:
         if self.preset not in PRESETS:
             raise ValueError(f"Unknown preset {self.preset!r}; presets: {list(PRESETS)}.")
-        preset = PRESETS[self.preset]
-        for name in ("suite", "obs_mode", "rounds", "initial_demos", "budget_per_task", "steps_per_round"):
-            if getattr(self, name) is None:
-                setattr(self, name, preset[name])
-        if self.eval_episodes is None:
-            self.eval_episodes = preset["eval_episodes"]
-        if self.n_min is None:
-            self.n_min = preset["n_min"]
-        self.scheduler.n_min = self.n_min
-        if self.policy.lr is None:
-            self.policy.lr = preset["lr"]
-        if self.policy.batch_size is None:
-            self.policy.batch_size = preset["batch_size"]
+        if self.mode not in RUN_MODES:
+            raise ValueError(f"Unknown mode {self.mode!r}; choose one of {list(RUN_MODES)}.")
+        for path, value in PRESETS[self.preset].items():
+            owner, name = self._field_owner(path)
+            if getattr(owner, name) is None:
+                setattr(owner, name, value)
         if self.output_dir is None:
             self.output_dir = Path("outputs") / "mtdagger" / f"{self.preset}-{self.method}-seed{self.seed}"
         self._check()
+
+    def _field_owner(self, path: str) -> tuple[Any, str]:
+        """The object holding the option ``path`` (``policy.lr`` -> (self.policy, "lr"))."""
+        *parents, name = path.split(".")
+        owner: Any = self
+        for parent in parents:
+            owner = getattr(owner, parent)
+        return owner, name
 
     def _check(self) -> None:
         for name in ("rounds", "initial_demos", "eval_episodes", "steps_after_success"):
@@ -222,9 +229,14 @@ class RunConfig:
             )
 
     @property
+    def is_bc(self) -> bool:
+        """Whether this run is the one-round behaviour-cloning baseline."""
+        return self.mode == "bc"
+
+    @property
     def method(self) -> str:
-        """The experiment's method: ``bc`` or a scheduling method."""
-        return self.scheduler.type
+        """The experiment's method as reports name it: ``bc`` or the scheduling method."""
+        return "bc" if self.is_bc else self.scheduler.type
 
     def budget_for(self, num_tasks: int) -> int:
         """Expert episodes per DAgger round."""
@@ -236,3 +248,21 @@ class RunConfig:
         record["output_dir"] = str(self.output_dir)
         record["scheduler"] = {"type": self.scheduler.type, **self.scheduler.hyperparameters()}
         return record
+
+
+def renamed_option_error(args: list[str]) -> str | None:
+    """A message naming the new spelling when ``args`` use an option that was renamed (else None).
+
+    ``--scheduler.type=bc`` became ``--mode=bc`` (BC is a run mode, not a scheduler) and ``--n_min``
+    became ``--scheduler.n_min`` (one home per option).
+    """
+    for arg in args:
+        name, _, value = arg.partition("=")
+        if name == "--scheduler.type" and value == "bc":
+            return (
+                "--scheduler.type=bc is no longer accepted: behaviour cloning is a run mode, "
+                "use --mode=bc (the scheduler is then unused)."
+            )
+        if name == "--n_min":
+            return f"--n_min is no longer accepted: use --scheduler.n_min={value or '<n>'}."
+    return None

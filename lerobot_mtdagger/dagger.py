@@ -11,8 +11,12 @@ The loop, with round k's dataset committed before the policy trained on it::
                   beta_{k+1} = max(beta_k - delta, beta_min)
 
 This is the paper's ordering ("round k: train on D(k-1), then schedule and collect") with the
-training of round k+1 stored beside round k. ``bc`` runs round 0 only, with the whole budget
-``n0 + rounds * B / N`` per task, and trains ``rounds + 1`` phases' worth of steps.
+training of round k+1 stored beside round k. ``--mode=bc`` (the baseline) runs round 0 only, with the
+whole budget ``n0 + rounds * B / N`` per task, and trains ``rounds + 1`` phases' worth of steps.
+
+What the scheduler is fed is what its method declares it measures (``SchedulerConfig.measurements``)
+plus everything else the records show: the success of the previous round's rollouts (from round 2 on;
+round 1's rollouts are the first the learner took part in) and the gain of the previous phase.
 
 Resuming: committed rounds and phases are immutable; a run restarts at the first uncommitted step.
 Every random choice derives from the seed and the round, and the scheduler's state after each round
@@ -33,12 +37,13 @@ from tqdm import tqdm
 
 from lerobot_mtdagger.collect import COLLECT_STREAM, Episode, run_episodes, success_by_task
 from lerobot_mtdagger.configs import RunConfig
-from lerobot_mtdagger.envs import IMAGE_KEY, make_suite
+from lerobot_mtdagger.envs import IMAGE_KEY, suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.evaluate import EvalResult, PolicyRunner, evaluate
 from lerobot_mtdagger.policies import MTDAggerPolicy
-from lerobot_mtdagger.rounds import ExperimentDir, round_features
-from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities, make_scheduler
+from lerobot_mtdagger.records import PhaseRecord, RoundRecord, round_features
+from lerobot_mtdagger.rounds import ExperimentDir
+from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
 from lerobot_mtdagger.train import (
     NormalisedData,
     build_processors,
@@ -70,14 +75,9 @@ class RunContext:
         return self.suite.task_names
 
     @property
-    def is_bc(self) -> bool:
-        """Whether this is the one-round BC baseline."""
-        return self.config.method == "bc"
-
-    @property
     def last_round(self) -> int:
         """Index of the last round of the experiment."""
-        return 0 if self.is_bc else self.config.rounds
+        return 0 if self.config.is_bc else self.config.rounds
 
 
 def beta_for_round(config: RunConfig, round_index: int) -> float:
@@ -87,21 +87,9 @@ def beta_for_round(config: RunConfig, round_index: int) -> float:
     return max(config.beta - (round_index - 1) * config.beta_decay, config.beta_min)
 
 
-def make_run_suite(config: RunConfig) -> TaskSuite:
-    """The suite of a run config."""
-    return make_suite(
-        config.suite,
-        tasks=config.tasks or None,
-        obs_mode=config.obs_mode,
-        num_points=config.num_points,
-        image_size=config.image_size,
-    )
-
-
 def new_scheduler(config: RunConfig, num_tasks: int) -> Scheduler:
-    """A fresh scheduler for the run's method (BC allocates uniformly)."""
-    method = "uniform" if config.method == "bc" else config.method
-    return make_scheduler(method, num_tasks, **config.scheduler.hyperparameters())
+    """A fresh scheduler of the run's method (its config class is the run's ``scheduler``)."""
+    return Scheduler(config.scheduler, num_tasks)
 
 
 # -------------------------------------------------------------------------------------------------
@@ -112,7 +100,7 @@ def new_scheduler(config: RunConfig, num_tasks: int) -> Scheduler:
 def initial_allocation(ctx: RunContext) -> list[int]:
     """Round-0 episodes per task: n0, plus the DAgger rounds' budget for BC (split uniformly)."""
     num_tasks = len(ctx.task_names)
-    if not ctx.is_bc:
+    if not ctx.config.is_bc:
         return [ctx.config.initial_demos] * num_tasks
     extra = ctx.config.rounds * ctx.config.budget_for(num_tasks)
     uniform = allocate_probabilities(np.full(num_tasks, 1.0 / num_tasks), extra, 0)
@@ -124,13 +112,13 @@ def schedule_round(ctx: RunContext, round_index: int) -> tuple[Scheduler, Alloca
     experiment = ctx.experiment
     previous = experiment.read_round_record(round_index - 1)
     scheduler = new_scheduler(ctx.config, len(ctx.task_names))
-    if previous.get("scheduler_state") is not None:
-        scheduler.load_state_dict(previous["scheduler_state"])
+    if previous.scheduler_state is not None:
+        scheduler.load_state_dict(previous.scheduler_state)
     phase = experiment.read_phase_record(round_index - 1)
-    measurements: dict[str, Any] = {"gain": phase["gain"]}
-    if previous["rollout_success"] is not None and round_index - 1 > 0:
-        rates = [np.nan if r is None else r for r in previous["rollout_success"]]
-        measurements |= {"success_rate": rates, "episodes": previous["rollout_episodes"]}
+    measurements: dict[str, Any] = {"gain": phase.gain}
+    if previous.rollout_success is not None and round_index - 1 > 0:
+        rates = [np.nan if r is None else r for r in previous.rollout_success]
+        measurements |= {"success_rate": rates, "episodes": previous.rollout_episodes}
     scheduler.update(**measurements)
     allocation = scheduler.allocate(ctx.config.budget_for(len(ctx.task_names)))
     if round_index == 1:
@@ -198,17 +186,17 @@ def round_record(
     episodes: list[Episode],
     scheduler: Scheduler | None,
     allocation: Allocation | None,
-) -> dict[str, Any]:
-    """The round's ``mtdagger`` record for meta/info.json (lists aligned with task_names)."""
+) -> RoundRecord:
+    """The round's record for meta/info.json (lists aligned with task_names)."""
     config = ctx.config
     num_tasks = len(ctx.task_names)
     rollout_success, rollout_episodes = success_by_task(episodes, num_tasks)
     previous_demos = (
         [0] * num_tasks
         if round_index == 0
-        else ctx.experiment.read_round_record(round_index - 1)["demos_so_far"]
+        else ctx.experiment.read_round_record(round_index - 1).demos_so_far
     )
-    record: dict[str, Any] = {
+    common: dict[str, Any] = {
         "task_names": ctx.task_names,
         "round": round_index,
         "method": config.method,
@@ -216,7 +204,7 @@ def round_record(
         "seed": config.seed,
         "budget": int(sum(counts)),
         "temperature": config.scheduler.temperature,
-        "n_min": config.scheduler.n_min,
+        "n_min": config.scheduler.min_episodes,
         "episodes_per_task": [int(n) for n in counts],
         "demos_so_far": [int(a + b) for a, b in zip(previous_demos, counts, strict=True)],
         "rollout_success": rollout_success if round_index > 0 else None,
@@ -228,37 +216,41 @@ def round_record(
     }
     if allocation is None:
         notes = ["round 0: expert demonstrations only, no scheduling and no policy yet"]
-        if ctx.is_bc:
+        if config.is_bc:
             notes.append("bc: the whole data budget in one round of expert demonstrations")
         blank = {"p": None, "P": None}
-        record |= {
-            "success_rate": None,
-            "episodes": None,
-            "gain": None,
-            "kalman_prior": blank,
-            "kalman_posterior": blank,
-            "metric": None,
-            "score": None,
-            "probability": None,
-            "eval_success": None,
-            "allocation": None,
-            "scheduler_state": None,
-            "notes": notes,
-        }
-        return record
+        unscheduled = dict.fromkeys(
+            ("success_rate", "episodes", "gain", "metric", "score", "probability", "eval_success")
+        )
+        return RoundRecord(
+            **common,
+            **unscheduled,
+            kalman_prior=blank,
+            kalman_posterior=blank,
+            allocation=None,
+            scheduler_state=None,
+            notes=notes,
+        )
     phase = ctx.experiment.read_phase_record(round_index - 1)
     alloc = allocation.to_dict()
-    record |= {
-        key: alloc[key] for key in ("success_rate", "episodes", "gain", "kalman_prior", "kalman_posterior")
-    }
-    record |= {key: alloc[key] for key in ("metric", "score", "probability")}
-    record |= {
-        "eval_success": phase["eval"]["success"] if phase.get("eval") else None,
-        "allocation": alloc,
-        "scheduler_state": scheduler.state_dict(),
-        "notes": alloc["notes"],
-    }
-    return record
+    copied = (
+        "success_rate",
+        "episodes",
+        "gain",
+        "kalman_prior",
+        "kalman_posterior",
+        "metric",
+        "score",
+        "probability",
+    )
+    return RoundRecord(
+        **common,
+        **{key: alloc[key] for key in copied},
+        eval_success=phase.eval["success"] if phase.eval else None,
+        allocation=alloc,
+        scheduler_state=scheduler.state_dict(),
+        notes=alloc["notes"],
+    )
 
 
 # -------------------------------------------------------------------------------------------------
@@ -285,7 +277,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
         policy.load_state_dict(previous.state_dict())
     preprocessor, postprocessor = build_processors(policy_cfg, stats)
     normalised = NormalisedData(data, preprocessor, image_keys, ctx.task_names)
-    steps = config.steps_per_round * ((config.rounds + 1) if ctx.is_bc else 1)
+    steps = config.steps_per_round * ((config.rounds + 1) if config.is_bc else 1)
     loaded = time.perf_counter()
     with tqdm(
         total=steps, desc=f"round {round_index} train", leave=False, disable=not ctx.show_progress
@@ -306,24 +298,24 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     save_policy(policy, preprocessor, postprocessor, staging)
     eval_result = evaluate_phase(ctx, PolicyRunner(policy, preprocessor, postprocessor))
     evaluated = time.perf_counter()
-    demos = ctx.experiment.read_round_record(round_index)["demos_so_far"]
+    demos = ctx.experiment.read_round_record(round_index).demos_so_far
     timing = {"load_s": loaded - start, "train_s": trained - loaded, "eval_s": evaluated - trained}
     ctx.timings.setdefault(round_index, {}).update(timing)
-    record = {
-        "round": round_index,
-        "trained_on_rounds": list(range(round_index + 1)),
-        "frames": len(data),
-        "steps": steps,
-        "gain_split": config.gain_split,
-        "loss_start": result.loss_start,
-        "loss_end": result.loss_end,
-        "gain": result.gain,
-        "loss_samples": result.loss_samples,
-        "final_train_loss": result.train_loss,
-        "eval": None if eval_result is None else eval_result.to_dict(),
-        "demos_per_task": demos,
-        "timings": ctx.timings[round_index],
-    }
+    record = PhaseRecord(
+        round=round_index,
+        trained_on_rounds=list(range(round_index + 1)),
+        frames=len(data),
+        steps=steps,
+        gain_split=config.gain_split,
+        loss_start=result.loss_start,
+        loss_end=result.loss_end,
+        gain=result.gain,
+        loss_samples=result.loss_samples,
+        final_train_loss=result.train_loss,
+        eval=None if eval_result is None else eval_result.to_dict(),
+        demos_per_task=demos,
+        timings=ctx.timings[round_index],
+    )
     ctx.experiment.commit_phase(round_index, staging, record)
 
 
@@ -344,12 +336,12 @@ def summary_line(ctx: RunContext, round_index: int) -> str:
     """One line per round: demos so far, average success, allocation, time spent."""
     record = ctx.experiment.read_round_record(round_index)
     phase = ctx.experiment.read_phase_record(round_index)
-    success = "n/a" if phase["eval"] is None else f"{phase['eval']['mean']:.3f}"
-    demos = np.mean(record["demos_so_far"])
-    timing = " ".join(f"{k}={v:.1f}" for k, v in phase.get("timings", {}).items())
+    success = "n/a" if phase.eval_mean is None else f"{phase.eval_mean:.3f}"
+    demos = np.mean(record.demos_so_far)
+    timing = " ".join(f"{k}={v:.1f}" for k, v in phase.timings.items())
     return (
         f"round {round_index}: demos/task {demos:.1f} | eval success {success} | "
-        f"allocation {record['episodes_per_task']} | beta {record['beta']:.2f} | {timing}"
+        f"allocation {record.episodes_per_task} | beta {record.beta:.2f} | {timing}"
     )
 
 
@@ -360,11 +352,11 @@ def check_budget(config: RunConfig, num_tasks: int) -> None:
         ValueError: With the numbers and the fix.
     """
     budget = config.budget_for(num_tasks)
-    floor = config.scheduler.n_min * num_tasks
-    if config.method != "bc" and budget < floor:
+    n_min = config.scheduler.min_episodes
+    if not config.is_bc and budget < n_min * num_tasks:
         raise ValueError(
-            f"budget={budget} is smaller than n_min * num_tasks = {config.scheduler.n_min} * {num_tasks} = "
-            f"{floor}: raise --budget to at least {floor} or lower --n_min."
+            f"budget={budget} is smaller than n_min * num_tasks = {n_min} * {num_tasks} = "
+            f"{n_min * num_tasks}: raise --budget to at least {n_min * num_tasks} or lower --scheduler.n_min."
         )
 
 
@@ -376,7 +368,7 @@ def run(config: RunConfig) -> list[str]:
         ValueError: On a bad config or a foreign/corrupt output directory (left untouched).
         FloatingPointError: If training diverges.
     """
-    suite = make_run_suite(config)
+    suite = suite_from_config(config)
     check_budget(config, len(suite.task_names))
     experiment = ExperimentDir(config.output_dir)
     if config.resume:

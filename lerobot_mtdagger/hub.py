@@ -35,6 +35,7 @@ from typing import Any
 from huggingface_hub import DatasetCardData, HfApi
 
 from lerobot_mtdagger.datasets_cards import card_template
+from lerobot_mtdagger.records import PhaseRecord, RoundRecord
 from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir, round_name
 
 logger = logging.getLogger(__name__)
@@ -86,26 +87,19 @@ def task_table(task_names: Sequence[str]) -> str:
     return markdown_table(["task_index", "task"], [[i, name] for i, name in enumerate(task_names)])
 
 
-def revision_table(records: Sequence[dict[str, Any]]) -> str:
+def revision_table(records: Sequence[RoundRecord]) -> str:
     """Table of the rounds and their revisions: episodes, frames and the mixing coefficient beta."""
     rows = [
-        [
-            r["round"],
-            f"`{round_name(r['round'])}`",
-            sum(r["episodes_per_task"]),
-            r.get("frames"),
-            r.get("beta"),
-        ]
-        for r in records
+        [r.round, f"`{round_name(r.round)}`", sum(r.episodes_per_task), r.frames, r.beta] for r in records
     ]
     return markdown_table(["round", "revision", "episodes", "frames", "beta"], rows)
 
 
-def allocation_table(task_names: Sequence[str], records: Sequence[dict[str, Any]]) -> str:
+def allocation_table(task_names: Sequence[str], records: Sequence[RoundRecord]) -> str:
     """Expert-labelled episodes per task (rows) and round (columns), with a total row."""
-    header = ["task", *(f"round {r['round']}" for r in records)]
-    rows = [[name, *(r["episodes_per_task"][i] for r in records)] for i, name in enumerate(task_names)]
-    rows.append(["**total**", *(sum(r["episodes_per_task"]) for r in records)])
+    header = ["task", *(f"round {r.round}" for r in records)]
+    rows = [[name, *(r.episodes_per_task[i] for r in records)] for i, name in enumerate(task_names)]
+    rows.append(["**total**", *(sum(r.episodes_per_task) for r in records)])
     return markdown_table(header, rows)
 
 
@@ -142,7 +136,7 @@ def _phase_eval(experiment: ExperimentDir, round_index: int) -> dict[str, Any] |
     """The ``eval`` entry of a committed training phase (None if not committed or not evaluated)."""
     if round_index not in experiment.committed_phases():
         return None
-    return experiment.read_phase_record(round_index).get("eval")
+    return experiment.read_phase_record(round_index).eval
 
 
 def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: int | None = None) -> str:
@@ -168,8 +162,8 @@ def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: in
         raise ValueError(f"Round {last} is not committed in {experiment.root}; committed: {committed}.")
     records = [experiment.read_round_record(k) for k in range(last + 1)]
     latest = records[-1]
-    config = latest.get("config") or {}
-    task_names = list(latest["task_names"])
+    config = latest.config or {}
+    task_names = list(latest.task_names)
     values = {
         "card_data": card_metadata_yaml(),
         "repo_id": repo_id,
@@ -177,10 +171,10 @@ def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: in
         "revision": round_name(last),
         "suite": str(config.get("suite", NOT_AVAILABLE)),
         "obs_mode": str(config.get("obs_mode", NOT_AVAILABLE)),
-        "method": str(latest.get("method", NOT_AVAILABLE)),
-        "temperature": str(latest.get("temperature", NOT_AVAILABLE)),
-        "n_min": str(latest.get("n_min", NOT_AVAILABLE)),
-        "seed": str(latest.get("seed", NOT_AVAILABLE)),
+        "method": str(latest.method),
+        "temperature": str(latest.temperature),
+        "n_min": str(latest.n_min),
+        "seed": str(latest.seed),
         "revision_table": revision_table(records),
         "task_table": task_table(task_names),
         "allocation_table": allocation_table(task_names, records),
@@ -251,19 +245,18 @@ def upload_and_tag(
     return info.oid
 
 
-def round_commit_message(record: dict[str, Any]) -> str:
+def round_commit_message(record: RoundRecord) -> str:
     """Commit message of a round: its episodes, frames and allocation."""
-    episodes = record["episodes_per_task"]
+    episodes = record.episodes_per_task
     return (
-        f"round {record['round']}: {sum(episodes)} episodes, {record.get('frames')} frames, "
-        f"allocation {episodes} ({record.get('method')})"
+        f"round {record.round}: {sum(episodes)} episodes, {record.frames} frames, "
+        f"allocation {episodes} ({record.method})"
     )
 
 
-def phase_commit_message(round_index: int, record: dict[str, Any]) -> str:
+def phase_commit_message(round_index: int, record: PhaseRecord) -> str:
     """Commit message of a training phase: the rounds it was trained on and its evaluation."""
-    evaluation = record.get("eval")
-    success = NOT_AVAILABLE if not evaluation else f"{evaluation['mean']:.3f}"
+    success = NOT_AVAILABLE if record.eval_mean is None else f"{record.eval_mean:.3f}"
     return f"round {round_index}: policy trained on rounds 0..{round_index}, eval success {success}"
 
 

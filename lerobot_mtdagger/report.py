@@ -38,11 +38,9 @@ def experiment_curve(root: Path) -> tuple[str, int, list[tuple[int, float, float
     points = []
     for round_index in experiment.committed_phases():
         phase = experiment.read_phase_record(round_index)
-        if phase.get("eval") is not None:
-            points.append(
-                (round_index, float(np.mean(phase["demos_per_task"])), float(phase["eval"]["mean"]))
-            )
-    return record["method"], int(record["seed"]), points
+        if phase.eval_mean is not None:
+            points.append((round_index, float(np.mean(phase.demos_per_task)), phase.eval_mean))
+    return record.method, record.seed, points
 
 
 def learning_curves(roots: Sequence[Path]) -> list[CurvePoint]:

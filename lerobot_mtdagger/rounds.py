@@ -24,6 +24,7 @@ every round and in merged datasets.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import os
@@ -34,10 +35,10 @@ from typing import Any
 
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
+from lerobot_mtdagger.records import FORMAT_VERSION, RECORD_KEY, PhaseRecord, RoundRecord
+
 logger = logging.getLogger(__name__)
 
-RECORD_KEY = "mtdagger"
-FORMAT_VERSION = 1
 ROUNDS_DIR = "rounds"
 POLICIES_DIR = "policies"
 STAGING_DIR = ".staging"
@@ -45,24 +46,10 @@ TRAINING_FILE = "training.json"
 CONFIG_FILE = "config.json"
 DATASET_FPS = 80
 
-# Per-frame columns that DAgger adds to the suite's features. Their names avoid the "action" and
-# "observation" prefixes, which LeRobot would turn into policy outputs and inputs.
-EXTRA_FEATURES_TEMPLATE: dict[str, dict[str, Any]] = {
-    "learner_acted": {"dtype": "bool", "shape": (1,), "names": None},
-    "dagger_round": {"dtype": "int64", "shape": (1,), "names": None},
-}
-
 
 def round_name(round_index: int) -> str:
     """Folder and Hub revision name of a round: ``round-{k:03d}``."""
     return f"round-{round_index:03d}"
-
-
-def round_features(suite_features: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
-    """The features of a round dataset: the suite's, ``executed_action`` and the DAgger columns."""
-    action = suite_features["action"]
-    executed = {"dtype": action["dtype"], "shape": tuple(action["shape"]), "names": action["names"]}
-    return {**suite_features, "executed_action": executed, **EXTRA_FEATURES_TEMPLATE}
 
 
 def write_json_atomic(path: Path, payload: Any) -> None:
@@ -159,15 +146,14 @@ class ExperimentDir:
         if not self.rounds.exists():
             return indices
         for path in sorted(self.rounds.glob("round-*")):
-            record = self.read_round_record_at(path)
-            indices.append(int(record["round"]))
+            indices.append(self.read_round_record_at(path).round)
         expected = list(range(len(indices)))
         if indices != expected:
             raise ValueError(f"Committed rounds {indices} in {self.rounds} are not consecutive from 0.")
         return indices
 
     @staticmethod
-    def read_round_record_at(path: Path) -> dict[str, Any]:
+    def read_round_record_at(path: Path) -> RoundRecord:
         """The ``mtdagger`` record of the round dataset at ``path``.
 
         Raises:
@@ -186,9 +172,9 @@ class ExperimentDir:
             )
         if not record.get("committed"):
             raise ValueError(f"{path} holds an uncommitted round record.")
-        return record
+        return RoundRecord.from_dict(record, where=f"The round record in {info_path}")
 
-    def read_round_record(self, round_index: int) -> dict[str, Any]:
+    def read_round_record(self, round_index: int) -> RoundRecord:
         """The record of a committed round."""
         return self.read_round_record_at(self.round_root(round_index))
 
@@ -210,7 +196,7 @@ class ExperimentDir:
         dataset.meta.save_episode_tasks(list(task_names))
         return dataset
 
-    def commit_round(self, round_index: int, dataset: LeRobotDataset, record: dict[str, Any]) -> Path:
+    def commit_round(self, round_index: int, dataset: LeRobotDataset, record: RoundRecord) -> Path:
         """Finalises a staged round, writes its record into meta/info.json and commits it atomically.
 
         Raises:
@@ -223,7 +209,9 @@ class ExperimentDir:
         staging = Path(dataset.root)
         info_path = staging / "meta" / "info.json"
         info = json.loads(info_path.read_text())
-        info[RECORD_KEY] = {**record, "format_version": FORMAT_VERSION, "committed": True}
+        info[RECORD_KEY] = dataclasses.replace(
+            record, format_version=FORMAT_VERSION, committed=True
+        ).to_dict()
         write_json_atomic(info_path, info)
         os.replace(staging, final)
         return final
@@ -252,18 +240,19 @@ class ExperimentDir:
         staging.mkdir(parents=True)
         return staging
 
-    def commit_phase(self, round_index: int, staging: Path, record: dict[str, Any]) -> Path:
+    def commit_phase(self, round_index: int, staging: Path, record: PhaseRecord) -> Path:
         """Writes the training record into a staged phase and commits it atomically."""
-        write_json_atomic(staging / TRAINING_FILE, record)
+        write_json_atomic(staging / TRAINING_FILE, record.to_dict())
         final = self.policy_root(round_index)
         if final.exists():
             raise FileExistsError(f"Training phase {round_index} is already committed at {final}.")
         os.replace(staging, final)
         return final
 
-    def read_phase_record(self, round_index: int) -> dict[str, Any]:
+    def read_phase_record(self, round_index: int) -> PhaseRecord:
         """The training record of a committed phase."""
-        return json.loads((self.policy_root(round_index) / TRAINING_FILE).read_text())
+        path = self.policy_root(round_index) / TRAINING_FILE
+        return PhaseRecord.from_dict(json.loads(path.read_text()), where=f"The training record {path}")
 
 
 def merge_rounds(
@@ -292,87 +281,10 @@ def merge_rounds(
     )
     info_path = output / "meta" / "info.json"
     info = json.loads(info_path.read_text())
-    info[RECORD_KEY] = {"format_version": FORMAT_VERSION, "merged_rounds": list(rounds), "rounds": records}
+    info[RECORD_KEY] = {
+        "format_version": FORMAT_VERSION,
+        "merged_rounds": list(rounds),
+        "rounds": [record.to_dict() for record in records],
+    }
     write_json_atomic(info_path, info)
     return output
-
-
-def _stored_tasks(root: Path, num_tasks: int) -> tuple[list[str], list[int]]:
-    """The task vocabulary (in task_index order) and the episodes per task index of a round dataset."""
-    from lerobot.datasets.lerobot_dataset import LeRobotDatasetMetadata
-
-    meta = LeRobotDatasetMetadata(f"local/{root.name}", root=root)
-    order = [str(t) for t in meta.tasks.sort_values("task_index").index]
-    lookup = {task: index for index, task in enumerate(order)}
-    counts = [0] * num_tasks
-    for tasks in meta.episodes["tasks"]:
-        counts[lookup[tasks[0]]] += 1
-    return order, counts
-
-
-def verify_round(experiment: ExperimentDir, round_index: int) -> list[str]:
-    """Checks one committed round against its data and its own record; returns the problems found.
-
-    Checks: the task vocabulary and its order, the episodes per task actually stored, the
-    cumulative demonstration counts, and for DAgger rounds that the allocation recomputes from the
-    record alone (``allocation_mismatches``) and chains with the previous round (its measured success,
-    the previous phase's gain, the Kalman prior = the previous posterior).
-    """
-    from lerobot_mtdagger.scheduler import allocation_mismatches
-
-    problems: list[str] = []
-    name = round_name(round_index)
-    record = experiment.read_round_record(round_index)
-    root = experiment.round_root(round_index)
-    task_names = record["task_names"]
-    order, stored = _stored_tasks(root, len(task_names))
-    if order != task_names:
-        problems.append(f"{name}: task vocabulary {order} != record {task_names}")
-    if stored != record["episodes_per_task"]:
-        problems.append(
-            f"{name}: dataset holds {stored} episodes per task, record says {record['episodes_per_task']}"
-        )
-    previous = experiment.read_round_record(round_index - 1) if round_index > 0 else None
-    before = previous["demos_so_far"] if previous else [0] * len(task_names)
-    if record["demos_so_far"] != [a + b for a, b in zip(before, record["episodes_per_task"], strict=True)]:
-        problems.append(f"{name}: demos_so_far is not the running sum of episodes_per_task")
-    allocation = record.get("allocation")
-    if allocation is None:
-        if round_index > 0:
-            problems.append(f"{name}: a DAgger round without an allocation record")
-        return problems
-    problems += [f"{name}: {p}" for p in allocation_mismatches(allocation)]
-    if allocation["episodes_per_task"] != record["episodes_per_task"]:
-        problems.append(
-            f"{name}: collected {record['episodes_per_task']} != allocated {allocation['episodes_per_task']}"
-        )
-    problems += _verify_chain(experiment, round_index, record, previous)
-    return problems
-
-
-def _verify_chain(
-    experiment: ExperimentDir, round_index: int, record: dict[str, Any], previous: dict[str, Any]
-) -> list[str]:
-    """Checks that a round's scheduler inputs are the previous round's outputs."""
-    problems = []
-    name = round_name(round_index)
-    if round_index - 1 in experiment.committed_phases():
-        gain = experiment.read_phase_record(round_index - 1)["gain"]
-        if record["gain"] != gain:
-            problems.append(f"{name}: gain {record['gain']} != phase {round_index - 1} gain {gain}")
-    if round_index >= 2:
-        measured = previous["rollout_success"]
-        if record["success_rate"] != measured:
-            problems.append(f"{name}: success_rate {record['success_rate']} != previous rollouts {measured}")
-        posterior = previous["allocation"]["kalman_posterior"]
-        if record["kalman_prior"] != posterior:
-            problems.append(f"{name}: Kalman prior is not round {round_index - 1}'s posterior")
-    return problems
-
-
-def verify_experiment(experiment: ExperimentDir) -> list[str]:
-    """Verifies every committed round (see ``verify_round``); returns all problems found."""
-    problems = []
-    for round_index in experiment.committed_rounds():
-        problems += verify_round(experiment, round_index)
-    return problems

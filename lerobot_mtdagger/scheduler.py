@@ -12,9 +12,12 @@ softmax allocation of "Implementation details":
 4. Turn the scores into a budget split with a temperature softmax, give every task at least
    ``n_min`` episodes and repair the total to exactly the budget (``allocate``).
 
+Each method is one registered config class (``SchedulerConfig`` subclass, selected with
+``--scheduler.type``) that declares the measurements it needs and computes its metric from the
+scheduler's state; everything else (filtering, ranking, softmax, rounding, records) is shared.
 Every allocation returns an ``Allocation`` record with the measurements, the Kalman state, the
 metric, the scores and the probabilities it used; ``recompute_allocation`` rebuilds an allocation
-from such a record alone, so a stored round can be audited.
+from such a record alone, through the same config class, so a stored round can be audited.
 
 This module is pure numpy (plus draccus for the command-line configs): no torch, no environment.
 """
@@ -23,17 +26,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import draccus
 import numpy as np
-
-METHODS: tuple[str, ...] = ("uniform", "need", "need_raw", "gain")
-"""Scheduling methods known to ``make_scheduler``."""
-
-STATE_FORMAT_VERSION = 1
 
 ArrayLike = Sequence[float] | np.ndarray
 
@@ -371,27 +369,72 @@ def _num_floored_tasks(sorted_probability: np.ndarray, budget: int, n_min: int) 
 
 
 # --------------------------------------------------------------------------------------------------
-# Schedulers
+# Scheduling methods: one registered config class each
 # --------------------------------------------------------------------------------------------------
+
+SUCCESS = "success"
+"""Measurement: the raw success rate of the learner's rollouts per task (and their count)."""
+
+GAIN = "gain"
+"""Measurement: the per-task imitation-loss drop of the round's training."""
+
+DEFAULT_N_MIN = 1
+"""The paper's minimum episodes per task per round on MetaWorld (a run's preset may set another)."""
+
+
+@dataclass(frozen=True)
+class SchedulerState:
+    """What a scheduler knows about the tasks: the inputs of every method's metric.
+
+    Attributes:
+        kalman_p: Kalman-filtered success probability per task (``p0`` before any measurement).
+        raw_success: Latest raw measured success rate per task (``p0`` for a task never measured).
+        gain: Latest performance gain ``max(0, L_start - L_end)`` per task (0 before any training).
+    """
+
+    kalman_p: np.ndarray
+    raw_success: np.ndarray
+    gain: np.ndarray
+
+    @property
+    def num_tasks(self) -> int:
+        """Number of tasks."""
+        return int(self.kalman_p.size)
 
 
 @dataclass
 class SchedulerConfig(draccus.ChoiceRegistry):
-    """Hyperparameters of a scheduler; select the method with ``--scheduler.type=<method>``.
+    """A scheduling method and its hyperparameters; select it with ``--scheduler.type=<method>``.
+
+    Each method is ONE subclass registered under its name. It declares the measurements its metric
+    needs (``measurements``, a subset of ``SUCCESS`` and ``GAIN``) and computes the metric from the
+    scheduler's state (``metric``; higher = more episodes). ``make_scheduler``, the runner and the
+    recomputation behind ``verify`` all go through that class, so adding a method is::
+
+        @SchedulerConfig.register_subclass("my_method")
+        @dataclass
+        class MyMethodConfig(SchedulerConfig):
+            measurements: ClassVar[tuple[str, ...]] = (SUCCESS,)
+
+            def metric(self, state: SchedulerState) -> np.ndarray:
+                return 1.0 - state.raw_success ** 2
 
     Defaults are the paper's (hyperparameter table, MetaWorld column).
 
     Attributes:
         temperature: Softmax temperature T > 0.
-        n_min: Minimum episodes per task per round (1 for MetaWorld, 5 for the drawers).
+        n_min: Minimum episodes per task per round; None: the run preset's (1 for MetaWorld, 5 for
+            the drawers), or ``DEFAULT_N_MIN`` outside a run.
         p0: Initial Kalman success estimate.
         P0: Initial Kalman variance.
         Q: Kalman process noise per round.
         R0: Kalman measurement noise scale; a round of n rollouts has noise R0 / (n + 1).
     """
 
+    measurements: ClassVar[tuple[str, ...]] = ()
+
     temperature: float = 0.5
-    n_min: int = 1
+    n_min: int | None = None
     p0: float = 0.5
     P0: float = 0.25
     Q: float = 0.03
@@ -399,7 +442,8 @@ class SchedulerConfig(draccus.ChoiceRegistry):
 
     def __post_init__(self) -> None:
         _require_positive(self.temperature, "scheduler.temperature")
-        _require_integer(self.n_min, "scheduler.n_min", 0)
+        if self.n_min is not None:
+            _require_integer(self.n_min, "scheduler.n_min", 0)
         # The Kalman filter checks p0, P0, Q and R0 with named errors.
         KalmanSuccessEstimator(1, p0=self.p0, P0=self.P0, Q=self.Q, R0=self.R0)
 
@@ -413,33 +457,94 @@ class SchedulerConfig(draccus.ChoiceRegistry):
         """The method name this config is registered under."""
         return self.get_choice_name(self.__class__)
 
+    @property
+    def min_episodes(self) -> int:
+        """``n_min``, or ``DEFAULT_N_MIN`` when it was left to a preset and no preset filled it."""
+        return DEFAULT_N_MIN if self.n_min is None else int(self.n_min)
+
+    def metric(self, state: SchedulerState) -> np.ndarray:
+        """The method's metric per task (higher = more episodes), shape (num_tasks,)."""
+        raise NotImplementedError(f"{type(self).__name__} must implement metric(state).")
+
     def hyperparameters(self) -> dict[str, float | int]:
-        """The fields as a plain dict (``make_scheduler`` keyword arguments)."""
-        return dataclasses.asdict(self)
+        """The fields as a plain dict (``make_scheduler`` keyword arguments), n_min resolved."""
+        return {**dataclasses.asdict(self), "n_min": self.min_episodes}
 
 
 @SchedulerConfig.register_subclass("uniform")
 @dataclass
 class UniformSchedulerConfig(SchedulerConfig):
-    """Uniform DAgger: the same number of episodes for every task."""
+    """Uniform DAgger: the same number of episodes for every task (leftovers to low task indices)."""
+
+    measurements: ClassVar[tuple[str, ...]] = ()
+
+    def metric(self, state: SchedulerState) -> np.ndarray:
+        """Zeros: every task ranks equal."""
+        return np.zeros(state.num_tasks)
 
 
 @SchedulerConfig.register_subclass("need")
 @dataclass
 class NeedSchedulerConfig(SchedulerConfig):
-    """MTDAgger-TN: task need ``1 - p_hat`` with Kalman-filtered success ``p_hat``."""
+    """MTDAgger-TN: task need ``1 - p_hat`` with ``p_hat`` the Kalman-filtered success rate."""
+
+    measurements: ClassVar[tuple[str, ...]] = (SUCCESS,)
+
+    def metric(self, state: SchedulerState) -> np.ndarray:
+        """``1 - p_hat``."""
+        return 1.0 - state.kalman_p
 
 
 @SchedulerConfig.register_subclass("need_raw")
 @dataclass
 class NeedRawSchedulerConfig(SchedulerConfig):
-    """Task need on the raw measured success rate (the paper's "TN without Kalman filter")."""
+    """Task need on the last raw measured success rate (the paper's "TN without Kalman filter")."""
+
+    measurements: ClassVar[tuple[str, ...]] = (SUCCESS,)
+
+    def metric(self, state: SchedulerState) -> np.ndarray:
+        """``1 - s`` (``p0`` for a task never measured)."""
+        return 1.0 - state.raw_success
 
 
 @SchedulerConfig.register_subclass("gain")
 @dataclass
 class GainSchedulerConfig(SchedulerConfig):
-    """MTDAgger-PG: performance gain ``max(0, L_start - L_end)`` per task."""
+    """MTDAgger-PG: performance gain ``max(0, L_start - L_end)`` per task (0 before any training)."""
+
+    measurements: ClassVar[tuple[str, ...]] = (GAIN,)
+
+    def metric(self, state: SchedulerState) -> np.ndarray:
+        """The clipped loss drop of the last training phase."""
+        return state.gain.copy()
+
+
+def scheduling_methods() -> tuple[str, ...]:
+    """Names of the registered scheduling methods, in registration order."""
+    return tuple(SchedulerConfig.get_known_choices())
+
+
+def scheduler_config_class(method: str) -> type[SchedulerConfig]:
+    """The registered config class of ``method``.
+
+    Raises:
+        ValueError: On an unknown method, naming the known ones (and the BC run mode for ``bc``).
+    """
+    known = scheduling_methods()
+    if method == "bc":
+        raise ValueError(
+            "'bc' is not a scheduling method: behaviour cloning is a run mode, run it with --mode=bc "
+            f"(scheduling methods: {list(known)})."
+        )
+    if method not in known:
+        raise ValueError(f"Unknown scheduling method {method!r}; known methods: {list(known)}.")
+    return SchedulerConfig.get_choice_class(method)
+
+
+METHODS: tuple[str, ...] = scheduling_methods()
+"""The paper's scheduling methods (``scheduling_methods()`` also lists methods registered later)."""
+
+STATE_FORMAT_VERSION = 1
 
 
 @dataclass
@@ -509,67 +614,67 @@ class Allocation:
             values["success_rate"] = [math.nan if v is None else float(v) for v in values["success_rate"]]
         return cls(**values)
 
+    def config(self) -> SchedulerConfig:
+        """The scheduler config this allocation was made with.
 
-def _metric_uniform(scheduler: Scheduler) -> np.ndarray:
-    return np.zeros(scheduler.num_tasks)
-
-
-def _metric_need(scheduler: Scheduler) -> np.ndarray:
-    return 1.0 - scheduler.kalman.p
-
-
-def _metric_need_raw(scheduler: Scheduler) -> np.ndarray:
-    return 1.0 - scheduler.raw_success
+        Raises:
+            ValueError: If the method is not registered.
+        """
+        return scheduler_config_class(self.method)(
+            temperature=self.temperature, n_min=self.n_min, **self.kalman
+        )
 
 
-def _metric_gain(scheduler: Scheduler) -> np.ndarray:
-    return scheduler.gain.copy()
+def _allocation_notes(config: SchedulerConfig, measured: set[str]) -> list[str]:
+    """Remarks on measurements the method needs but has not received yet."""
+    notes = []
+    if SUCCESS in config.measurements and SUCCESS not in measured:
+        notes.append("no rollouts measured yet: the prior decides (uniform allocation)")
+    if GAIN in config.measurements and GAIN not in measured:
+        notes.append("no training gain measured yet: uniform allocation")
+    return notes
 
 
-_METRICS: dict[str, Callable[[Scheduler], np.ndarray]] = {
-    "uniform": _metric_uniform,
-    "need": _metric_need,
-    "need_raw": _metric_need_raw,
-    "gain": _metric_gain,
-}
+def _score_and_allocate(
+    config: SchedulerConfig, metric: np.ndarray, budget: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rank-normalised scores, softmax probabilities and episode counts of a metric."""
+    score = rank_normalize(metric)
+    probability = softmax(score, config.temperature)
+    counts = allocate_probabilities(probability, budget, config.min_episodes, score)
+    return score, probability, counts
 
 
 class Scheduler:
     """Allocates each DAgger round's demonstration budget across tasks.
 
-    Every method tracks the same measurements (so every record can show them); only the metric it
-    ranks differs:
-
-    - ``uniform``: zeros, so every task gets ``B / N`` (leftover units to the lowest task indices).
-    - ``need``: ``1 - p_hat`` with ``p_hat`` the Kalman-filtered success rate.
-    - ``need_raw``: ``1 - s`` with ``s`` the last raw measured success rate of the task (``p0`` for a
-      task never measured).
-    - ``gain``: ``max(0, L_start - L_end)`` from the last training round (0 before the first).
-
-    Before any measurement every metric is constant across tasks, so the first allocation is
-    uniform: the prior decides.
+    Every method tracks the same measurements (so every record can show them): the Kalman filter and
+    the raw success rates from rollouts, the performance gain from training. Only the metric differs;
+    it comes from the method's config class (``SchedulerConfig.metric``). Before any measurement every
+    metric is constant across tasks, so the first allocation is uniform: the prior decides.
     """
 
-    def __init__(self, method: str, num_tasks: int, config: SchedulerConfig | None = None) -> None:
+    def __init__(self, config: SchedulerConfig, num_tasks: int) -> None:
         """Creates a scheduler.
 
         Args:
-            method: One of ``METHODS``.
+            config: A registered method's config (``make_scheduler`` builds one by name).
             num_tasks: Number of tasks (>= 1).
-            config: Hyperparameters; the paper's defaults when None.
 
         Raises:
-            ValueError: On an unknown method or a bad hyperparameter.
+            ValueError: On a bad hyperparameter.
+            TypeError: If ``config`` is not a ``SchedulerConfig``.
         """
-        if method not in _METRICS:
-            raise ValueError(f"Unknown scheduling method {method!r}; known methods: {list(METHODS)}.")
-        self.method = method
-        self.config = config if config is not None else SchedulerConfig()
-        self.kalman = KalmanSuccessEstimator(
-            num_tasks, p0=self.config.p0, P0=self.config.P0, Q=self.config.Q, R0=self.config.R0
-        )
+        if not isinstance(config, SchedulerConfig):
+            raise TypeError(
+                f"Scheduler needs a SchedulerConfig, got {type(config).__name__}; build one by name with "
+                "make_scheduler(method, num_tasks)."
+            )
+        self.config = config
+        self.method = config.type
+        self.kalman = KalmanSuccessEstimator(num_tasks, p0=config.p0, P0=config.P0, Q=config.Q, R0=config.R0)
         self.num_tasks = self.kalman.num_tasks
-        self.raw_success = np.full(self.num_tasks, self.config.p0)
+        self.raw_success = np.full(self.num_tasks, config.p0)
         self.gain = np.zeros(self.num_tasks)
         self.last_success_rate: np.ndarray | None = None
         self.last_episodes: np.ndarray | None = None
@@ -613,9 +718,25 @@ class Scheduler:
             self.last_gain = self.gain.copy()
         self.num_updates += 1
 
+    @property
+    def state(self) -> SchedulerState:
+        """The current inputs of the metric."""
+        return SchedulerState(
+            kalman_p=self.kalman.p.copy(), raw_success=self.raw_success.copy(), gain=self.gain.copy()
+        )
+
+    @property
+    def measured(self) -> set[str]:
+        """The measurements received so far (``SUCCESS``, ``GAIN``)."""
+        return {
+            name
+            for name, last in ((SUCCESS, self.last_success_rate), (GAIN, self.last_gain))
+            if last is not None
+        }
+
     def metric(self) -> np.ndarray:
         """The method's current metric per task (higher = more episodes)."""
-        return _METRICS[self.method](self)
+        return np.asarray(self.config.metric(self.state), dtype=np.float64)
 
     def allocate(self, budget: int) -> Allocation:
         """Allocates ``budget`` episodes and returns the full record.
@@ -624,19 +745,12 @@ class Scheduler:
             ValueError: If ``budget`` is not an integer >= n_min * num_tasks.
         """
         metric = self.metric()
-        score = rank_normalize(metric)
-        probability = softmax(score, self.config.temperature)
-        counts = allocate_probabilities(probability, budget, self.config.n_min, score)
-        notes = []
-        if self.last_success_rate is None and self.method in ("need", "need_raw"):
-            notes.append("no rollouts measured yet: the prior decides (uniform allocation)")
-        if self.last_gain is None and self.method == "gain":
-            notes.append("no training gain measured yet: uniform allocation")
+        score, probability, counts = _score_and_allocate(self.config, metric, budget)
         return Allocation(
             method=self.method,
             budget=int(budget),
             temperature=self.config.temperature,
-            n_min=self.config.n_min,
+            n_min=self.config.min_episodes,
             success_rate=None if self.last_success_rate is None else self.last_success_rate.tolist(),
             episodes=None if self.last_episodes is None else [int(n) for n in self.last_episodes],
             gain=None if self.last_gain is None else self.last_gain.tolist(),
@@ -648,7 +762,7 @@ class Scheduler:
             probability=probability.tolist(),
             episodes_per_task=counts.tolist(),
             kalman={"p0": self.config.p0, "P0": self.config.P0, "Q": self.config.Q, "R0": self.config.R0},
-            notes=notes,
+            notes=_allocation_notes(self.config, self.measured),
         )
 
     def state_dict(self) -> dict[str, Any]:
@@ -710,11 +824,11 @@ class Scheduler:
         self.num_updates = int(state["num_updates"])
 
 
-def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int) -> Scheduler:
+def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int | None) -> Scheduler:
     """Creates a scheduler by method name.
 
     Args:
-        method: One of ``uniform``, ``need``, ``need_raw``, ``gain``.
+        method: A registered method (``scheduling_methods()``: uniform, need, need_raw, gain, ...).
         num_tasks: Number of tasks.
         **hyperparameters: Any ``SchedulerConfig`` field (temperature, n_min, p0, P0, Q, R0).
 
@@ -724,26 +838,19 @@ def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int) 
     Raises:
         ValueError: On an unknown method, an unknown hyperparameter or a bad value.
     """
-    if method not in _METRICS:
-        raise ValueError(f"Unknown scheduling method {method!r}; known methods: {list(METHODS)}.")
-    known = {f.name for f in dataclasses.fields(SchedulerConfig)}
+    config_class = scheduler_config_class(method)
+    known = {f.name for f in dataclasses.fields(config_class)}
     unknown = sorted(set(hyperparameters) - known)
     if unknown:
         raise ValueError(f"Unknown scheduler hyperparameter(s) {unknown}; known: {sorted(known)}.")
-    config_class = SchedulerConfig.get_choice_class(method)
-    return Scheduler(method, num_tasks, config_class(**hyperparameters))
-
-
-def scheduler_from_config(config: SchedulerConfig, num_tasks: int) -> Scheduler:
-    """Creates the scheduler selected by a (command-line) config."""
-    return Scheduler(config.type, num_tasks, config)
+    return Scheduler(config_class(**hyperparameters), num_tasks)
 
 
 def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
-    """Recomputes an allocation from its stored record alone.
+    """Recomputes an allocation from its stored record alone, through the method's config class.
 
-    For ``need`` the Kalman posterior is recomputed from the stored prior and measurements (when
-    the record carries measurements), so a tampered metric or Kalman state is detected too.
+    The Kalman posterior is recomputed from the stored prior and measurements (when the record
+    carries measurements), so a tampered metric or Kalman state is detected too.
 
     Args:
         record: An ``Allocation.to_dict()`` record.
@@ -752,29 +859,25 @@ def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
         The allocation recomputed from the record's inputs.
 
     Raises:
-        ValueError: If the record is incomplete or inconsistent with itself.
+        ValueError: If the record is incomplete, of an unknown method or inconsistent with itself.
     """
     stored = Allocation.from_dict(record)
+    config = stored.config()
     num_tasks = len(stored.episodes_per_task)
-    config_class = SchedulerConfig.get_choice_class(stored.method) if stored.method in _METRICS else None
-    if config_class is None:
-        raise ValueError(f"Record has unknown method {stored.method!r}; known methods: {list(METHODS)}.")
-    config = config_class(temperature=stored.temperature, n_min=stored.n_min, **stored.kalman)
     kalman = KalmanSuccessEstimator(num_tasks, p0=config.p0, P0=config.P0, Q=config.Q, R0=config.R0)
     kalman.load_snapshot(stored.kalman_prior)
     if stored.success_rate is not None:
         kalman.update(stored.success_rate, stored.episodes)
-    if stored.method == "need":
-        metric = 1.0 - kalman.p
-    elif stored.method == "need_raw":
-        metric = 1.0 - np.asarray(stored.raw_success, dtype=np.float64)
-    elif stored.method == "gain":
-        metric = np.zeros(num_tasks) if stored.gain is None else np.maximum(np.asarray(stored.gain), 0.0)
-    else:
-        metric = np.zeros(num_tasks)
-    score = rank_normalize(metric)
-    probability = softmax(score, config.temperature)
-    counts = allocate_probabilities(probability, stored.budget, config.n_min, score)
+    gain = (
+        np.zeros(num_tasks)
+        if stored.gain is None
+        else np.maximum(np.asarray(stored.gain, dtype=np.float64), 0.0)
+    )
+    state = SchedulerState(
+        kalman_p=kalman.p.copy(), raw_success=np.asarray(stored.raw_success, dtype=np.float64), gain=gain
+    )
+    metric = np.asarray(config.metric(state), dtype=np.float64)
+    score, probability, counts = _score_and_allocate(config, metric, stored.budget)
     return dataclasses.replace(
         stored,
         kalman_posterior=kalman.snapshot(),
@@ -800,12 +903,11 @@ def allocation_mismatches(record: Mapping[str, Any], rtol: float = 1e-9) -> list
     for name in ("metric", "score", "probability"):
         if not np.allclose(record[name], getattr(recomputed, name), rtol=rtol, atol=1e-12):
             problems.append(f"{name}: stored {record[name]} != recomputed {getattr(recomputed, name)}")
-    if record["method"] == "need" and record.get("success_rate") is not None:
+    if record.get("success_rate") is not None:
         for key in ("p", "P"):
             stored, again = record["kalman_posterior"][key], recomputed.kalman_posterior[key]
             if not np.allclose(stored, again, rtol=rtol, atol=1e-12):
                 problems.append(f"kalman_posterior.{key}: stored {stored} != recomputed {again}")
-    if record.get("success_rate") is not None:
         measured = np.asarray(record["episodes"]) > 0
         rate = np.asarray(recomputed.success_rate)[measured]
         if not np.array_equal(np.asarray(record["raw_success"])[measured], rate):

@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw
 
-from lerobot_mtdagger.envs.drawers import HELDOUT_DRAWERS, TRAINING_DRAWERS, render_drawer_picture
+from lerobot_mtdagger.envs.drawers.catalogue import HELDOUT_DRAWERS, TRAINING_DRAWERS
+from lerobot_mtdagger.envs.drawers.pictures import render_drawer_picture
 
 logger = logging.getLogger(__name__)
 

@@ -19,12 +19,14 @@ def record_expert_dataset(
     """
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
+    from lerobot_mtdagger.experts import make_expert
+
     dataset = LeRobotDataset.create(
         repo_id=repo_id, fps=80, features=suite.features, root=root, use_videos=False
     )
     dataset.meta.save_episode_tasks(suite.task_names)
     for task_name in suite.task_names:
-        env, expert = suite.make_env(task_name), suite.make_expert(task_name)
+        env, expert = suite.make_env(task_name), make_expert(suite, task_name)
         for seed in range(episodes_per_task):
             observation, info = env.reset(seed=seed)
             expert.reset()

@@ -20,7 +20,9 @@ from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.policies import MTDAggerPolicy
-from lerobot_mtdagger.rounds import ExperimentDir, merge_rounds, verify_experiment
+from lerobot_mtdagger.records import RoundRecord
+from lerobot_mtdagger.rounds import ExperimentDir, merge_rounds
+from lerobot_mtdagger.verify import verify_experiment
 from tests.conftest import lerobot_train
 
 TASKS = ["reach-v3", "button-press-topdown-v3", "push-v3"]
@@ -33,11 +35,6 @@ TINY = [
     "--policy.batch_size=64",
     "--progress=false",
 ]
-ISSUE_KEYS = [
-    "format_version", "task_names", "round", "method", "beta", "seed", "budget", "temperature", "n_min",
-    "success_rate", "episodes", "gain", "kalman_prior", "kalman_posterior", "metric", "score",
-    "probability", "episodes_per_task", "eval_success", "config",
-]  # fmt: skip
 
 
 def tiny_config(output_dir: Path, *extra: str) -> RunConfig:
@@ -59,25 +56,26 @@ def test_every_round_is_committed_with_its_record(experiment):
     assert experiment.committed_phases() == [0, 1, 2]
     for k in range(3):
         record = experiment.read_round_record(k)
-        assert all(key in record for key in ISSUE_KEYS), [key for key in ISSUE_KEYS if key not in record]
-        assert record["task_names"] == TASKS and record["round"] == k and record["method"] == "need"
-        assert sum(record["episodes_per_task"]) == record["budget"]
+        stored = json.loads((experiment.round_root(k) / "meta" / "info.json").read_text())["mtdagger"]
+        assert RoundRecord.from_dict(stored) == record and record.committed
+        assert record.task_names == TASKS and record.round == k and record.method == "need"
+        assert sum(record.episodes_per_task) == record.budget
     round0, round1, round2 = (experiment.read_round_record(k) for k in range(3))
-    assert round0["episodes_per_task"] == [3, 3, 3] and round0["beta"] == 1.0
-    assert round0["success_rate"] is None and round0["allocation"] is None and "round 0" in round0["notes"][0]
-    assert round1["success_rate"] is None and any("prior decides" in n for n in round1["notes"])
-    assert round1["episodes_per_task"] == [3, 3, 3], "the prior decides: uniform"
-    assert round1["beta"] == 0.5 and round2["beta"] == 0.0
-    assert round2["success_rate"] == round1["rollout_success"]
-    assert round2["gain"] == experiment.read_phase_record(1)["gain"]
-    assert round2["eval_success"] == experiment.read_phase_record(1)["eval"]["success"]
-    assert round2["demos_so_far"] == [
-        a + b for a, b in zip(round1["demos_so_far"], round2["episodes_per_task"], strict=True)
+    assert round0.episodes_per_task == [3, 3, 3] and round0.beta == 1.0
+    assert round0.success_rate is None and round0.allocation is None and "round 0" in round0.notes[0]
+    assert round1.success_rate is None and any("prior decides" in n for n in round1.notes)
+    assert round1.episodes_per_task == [3, 3, 3], "the prior decides: uniform"
+    assert round1.beta == 0.5 and round2.beta == 0.0
+    assert round2.success_rate == round1.rollout_success
+    assert round2.gain == experiment.read_phase_record(1).gain
+    assert round2.eval_success == experiment.read_phase_record(1).eval["success"]
+    assert round2.demos_so_far == [
+        a + b for a, b in zip(round1.demos_so_far, round2.episodes_per_task, strict=True)
     ]
 
 
 def test_verify_recomputes_every_allocation(experiment):
-    assert verify_experiment(experiment) == []
+    assert verify_experiment(experiment) == (3, [])
 
 
 def test_verify_detects_a_tampered_round(experiment, tmp_path):
@@ -88,7 +86,7 @@ def test_verify_detects_a_tampered_round(experiment, tmp_path):
     info["mtdagger"]["allocation"]["metric"][0] += 0.5
     info["mtdagger"]["episodes_per_task"] = [9, 0, 0]
     info_path.write_text(json.dumps(info))
-    problems = verify_experiment(ExperimentDir(copy))
+    _, problems = verify_experiment(ExperimentDir(copy))
     assert any("dataset holds" in p for p in problems)
     assert any("metric" in p for p in problems)
     with pytest.raises(SystemExit):
@@ -114,7 +112,7 @@ def test_merged_rounds_load_as_one_dataset_with_the_same_task_indices(experiment
 
     merged_root = merge_rounds(experiment, [0, 1, 2], tmp_path / "merged")
     merged = LeRobotDataset("local/merged", root=merged_root)
-    episodes = sum(sum(experiment.read_round_record(k)["episodes_per_task"]) for k in range(3))
+    episodes = sum(sum(experiment.read_round_record(k).episodes_per_task) for k in range(3))
     assert merged.num_episodes == episodes
     assert merged.meta.tasks.sort_values("task_index").index.tolist() == TASKS
     item = merged[len(merged) - 1]
@@ -131,7 +129,7 @@ def test_report_gives_success_against_demos(experiment, tmp_path, capsys):
         ("need", 0, 3.0, 1),
         ("need", 1, 6.0, 1),
     ]
-    assert curves[2].mean == experiment.read_phase_record(2)["eval"]["mean"]
+    assert curves[2].mean == experiment.read_phase_record(2).eval_mean
     with pytest.raises(ValueError, match="Two need experiments with seed 0"):
         learning_curves([experiment.root, experiment.root])
     main(["report", f"--experiments=[{experiment.root}]", f"--output={tmp_path / 'r.md'}"])
@@ -214,12 +212,12 @@ def test_nan_loss_is_an_error_and_committed_rounds_survive(tmp_path, monkeypatch
 
 
 def test_bc_collects_the_whole_budget_in_one_round(tmp_path):
-    lines = run(tiny_config(tmp_path / "bc", "--scheduler.type=bc", "--rounds=2", "--budget=6"))
+    lines = run(tiny_config(tmp_path / "bc", "--mode=bc", "--rounds=2", "--budget=6"))
     experiment = ExperimentDir(tmp_path / "bc")
     assert experiment.committed_rounds() == [0] and len(lines) == 1
     record = experiment.read_round_record(0)
-    assert record["episodes_per_task"] == [3 + 4, 3 + 4, 3 + 4]
-    assert experiment.read_phase_record(0)["steps"] == 3 * 60
+    assert record.episodes_per_task == [3 + 4, 3 + 4, 3 + 4] and record.method == "bc"
+    assert experiment.read_phase_record(0).steps == 3 * 60
 
 
 def test_drawer_suite_runs_with_point_clouds(tmp_path):
@@ -231,7 +229,7 @@ def test_drawer_suite_runs_with_point_clouds(tmp_path):
         "--rounds=1",
         "--initial_demos=1",
         "--budget_per_task=1",
-        "--n_min=1",
+        "--scheduler.n_min=1",
         "--steps_per_round=20",
         "--eval_episodes=1",
         "--num_points=128",
@@ -242,9 +240,9 @@ def test_drawer_suite_runs_with_point_clouds(tmp_path):
     run(draccus.parse(RunConfig, args=args))
     experiment = ExperimentDir(tmp_path / "drawers")
     assert experiment.committed_rounds() == [0, 1]
-    assert verify_experiment(experiment) == []
+    assert verify_experiment(experiment) == (2, [])
     record = experiment.read_round_record(1)
-    assert record["task_names"] == ["drawer-bar-wide", "drawer-lip-shallow"]
+    assert record.task_names == ["drawer-bar-wide", "drawer-lip-shallow"]
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     dataset = LeRobotDataset("local/drawers", root=experiment.round_root(1))
@@ -264,7 +262,7 @@ def _cli(output_dir: Path, *extra: str) -> list[str]:
 def _allocations(root: Path) -> list:
     experiment = ExperimentDir(root)
     return [
-        (r["episodes_per_task"], r["metric"], r["rollout_success"], r["eval_success"])
+        (r.episodes_per_task, r.metric, r.rollout_success, r.eval_success)
         for r in (experiment.read_round_record(k) for k in experiment.committed_rounds())
     ]
 
@@ -291,7 +289,7 @@ def test_kill_9_and_resume_gives_the_same_allocations(tmp_path, kill_when):
     process.wait()
     subprocess.run(_cli(killed, "--scheduler.type=need", "--resume=true"), check=True, capture_output=True)
     assert _allocations(killed) == _allocations(reference)
-    assert verify_experiment(ExperimentDir(killed)) == []
+    assert verify_experiment(ExperimentDir(killed)) == (3, [])
     for k in range(3):
         weights = [
             MTDAggerPolicy.from_pretrained(str(ExperimentDir(r).policy_root(k))).state_dict()
@@ -321,5 +319,5 @@ def test_dagger_improves_a_weak_bc_policy(tmp_path):
     )
     run(config)
     experiment = ExperimentDir(tmp_path / "run")
-    means = [experiment.read_phase_record(k)["eval"]["mean"] for k in range(4)]
+    means = [experiment.read_phase_record(k).eval_mean for k in range(4)]
     assert means[-1] >= means[0] + 0.15, means

@@ -8,21 +8,23 @@ import numpy as np
 import pytest
 
 from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, make_suite
-from lerobot_mtdagger.envs.drawers import (
-    DRAWER_STATE_NAMES,
+from lerobot_mtdagger.envs.drawers.catalogue import (
     DRAWER_TASKS,
     HELDOUT_DRAWERS,
     HELDOUT_TASKS,
+    TRAINING_DRAWERS,
+    VARIANTS,
+)
+from lerobot_mtdagger.envs.drawers.pictures import render_drawer_picture
+from lerobot_mtdagger.envs.drawers.scene import DrawerSceneEnv
+from lerobot_mtdagger.envs.drawers.variants import (
+    DRAWER_STATE_NAMES,
     PLACEMENT_RANGE,
     STATE_INDEX,
     SUCCESS_FRACTION,
-    TRAINING_DRAWERS,
-    VARIANTS,
-    DrawerSceneEnv,
-    render_drawer_picture,
 )
 from lerobot_mtdagger.envs.lerobot_env import LeRobotSuiteEnv
-from lerobot_mtdagger.experts import run_expert_episode
+from lerobot_mtdagger.experts import make_expert, run_expert_episode
 
 ALL_DRAWERS = DRAWER_TASKS + HELDOUT_TASKS
 EXPERT_TARGET = 0.95
@@ -30,7 +32,7 @@ EXPERT_TARGET = 0.95
 
 def expert_success_rate(suite, task_name: str, seeds) -> float:
     env = suite.make_env(task_name)
-    expert = suite.make_expert(task_name)
+    expert = make_expert(suite, task_name)
     try:
         return float(np.mean([run_expert_episode(env, expert, seed).success for seed in seeds]))
     finally:
@@ -113,7 +115,7 @@ def test_expert_opens_every_drawer_in_seeded_episodes(name):
 def test_progress_counts_touch_pull_and_opening_and_never_decreases():
     suite = make_suite("drawers", tasks=["drawer-bar-narrow"])
     env = suite.make_env("drawer-bar-narrow", seed=5)
-    expert = suite.make_expert("drawer-bar-narrow")
+    expert = make_expert(suite, "drawer-bar-narrow")
     travel = VARIANTS["drawer-bar-narrow"].travel
     try:
         _, info = env.reset()
@@ -150,7 +152,7 @@ def test_expert_recovers_from_states_a_learner_left_behind():
     """DAgger labels learner states: after random actions (gripper closed, drawer nudged) it still opens."""
     suite = make_suite("drawers", tasks=["drawer-vbar-tall"])
     env = suite.make_env("drawer-vbar-tall")
-    expert = suite.make_expert("drawer-vbar-tall")
+    expert = make_expert(suite, "drawer-vbar-tall")
     rng = np.random.default_rng(0)
     successes = []
     try:
@@ -214,7 +216,7 @@ def test_heldout_drawers_build_for_evaluation_but_are_not_tasks():
     env = suite.make_env(name, seed=0)
     try:
         _, info = env.reset()
-        action = suite.make_expert(name).act(info["privileged_state"])
+        action = make_expert(suite, name).act(info["privileged_state"])
     finally:
         env.close()
     assert action.shape == (4,) and np.all(np.abs(action) <= 1.0)
@@ -234,7 +236,7 @@ def test_a_suite_of_heldout_drawers_can_be_built_for_training_too():
 
 def test_user_defined_variants_join_a_suite():
     from lerobot_mtdagger.envs.base import ObservationConfig
-    from lerobot_mtdagger.envs.drawers import DrawerSuite
+    from lerobot_mtdagger.envs.drawers.suite import DrawerSuite
 
     mine = dataclasses.replace(
         VARIANTS["drawer-bar-wide"], name="drawer-bar-mine", travel=0.1, yaw=-12.0, y=0.72

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import os
+
+import gymnasium as gym
 import numpy as np
 import pytest
 import torch
 
 from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, SUITE_NAMES, make_suite
 from lerobot_mtdagger.envs.metaworld import METAWORLD_CROP, MT10_TASKS, MT25_TASKS, MT50_TASKS
-from lerobot_mtdagger.experts import CallableExpert, LeRobotPolicyExpert
+from lerobot_mtdagger.experts import CallableExpert, LeRobotPolicyExpert, make_expert
 from lerobot_mtdagger.experts import run_expert_episode as expert_episode
 
 MODES = ("state", "rgb", "pointcloud")
@@ -18,7 +21,7 @@ def run_expert_episode(suite, task_name: str, seed: int) -> tuple[bool, int]:
     """Runs the task's expert for one seeded episode; success if info["success"] at any step."""
     env = suite.make_env(task_name)
     try:
-        episode = expert_episode(env, suite.make_expert(task_name), seed)
+        episode = expert_episode(env, make_expert(suite, task_name), seed)
         return episode.success, episode.steps
     finally:
         env.close()
@@ -172,16 +175,55 @@ def test_point_cloud_with_color():
     env.close()
 
 
+def where_the_arm_was(frames: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Mean (row, column) of the arm at its first and at its last position, from 3 frames along a motion.
+
+    A pixel that changed between the first and the middle frame but not between the middle and the
+    last one shows the arm at its first position (the middle and last frames agree there), and vice
+    versa. Renders are deterministic, so any change counts: no noise threshold.
+    """
+    first, middle, last = (frame.astype(int) for frame in frames)
+    changed_early = np.any(middle != first, axis=-1)
+    changed_late = np.any(last != middle, axis=-1)
+    only_first, only_last = changed_early & ~changed_late, changed_late & ~changed_early
+    assert only_first.any() and only_last.any(), "the arm must show at both ends of its motion"
+    return np.argwhere(only_first).mean(axis=0), np.argwhere(only_last).mean(axis=0)
+
+
 def test_rgb_image_is_upright_and_changes_with_the_arm():
     suite = make_suite("metaworld-mt10", obs_mode="rgb", image_size=64)
     env = suite.make_env("reach-v3", seed=0)
-    observation, _ = env.reset()
-    first = observation[IMAGE_KEY].copy()
-    for _ in range(20):
-        observation, *_ = env.step(np.array([1.0, 0.0, 0.0, 0.0]))
-    assert first.shape == (64, 64, 3) and first.dtype == np.uint8
-    assert np.abs(observation[IMAGE_KEY].astype(int) - first).mean() > 1.0
-    env.close()
+    observation, info = env.reset()
+    assert observation[IMAGE_KEY].shape == (64, 64, 3) and observation[IMAGE_KEY].dtype == np.uint8
+
+    def move(action: list[float], steps: int) -> tuple[list[np.ndarray], np.ndarray]:
+        """Images before, halfway through and after ``steps`` steps of ``action``; the hand's displacement."""
+        nonlocal observation, info
+        frames, hand_before = [observation[IMAGE_KEY].copy()], info["privileged_state"][:3].copy()
+        for step in range(1, steps + 1):
+            observation, _, _, _, info = env.step(np.array(action))
+            if step in (steps // 2, steps):
+                frames.append(observation[IMAGE_KEY].copy())
+        return frames, info["privileged_state"][:3] - hand_before
+
+    try:
+        move([0.0, 0.0, -1.0, 0.0], 15)  # lower the hand towards the table first
+        frames, displacement = move([0.0, 0.0, 1.0, 0.0], 30)
+        assert displacement[2] > 0.15, "the hand must have risen"
+        low, high = where_the_arm_was(frames)
+        assert high[0] < low[0], (
+            f"world up must be image up (row 0 at the top): rows {low[0]:.1f} -> {high[0]:.1f}"
+        )
+
+        move([-1.0, 0.0, 0.0, 0.0], 20)
+        frames, displacement = move([1.0, 0.0, 0.0, 0.0], 40)
+        assert displacement[0] > 0.2, "the hand must have moved along +x"
+        start, end = where_the_arm_was(frames)
+        # The corner camera looks along (+x, +y) from (-1.1, -0.4): world +x is on its right, so the
+        # arm moves right unless the image is mirrored (flipped vertically instead of rotated).
+        assert end[1] > start[1], f"+x must be to the right: columns {start[1]:.1f} -> {end[1]:.1f}"
+    finally:
+        env.close()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -199,7 +241,7 @@ def test_plugged_in_callable_expert_is_used():
     suite = make_suite("metaworld-mt10", tasks=["reach-v3"]).with_experts(
         {"reach-v3": CallableExpert(expert)}
     )
-    action = suite.make_expert("reach-v3").act(np.zeros(39))
+    action = make_expert(suite, "reach-v3").act(np.zeros(39))
     assert action.tolist() == [0.0, 0.0, 0.0, 0.0] and len(calls) == 1
 
 
@@ -233,8 +275,15 @@ def test_lerobot_policy_expert_adapter():
 def test_vector_env_steps_several_tasks_in_parallel():
     suite = make_suite("metaworld-mt10", tasks=["reach-v3", "button-press-topdown-v3"])
     envs = suite.make_vector_env(suite.task_names, seeds=[0, 1])
-    experts = [suite.make_expert(t) for t in suite.task_names]
+    experts = [make_expert(suite, t) for t in suite.task_names]
     try:
+        # One worker process per task, not in-process stepping (gymnasium's SyncVectorEnv): each
+        # sub-env reports the pid of the process it lives in (os.getpid pickles by reference).
+        assert isinstance(envs, gym.vector.AsyncVectorEnv), type(envs).__name__
+        envs.set_attr("process_id", os.getpid)
+        env_pids = envs.call("process_id")
+        assert len(set(env_pids)) == 2 and os.getpid() not in env_pids, env_pids
+        assert set(env_pids) == {process.pid for process in envs.processes}
         observation, info = envs.reset()
         assert observation[STATE_KEY].shape == (2, 39)
         succeeded = np.zeros(2, dtype=bool)
@@ -245,6 +294,7 @@ def test_vector_env_steps_several_tasks_in_parallel():
             if succeeded.all():
                 break
         assert succeeded.all()
+        assert all(process.is_alive() for process in envs.processes), "the workers must outlive the steps"
         observation, info = envs.reset(options={"reset_mask": np.array([True, False])})
     finally:
         envs.close()
@@ -259,7 +309,7 @@ def test_features_create_a_lerobot_dataset(tmp_path, obs_mode):
         repo_id="local/test", fps=80, features=suite.features, root=tmp_path / "ds", use_videos=False
     )
     env = suite.make_env("reach-v3", seed=0)
-    expert = suite.make_expert("reach-v3")
+    expert = make_expert(suite, "reach-v3")
     observation, info = env.reset()
     for _ in range(3):
         action = expert.act(info["privileged_state"])
@@ -320,7 +370,7 @@ def test_expert_with_wrong_action_size_is_a_clear_error():
     with pytest.raises(
         ValueError, match=r"returned an action of size 3, but the task's action space has size 4"
     ):
-        suite.make_expert("reach-v3").act(np.zeros(39))
+        make_expert(suite, "reach-v3").act(np.zeros(39))
 
 
 def test_object_without_act_is_not_an_expert():

@@ -216,7 +216,7 @@ def test_policies_are_pushed_and_tagged_per_phase(experiment_dir, fake_api):
         snapshot = fake_api.snapshot(POLICY_REPO, f"round-{k:03d}", repo_type="model")
         assert set(tree_files(snapshot)) == set(tree_files(experiment.policy_root(k))) | {".gitattributes"}
         training = json.loads((snapshot / "training.json").read_text())
-        assert training == experiment.read_phase_record(k)
+        assert training == experiment.read_phase_record(k).to_dict()
         assert (snapshot / "model.safetensors").read_bytes() == (
             experiment.policy_root(k) / "model.safetensors"
         ).read_bytes()
@@ -275,7 +275,7 @@ def test_rendered_card_has_metadata_tasks_and_eval(experiment_dir):
     assert "Scheduling method: `need`" in text
     assert "| 0 | reach-v3 |\n| 1 | button-press-topdown-v3 |" in text
     assert "| 1 | `round-001` | 6 |" in text
-    evals = [experiment.read_phase_record(k)["eval"] for k in (0, 1)]
+    evals = [experiment.read_phase_record(k).eval for k in (0, 1)]
     assert "| **mean** | " + " | ".join(f"{e['mean']:.3f}" for e in evals) + " |" in text
     with pytest.raises(ValueError, match="Round 5 is not committed"):
         render_dataset_card(experiment, DATASET_REPO, up_to_round=5)

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -12,13 +14,17 @@ from hypothesis import strategies as st
 
 from lerobot_mtdagger.scheduler import (
     METHODS,
+    SUCCESS,
     KalmanSuccessEstimator,
+    Scheduler,
     SchedulerConfig,
+    SchedulerState,
     allocate,
     allocation_mismatches,
     make_scheduler,
     rank_normalize,
     recompute_allocation,
+    scheduling_methods,
     softmax,
 )
 
@@ -251,6 +257,11 @@ def test_make_scheduler_rejects_unknown_method_listing_known_ones():
         make_scheduler("greedy", 3)
 
 
+def test_bc_is_not_a_scheduler_and_the_error_names_the_run_mode():
+    with pytest.raises(ValueError, match="behaviour cloning is a run mode.*--mode=bc"):
+        make_scheduler("bc", 3)
+
+
 def test_make_scheduler_rejects_unknown_hyperparameter():
     with pytest.raises(ValueError, match="Unknown scheduler hyperparameter"):
         make_scheduler("need", 3, temprature=0.5)
@@ -380,12 +391,13 @@ def test_scheduler_config_parses_from_command_line():
     config = draccus.parse(DemoConfig, args=["--scheduler.type=gain", "--scheduler.temperature=0.25"])
     assert config.scheduler.type == "gain"
     assert config.scheduler.temperature == 0.25
-    assert config.scheduler.n_min == 1 and config.scheduler.Q == 0.03
+    assert config.scheduler.n_min is None and config.scheduler.min_episodes == 1
+    assert config.scheduler.Q == 0.03
 
 
 def test_scheduler_config_defaults_are_the_papers():
     config = SchedulerConfig.get_choice_class("need")()
-    assert (config.temperature, config.n_min, config.p0, config.P0, config.Q, config.R0) == (
+    assert (config.temperature, config.min_episodes, config.p0, config.P0, config.Q, config.R0) == (
         0.5,
         1,
         0.5,
@@ -399,3 +411,75 @@ def test_scheduler_config_defaults_are_the_papers():
 def test_scheduler_config_rejects_bad_values(field, value):
     with pytest.raises(ValueError, match=field):
         SchedulerConfig.get_choice_class("need")(**{field: value})
+
+
+# ---------------------------------------------------------------------------------------------
+# One registered class per method
+# ---------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("method", "measurements"),
+    [("uniform", ()), ("need", ("success",)), ("need_raw", ("success",)), ("gain", ("gain",))],
+)
+def test_each_paper_method_is_one_registered_class_declaring_its_measurements(method, measurements):
+    config_class = SchedulerConfig.get_choice_class(method)
+    assert config_class().type == method
+    assert config_class.measurements == measurements
+    assert make_scheduler(method, 3).config.__class__ is config_class
+
+
+def test_each_method_computes_its_metric_from_the_scheduler_state():
+    state = SchedulerState(
+        kalman_p=np.array([0.9, 0.5, 0.1]),
+        raw_success=np.array([1.0, 0.0, 0.5]),
+        gain=np.array([0.2, 0.0, 0.1]),
+    )
+    metrics = {m: SchedulerConfig.get_choice_class(m)().metric(state).tolist() for m in METHODS}
+    assert metrics["uniform"] == [0.0, 0.0, 0.0]
+    np.testing.assert_allclose(metrics["need"], [0.1, 0.5, 0.9])
+    assert metrics["need_raw"] == [0.0, 1.0, 0.5]
+    assert metrics["gain"] == [0.2, 0.0, 0.1]
+
+
+@pytest.fixture
+def squared_need_method():
+    """A method added the documented way: one registered class, removed again after the test."""
+
+    @SchedulerConfig.register_subclass("squared_need_test")
+    @dataclasses.dataclass
+    class SquaredNeedConfig(SchedulerConfig):
+        measurements: ClassVar[tuple[str, ...]] = (SUCCESS,)
+
+        def metric(self, state: SchedulerState) -> np.ndarray:
+            return (1.0 - state.raw_success) ** 2
+
+    yield "squared_need_test"
+    SchedulerConfig.get_known_choices().pop("squared_need_test")
+
+
+def test_a_method_added_as_one_class_schedules_parses_and_verifies(squared_need_method):
+    import draccus
+
+    from lerobot_mtdagger.cli import DemoConfig
+
+    assert squared_need_method in scheduling_methods()
+    scheduler = make_scheduler(squared_need_method, 3)
+    first = scheduler.allocate(9)
+    assert first.episodes_per_task == [3, 3, 3] and first.notes == [
+        "no rollouts measured yet: the prior decides (uniform allocation)"
+    ]
+    scheduler.update(success_rate=[1.0, 0.5, 0.0], episodes=[2, 2, 2])
+    record = scheduler.allocate(9).to_dict()
+    assert record["metric"] == [0.0, 0.25, 1.0]
+    assert record["episodes_per_task"][2] > record["episodes_per_task"][0]
+    assert allocation_mismatches(record) == []  # verify recomputes it through the same class
+    record["metric"][2] = 0.5
+    assert any(p.startswith("metric") for p in allocation_mismatches(record))
+    parsed = draccus.parse(DemoConfig, args=[f"--scheduler.type={squared_need_method}"])
+    assert parsed.scheduler.type == squared_need_method
+
+
+def test_scheduler_takes_a_config_not_a_method_name():
+    with pytest.raises(TypeError, match="make_scheduler"):
+        Scheduler("need", 3)

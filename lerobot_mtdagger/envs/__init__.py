@@ -9,9 +9,14 @@ metaworld-mt10      MetaWorld's MT10 list (v3 envs)
 metaworld-mt25      MetaWorld's MT25 list
 metaworld-mt50      MetaWorld's MT50 list (all v3 tasks)
 metaworld           any explicit ``tasks=[...]`` list of v3 task names
-drawers             the 11 procedurally generated training drawers (``envs/drawers.py``);
+drawers             the 11 procedurally generated training drawers (``envs/drawers/``);
                     ``suite.heldout_task_names`` are unseen drawers the suite also builds
+toy                 a point mass pushed to task-specific goals (``envs/toy.py``): no MuJoCo,
+                    state only, for fast tests
 ==================  =====================================================================
+
+``suite_from_config(config)`` builds the suite a command's config names (``run``, ``eval`` and the
+LeRobot env plugin all go through it).
 
 ``tasks=[...]`` with a named list selects a subset in the given order. Rendering uses MuJoCo's EGL
 backend unless ``MUJOCO_GL`` is already set (``osmesa`` is the fallback without EGL).
@@ -25,18 +30,26 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
 
 from collections.abc import Sequence  # noqa: E402
+from typing import Any, Protocol  # noqa: E402
 
 from lerobot_mtdagger.envs.base import (  # noqa: E402
     IMAGE_KEY,
     OBS_MODES,
     POINTCLOUD_KEY,
     STATE_KEY,
+    CropBox,
     ObservationConfig,
     TaskSuite,
 )
-from lerobot_mtdagger.envs.rendering import CropBox  # noqa: E402
 
-SUITE_NAMES: tuple[str, ...] = ("metaworld-mt10", "metaworld-mt25", "metaworld-mt50", "metaworld", "drawers")
+SUITE_NAMES: tuple[str, ...] = (
+    "metaworld-mt10",
+    "metaworld-mt25",
+    "metaworld-mt50",
+    "metaworld",
+    "drawers",
+    "toy",
+)
 
 __all__ = [
     "IMAGE_KEY",
@@ -47,7 +60,9 @@ __all__ = [
     "CropBox",
     "ObservationConfig",
     "TaskSuite",
+    "SuiteOptions",
     "make_suite",
+    "suite_from_config",
 ]
 
 
@@ -106,6 +121,10 @@ def make_suite(
 
         task_names = list(tasks) if tasks else list(DRAWER_TASKS)
         return DrawerSuite(task_names, observation, max_episode_steps=max_episode_steps)
+    if name == "toy":
+        from lerobot_mtdagger.envs.toy import TOY_TASKS, ToySuite
+
+        return ToySuite(list(tasks) if tasks else list(TOY_TASKS), observation, max_episode_steps)
     from lerobot_mtdagger.envs.metaworld import MT10_TASKS, MT25_TASKS, MT50_TASKS, MetaWorldSuite
 
     named_lists = {"metaworld-mt10": MT10_TASKS, "metaworld-mt25": MT25_TASKS, "metaworld-mt50": MT50_TASKS}
@@ -120,3 +139,36 @@ def make_suite(
         if outside:
             raise ValueError(f"Task(s) {outside} are not in {name}; its tasks: {list(available)}.")
     return MetaWorldSuite(task_names, observation, max_episode_steps=max_episode_steps, name=name)
+
+
+class SuiteOptions(Protocol):
+    """What a command's config says about its suite (``RunConfig``, ``EvalConfig``, the env plugin)."""
+
+    suite: str
+    tasks: Any  # a sequence of task names, or None / empty for all the suite's tasks
+    obs_mode: str
+    image_size: int
+    num_points: int
+
+
+def suite_from_config(config: SuiteOptions, **overrides: Any) -> TaskSuite:
+    """The suite a config names; ``max_episode_steps`` comes from ``config.episode_length`` if it has one.
+
+    Args:
+        config: Any object with the ``SuiteOptions`` attributes.
+        **overrides: ``make_suite`` keyword arguments that replace the config's.
+
+    Raises:
+        ValueError: On an unknown suite, task or observation setting.
+    """
+    tasks = config.tasks
+    if isinstance(tasks, str):
+        tasks = [tasks]
+    options: dict[str, Any] = {
+        "tasks": list(tasks) if tasks else None,
+        "obs_mode": config.obs_mode,
+        "image_size": config.image_size,
+        "num_points": config.num_points,
+        "max_episode_steps": getattr(config, "episode_length", None),
+    }
+    return make_suite(config.suite, **(options | overrides))

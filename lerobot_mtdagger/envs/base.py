@@ -7,8 +7,9 @@ policy config, scheduler), plus:
   feature names (``observation.state`` always, ``observation.image`` in ``rgb`` mode,
   ``observation.pointcloud`` in ``pointcloud`` mode); ``info["success"]`` at every step and
   ``info["privileged_state"]``, the low-dimensional state the expert acts on;
-- ``make_expert(task_name)``: an ``Expert`` for that task (the suite's scripted expert unless
-  ``with_experts`` replaced it);
+- ``expert_family``: the key under which experts register for the suite's tasks
+  (``lerobot_mtdagger.experts.make_expert(suite, task)`` gives a task's expert; ``with_experts``
+  replaces some; suites never import experts);
 - ``features``: the LeRobot feature dict of what the suite emits plus ``action``;
 - ``make_vector_env(task_names, seeds)``: several tasks' envs stepped in parallel processes.
 """
@@ -23,15 +24,43 @@ from dataclasses import dataclass
 from typing import Any
 
 import gymnasium as gym
-
-from lerobot_mtdagger.envs.rendering import CropBox
-from lerobot_mtdagger.experts import ActionCheckedExpert, Expert
+import numpy as np
 
 OBS_MODES: tuple[str, ...] = ("state", "rgb", "pointcloud")
 
 STATE_KEY = "observation.state"
 IMAGE_KEY = "observation.image"
 POINTCLOUD_KEY = "observation.pointcloud"
+
+
+@dataclass(frozen=True)
+class CropBox:
+    """Axis-aligned box in world coordinates (metres) that keeps the workspace.
+
+    Attributes:
+        low: (x, y, z) lower corner.
+        high: (x, y, z) upper corner.
+    """
+
+    low: tuple[float, float, float]
+    high: tuple[float, float, float]
+
+    def __post_init__(self) -> None:
+        if len(self.low) != 3 or len(self.high) != 3:
+            raise ValueError(
+                f"CropBox corners need 3 coordinates each, got low={self.low}, high={self.high}."
+            )
+        if any(lo >= hi for lo, hi in zip(self.low, self.high, strict=True)):
+            raise ValueError(f"CropBox low={self.low} must be below high={self.high} on every axis.")
+
+    def contains(self, points: np.ndarray) -> np.ndarray:
+        """Boolean mask of the rows of ``points`` (..., 3) inside the box."""
+        return np.all((points >= np.asarray(self.low)) & (points <= np.asarray(self.high)), axis=-1)
+
+    @property
+    def center(self) -> np.ndarray:
+        """The box centre, shape (3,)."""
+        return (np.asarray(self.low) + np.asarray(self.high)) / 2.0
 
 
 @dataclass(frozen=True)
@@ -78,6 +107,8 @@ class TaskSuite(abc.ABC):
     """A fixed, ordered set of tasks with envs, experts and LeRobot features."""
 
     name: str
+    expert_family: str
+    """Key of the suite's experts in the expert registry (``lerobot_mtdagger.experts``)."""
 
     def __init__(self, task_names: Sequence[str], observation: ObservationConfig) -> None:
         """Stores the task order and the observation settings.
@@ -93,7 +124,7 @@ class TaskSuite(abc.ABC):
             raise ValueError(f"Task names must be unique; repeated: {duplicates}.")
         self.task_names = task_names
         self.observation = observation
-        self._experts: dict[str, Expert] = {}
+        self.expert_overrides: dict[str, Any] = {}
         # Unseen tasks the suite builds envs and experts for (evaluation only; no task index).
         self.heldout_task_names: list[str] = []
 
@@ -118,10 +149,6 @@ class TaskSuite(abc.ABC):
     def make_env(self, task_name: str, seed: int | None = None) -> gym.Env:
         """Builds the env of one task; ``seed`` seeds its first reset."""
 
-    @abc.abstractmethod
-    def _scripted_expert(self, task_name: str) -> Expert:
-        """The suite's own expert of one task."""
-
     def check_buildable(self, task_name: str) -> None:
         """Checks that the suite builds ``task_name``: one of its tasks or of its held-out tasks.
 
@@ -134,28 +161,25 @@ class TaskSuite(abc.ABC):
                 f"{self.heldout_task_names}."
             )
 
-    def make_expert(self, task_name: str) -> Expert:
-        """The task's expert (scripted unless replaced by ``with_experts``), action-size checked.
-
-        Raises:
-            ValueError: If the suite does not build the task.
-        """
-        self.check_buildable(task_name)
-        expert = self._experts.get(task_name) or self._scripted_expert(task_name)
-        return ActionCheckedExpert(expert, task_name, self.action_dim)
-
-    def with_experts(self, experts: dict[str, Expert]) -> TaskSuite:
+    def with_experts(self, experts: dict[str, Any]) -> TaskSuite:
         """A copy of the suite with the expert of some tasks replaced (for example by RL policies).
+
+        ``lerobot_mtdagger.experts.make_expert`` returns these instead of the registered experts.
 
         Raises:
             ValueError: On a task not in the suite.
-            TypeError: On an object that is not an ``Expert``.
+            TypeError: On an object without the ``Expert`` protocol's ``reset()`` and ``act(state)``.
         """
         for task_name, expert in experts.items():
             self.task_index(task_name)
-            ActionCheckedExpert(expert, task_name, self.action_dim)
+            if not (callable(getattr(expert, "reset", None)) and callable(getattr(expert, "act", None))):
+                raise TypeError(
+                    f"The expert for {task_name!r} is a {type(expert).__name__} without reset() and "
+                    "act(privileged_state); wrap a function with CallableExpert or a LeRobot policy with "
+                    "LeRobotPolicyExpert."
+                )
         clone = self.with_observation()
-        clone._experts = {**self._experts, **experts}
+        clone.expert_overrides = {**self.expert_overrides, **experts}
         return clone
 
     @property

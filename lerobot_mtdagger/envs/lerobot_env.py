@@ -34,7 +34,7 @@ from lerobot.envs.configs import EnvConfig
 # config before it could honour a --policy.discover_packages_path (LeRobot 0.4.4 passes that flag on
 # to the config as an unknown field when --policy.path is given), so the env plugin brings it along.
 import lerobot_mtdagger.policies  # noqa: F401
-from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, make_suite
+from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, suite_from_config
 
 GYM_ID = "MTDAgger/Suite-v0"
 RAW_KEYS = {STATE_KEY: "agent_pos", IMAGE_KEY: "pixels", POINTCLOUD_KEY: "environment_state"}
@@ -56,8 +56,15 @@ class LeRobotSuiteEnv(gym.Env):
         render_mode: str | None = "rgb_array",
     ) -> None:
         """Builds the suite env of ``task``."""
-        kwargs = {"obs_mode": obs_mode, "image_size": image_size, "num_points": num_points}
-        self._suite = make_suite(suite, tasks=[task], max_episode_steps=episode_length, **kwargs)
+        config = MTDAggerSuiteEnvConfig(
+            suite=suite,
+            task=task,
+            obs_mode=obs_mode,
+            image_size=image_size,
+            num_points=num_points,
+            episode_length=episode_length,
+        )
+        self._suite = suite_from_config(config)
         self._env = self._suite.make_env(task)
         self.task_description = task
         self.render_mode = render_mode
@@ -123,13 +130,7 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
     features_map: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        suite = make_suite(
-            self.suite,
-            tasks=[self.task] if self.task else None,
-            obs_mode=self.obs_mode,
-            image_size=self.image_size,
-            num_points=self.num_points,
-        )
+        suite = suite_from_config(self)
         self.features, self.features_map = {}, {}
         for key, feature in suite.features.items():
             if key == "action":
@@ -143,6 +144,11 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
             feature_type = FeatureType.VISUAL if feature["dtype"] == "image" else FeatureType.STATE
             self.features[raw] = PolicyFeature(type=feature_type, shape=shape)
             self.features_map[raw] = key if key != POINTCLOUD_KEY else "observation.environment_state"
+
+    @property
+    def tasks(self) -> list[str]:
+        """The suite's tasks for ``suite_from_config``: the one task (all the suite's when None)."""
+        return [self.task] if self.task else []
 
     @property
     def package_name(self) -> str:

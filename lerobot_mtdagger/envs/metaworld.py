@@ -38,8 +38,6 @@ from lerobot_mtdagger.envs.base import (
     observation_features,
 )
 from lerobot_mtdagger.envs.rendering import CropBox, PointCloudCamera, SceneRenderer, camera_rays
-from lerobot_mtdagger.experts import Expert
-from lerobot_mtdagger.experts.metaworld import MetaWorldScriptedExpert
 
 logger = logging.getLogger(__name__)
 
@@ -275,6 +273,7 @@ class MetaWorldSuite(TaskSuite):
     """MetaWorld v3 tasks: MT10, MT25, MT50 or any explicit list."""
 
     name = "metaworld"
+    expert_family = "metaworld"
 
     def __init__(
         self,
@@ -306,10 +305,6 @@ class MetaWorldSuite(TaskSuite):
         return MetaWorldTaskEnv(
             task_name, self.observation, seed=seed, max_episode_steps=self.max_episode_steps
         )
-
-    def _scripted_expert(self, task_name: str) -> Expert:
-        """MetaWorld's scripted policy of the task."""
-        return MetaWorldScriptedExpert(task_name)
 
     @property
     def features(self) -> dict[str, dict[str, Any]]:

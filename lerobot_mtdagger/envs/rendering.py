@@ -26,10 +26,11 @@ from __future__ import annotations
 import atexit
 import logging
 import weakref
-from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+
+from lerobot_mtdagger.envs.base import CropBox
 
 logger = logging.getLogger(__name__)
 
@@ -51,36 +52,6 @@ def _register_exit_handler() -> None:
     if not _EXIT_HANDLER_REGISTERED:
         atexit.register(_close_open_renderers)
         _EXIT_HANDLER_REGISTERED = True
-
-
-@dataclass(frozen=True)
-class CropBox:
-    """Axis-aligned box in world coordinates (metres) that keeps the workspace.
-
-    Attributes:
-        low: (x, y, z) lower corner.
-        high: (x, y, z) upper corner.
-    """
-
-    low: tuple[float, float, float]
-    high: tuple[float, float, float]
-
-    def __post_init__(self) -> None:
-        if len(self.low) != 3 or len(self.high) != 3:
-            raise ValueError(
-                f"CropBox corners need 3 coordinates each, got low={self.low}, high={self.high}."
-            )
-        if any(lo >= hi for lo, hi in zip(self.low, self.high, strict=True)):
-            raise ValueError(f"CropBox low={self.low} must be below high={self.high} on every axis.")
-
-    def contains(self, points: np.ndarray) -> np.ndarray:
-        """Boolean mask of the rows of ``points`` (..., 3) inside the box."""
-        return np.all((points >= np.asarray(self.low)) & (points <= np.asarray(self.high)), axis=-1)
-
-    @property
-    def center(self) -> np.ndarray:
-        """The box centre, shape (3,)."""
-        return (np.asarray(self.low) + np.asarray(self.high)) / 2.0
 
 
 class SceneRenderer:

@@ -1,4 +1,4 @@
-"""Experts: the ``Expert`` protocol and adapters that turn other policies into experts.
+"""The ``Expert`` protocol and the adapters that turn other policies into experts.
 
 An expert acts on the env's privileged low-dimensional state (``info["privileged_state"]``), never
 on the learner's observation. The paper's experts are PPO policies trained on state; any such
@@ -10,7 +10,7 @@ policy can be brought in:
   ``make_policy``/``make_pre_post_processors`` or ``PreTrainedPolicy.from_pretrained``);
 - then ``suite.with_experts({"reach-v3": my_expert})`` or pass it where an ``Expert`` is expected.
 
-Every expert is wrapped in ``ActionCheckedExpert`` by the suites, so a plugged-in expert with the
+Every expert is wrapped in ``ActionCheckedExpert`` by ``make_expert``, so a plugged-in expert with the
 wrong action size fails on its first action with a message naming the task and both sizes.
 """
 

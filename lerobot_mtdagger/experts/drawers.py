@@ -19,9 +19,11 @@ from drawers a learner left half open.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from lerobot_mtdagger.envs.drawers import STATE_INDEX, DrawerVariant
+from lerobot_mtdagger.envs.drawers.variants import STATE_INDEX, DrawerVariant
 
 SAFE_HEIGHT = 0.08
 OPEN_TARGET = 0.95
@@ -104,3 +106,8 @@ class DrawerScriptedExpert:
     @staticmethod
     def _action(move: np.ndarray, grip: float) -> np.ndarray:
         return np.clip(np.append(move, grip), -1.0, 1.0).astype(np.float32)
+
+
+def scripted_expert(suite: Any, task_name: str) -> DrawerScriptedExpert:
+    """The registry's factory for the ``drawers`` suite family (``experts.registry``)."""
+    return DrawerScriptedExpert(suite.variants[task_name])

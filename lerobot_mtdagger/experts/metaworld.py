@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import warnings
+from typing import Any
 
 import numpy as np
 from metaworld.policies import ENV_POLICY_MAP
@@ -35,3 +36,8 @@ class MetaWorldScriptedExpert:
         """The scripted action, clipped to the action space [-1, 1]."""
         action = self._policy.get_action(np.asarray(privileged_state, dtype=np.float64))
         return np.clip(action, -1.0, 1.0).astype(np.float32)
+
+
+def scripted_expert(suite: Any, task_name: str) -> MetaWorldScriptedExpert:
+    """The registry's factory for the ``metaworld`` suite family (``experts.registry``)."""
+    return MetaWorldScriptedExpert(task_name)

@@ -1,0 +1,113 @@
+"""The drawer suite: LeRobot-keyed envs (``DrawerTaskEnv``) and the ``DrawerSuite`` that builds them.
+
+``DrawerTaskEnv`` wraps a ``DrawerSceneEnv`` like the MetaWorld suites wrap theirs (same
+observation modes, cameras, point-cloud crop ``DRAWER_CROP``); ``DrawerSuite`` selects training
+drawers from the catalogue (or user-defined variants), names the held-out ones, and gives each
+drawer the scripted expert of ``lerobot_mtdagger.experts.drawers`` (through the expert registry).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from lerobot_mtdagger.envs.base import ObservationConfig, TaskSuite, observation_features
+from lerobot_mtdagger.envs.drawers.catalogue import HELDOUT_TASKS, VARIANTS
+from lerobot_mtdagger.envs.drawers.scene import DrawerSceneEnv
+from lerobot_mtdagger.envs.drawers.variants import DRAWER_STATE_NAMES, STATE_INDEX, DrawerVariant
+from lerobot_mtdagger.envs.metaworld import ACTION_DIM, ACTION_NAMES, PROPRIO_NAMES, MetaWorldTaskEnv
+from lerobot_mtdagger.envs.rendering import CropBox
+
+DRAWER_CROP = CropBox(low=(-0.62, 0.3, 0.005), high=(0.62, 0.975, 0.55))
+
+
+def drawer_state_names(config: ObservationConfig) -> list[str]:
+    """Names of ``observation.state``: privileged state in ``state`` mode, else hand xyz + gripper."""
+    return DRAWER_STATE_NAMES if config.obs_mode == "state" else PROPRIO_NAMES
+
+
+class DrawerTaskEnv(MetaWorldTaskEnv):
+    """One drawer with LeRobot-keyed observations (see the ``lerobot_mtdagger.envs.drawers`` docstring)."""
+
+    default_crop = DRAWER_CROP
+
+    def __init__(
+        self,
+        variant: DrawerVariant,
+        observation: ObservationConfig,
+        seed: int | None = None,
+        max_episode_steps: int | None = None,
+    ) -> None:
+        """Builds the drawer's model and env."""
+        self.variant = variant
+        super().__init__(variant.name, observation, seed=seed, max_episode_steps=max_episode_steps)
+
+    def _build_raw_env(self) -> DrawerSceneEnv:
+        return DrawerSceneEnv(self.variant)
+
+    def state_names(self) -> list[str]:
+        """Privileged state names in ``state`` mode, hand xyz + gripper otherwise."""
+        return drawer_state_names(self.observation_config)
+
+    def _proprio_state(self, raw: np.ndarray) -> np.ndarray:
+        return raw[:4]
+
+    def _step_info(self, raw: np.ndarray, raw_info: dict[str, Any]) -> dict[str, Any]:
+        info = super()._step_info(raw, raw_info)
+        info["progress"] = int(raw_info.get("progress", 0))
+        info["opening"] = float(raw[STATE_INDEX["opening"]])
+        return info
+
+
+class DrawerSuite(TaskSuite):
+    """The drawer-opening suite: 11 training drawers, held-out drawers for evaluation."""
+
+    name = "drawers"
+    expert_family = "drawers"
+
+    def __init__(
+        self,
+        task_names: Sequence[str],
+        observation: ObservationConfig,
+        max_episode_steps: int | None = None,
+        variants: Sequence[DrawerVariant] | None = None,
+    ) -> None:
+        """Selects the drawers of the suite.
+
+        Args:
+            task_names: Training drawers (any of ``DRAWER_TASKS`` and ``HELDOUT_TASKS``, or the
+                names of ``variants``).
+            observation: What the envs show the policy.
+            max_episode_steps: Truncation length (``MAX_EPISODE_STEPS`` when None).
+            variants: Extra drawer variants (user-defined) that task names may refer to.
+
+        Raises:
+            ValueError: On an unknown drawer.
+        """
+        self.variants = dict(VARIANTS)
+        for variant in variants or ():
+            self.variants[variant.name] = variant
+        unknown = [t for t in task_names if t not in self.variants]
+        if unknown:
+            raise ValueError(f"Unknown drawer(s) {unknown}; known drawers: {sorted(self.variants)}.")
+        super().__init__(task_names, observation)
+        self.max_episode_steps = max_episode_steps
+        self.heldout_task_names = [t for t in HELDOUT_TASKS if t not in self.task_names]
+
+    @property
+    def action_dim(self) -> int:
+        """MetaWorld's 4-d action: end-effector displacement xyz and gripper effort."""
+        return ACTION_DIM
+
+    def make_env(self, task_name: str, seed: int | None = None) -> DrawerTaskEnv:
+        """Builds the env of a training or held-out drawer."""
+        self.check_buildable(task_name)
+        variant = self.variants[task_name]
+        return DrawerTaskEnv(variant, self.observation, seed=seed, max_episode_steps=self.max_episode_steps)
+
+    @property
+    def features(self) -> dict[str, dict[str, Any]]:
+        """LeRobot features of the observations of the current mode, plus ``action``."""
+        return observation_features(self.observation, drawer_state_names(self.observation), ACTION_NAMES)

@@ -1,0 +1,244 @@
+"""What a drawer is: the ``DrawerVariant`` dataclass, its validation, and the suite's constants.
+
+Holds the handle types, the success and pull fractions, the per-reset placement range, the episode
+length, the table limits and handle-part sizes the validation checks against, and the names of the
+privileged state (``DRAWER_STATE_NAMES``, ``STATE_INDEX``). Numpy and the standard library only: no
+MuJoCo, MetaWorld or gymnasium, so the scripted expert and the catalogue depend on nothing heavier.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+HANDLE_TYPES: tuple[str, ...] = ("bar", "knob", "lip", "vbar")
+SUCCESS_FRACTION = 0.8
+PULL_FRACTION = 0.1
+PLACEMENT_RANGE = (0.03, 0.03, 5.0)  # +- x (m), +- y (m), +- yaw (degrees) per reset
+MAX_EPISODE_STEPS = 300
+
+# The table top is z = 0, x in [-0.7, 0.7]; MetaWorld's retaining walls stand at y = 0.21 and 0.99.
+TABLE_X_LIMIT = 0.62
+TABLE_Y_RANGE = (0.45, 0.985)
+
+# Handle-part sizes shared by the validation below and the MJCF (``mjcf.py``).
+BAR_RADIUS = 0.007
+VBAR_OVERHANG = 0.03
+LIP_TAB_HEIGHT = 0.035
+FINGER_MARGIN = 0.005
+
+DRAWER_STATE_NAMES: list[str] = [
+    "hand_x",
+    "hand_y",
+    "hand_z",
+    "gripper",
+    "handle_x",
+    "handle_y",
+    "handle_z",
+    "grasp_x",
+    "grasp_y",
+    "grasp_z",
+    "axis_x",
+    "axis_y",
+    "axis_z",
+    "opening",
+    "travel",
+    "goal_x",
+    "goal_y",
+    "goal_z",
+]
+STATE_INDEX = {name: i for i, name in enumerate(DRAWER_STATE_NAMES)}
+
+
+def _check(condition: bool, message: str) -> None:
+    if not condition:
+        raise ValueError(message)
+
+
+@dataclass(frozen=True)
+class DrawerVariant:
+    """One procedurally generated drawer. Lengths in metres, angles in degrees.
+
+    Attributes:
+        name: Task name, ``drawer-<handle>-<what sets it apart>``.
+        handle: ``bar``, ``knob``, ``lip`` or ``vbar``.
+        handle_size: Bar length (bar, vbar), cap radius (knob) or tab width (lip).
+        handle_height: Height of the handle centre on the front, as a fraction of half the front
+            height (-1 bottom edge, 0 centre, 1 top edge); must be 0 for ``lip``.
+        handle_clearance: Gap between the front panel and the back of the handle (finger room);
+            unused by ``lip`` (its tab stands flush on the top edge; the finger goes behind it).
+        width: Outer width of the case.
+        height: Outer height of the case.
+        depth: Outer depth of the case.
+        travel: How far the drawer slides open.
+        damping: Viscous damping of the slide joint, N s/m.
+        friction: Dry friction of the slide joint (MuJoCo ``frictionloss``), N.
+        x: Case front centre, world x (the table spans about -0.6 .. 0.6).
+        y: Case front centre, world y (the case extends from here away from the robot).
+        yaw: Case rotation about the vertical axis; 0 faces the robot.
+        elevation: Height of a plinth under the case (0: the case stands on the table).
+        case_rgba: Case colour.
+        front_rgba: Front panel colour.
+        handle_rgba: Handle colour.
+    """
+
+    name: str
+    handle: str
+    handle_size: float
+    handle_height: float
+    handle_clearance: float
+    width: float
+    height: float
+    depth: float
+    travel: float
+    damping: float
+    friction: float
+    x: float
+    y: float
+    yaw: float
+    elevation: float = 0.0
+    case_rgba: tuple[float, float, float, float] = (0.55, 0.42, 0.3, 1.0)
+    front_rgba: tuple[float, float, float, float] = (0.75, 0.6, 0.42, 1.0)
+    handle_rgba: tuple[float, float, float, float] = (0.7, 0.7, 0.72, 1.0)
+
+    def __post_init__(self) -> None:
+        where = f"DrawerVariant {self.name!r}"
+        _check(
+            self.name.startswith("drawer-"),
+            f"{where}: task names start with 'drawer-' (got {self.name!r}).",
+        )
+        _check(
+            self.handle in HANDLE_TYPES,
+            f"{where}: handle must be one of {HANDLE_TYPES}, got {self.handle!r}.",
+        )
+        for field in ("handle_size", "handle_clearance", "width", "height", "depth"):
+            value = getattr(self, field)
+            _check(
+                math.isfinite(value) and value > 0,
+                f"{where}: {field} must be a positive length in metres, got {value}.",
+            )
+        _check(
+            math.isfinite(self.travel) and self.travel > 0,
+            f"{where}: travel must be > 0 (a drawer that cannot move cannot be opened), got {self.travel}.",
+        )
+        _check(
+            self.travel <= 0.8 * self.depth,
+            f"{where}: travel {self.travel} m exceeds 0.8 x depth ({0.8 * self.depth:.3f} m); "
+            "make the case deeper or the travel shorter.",
+        )
+        for field in ("damping", "friction", "elevation"):
+            value = getattr(self, field)
+            _check(math.isfinite(value) and value >= 0, f"{where}: {field} must be >= 0, got {value}.")
+        _check(
+            -1.0 < self.handle_height < 1.0,
+            f"{where}: handle_height must be in (-1, 1), got {self.handle_height}.",
+        )
+        _check(
+            self.handle != "lip" or self.handle_height == 0.0,
+            f"{where}: a lip handle sits on the top edge; set handle_height=0 (got {self.handle_height}).",
+        )
+        _check(abs(self.yaw) <= 30.0, f"{where}: yaw must be within +-30 degrees, got {self.yaw}.")
+        for field in ("case_rgba", "front_rgba", "handle_rgba"):
+            color = getattr(self, field)
+            _check(
+                len(color) == 4 and all(0.0 <= c <= 1.0 for c in color),
+                f"{where}: {field} must be 4 numbers in [0, 1], got {color}.",
+            )
+        self._check_handle_fits(where)
+        self._check_on_table(where)
+
+    def _check_handle_fits(self, where: str) -> None:
+        pad_room = 2 * 0.004 + 2 * FINGER_MARGIN
+        _check(
+            self.handle_clearance >= pad_room,
+            f"{where}: handle_clearance {self.handle_clearance} m leaves no room for a finger; "
+            f"use >= {pad_room}.",
+        )
+        _check(self.width >= 0.12, f"{where}: width must be >= 0.12 m, got {self.width}.")
+        _check(self.height >= 0.06, f"{where}: height must be >= 0.06 m, got {self.height}.")
+        _check(self.depth >= 0.12, f"{where}: depth must be >= 0.12 m, got {self.depth}.")
+        low, high = self.handle_extent_z()
+        front_low, front_high = self.elevation + 0.003, self.elevation + self.height - 0.003
+        if self.handle in ("bar", "lip"):
+            _check(
+                0.08 <= self.handle_size <= self.width - 0.02,
+                f"{where}: a {self.handle} handle needs handle_size in [0.08, width - 0.02], "
+                f"got {self.handle_size}.",
+            )
+        if self.handle == "knob":
+            _check(
+                0.018 <= self.handle_size <= 0.04,
+                f"{where}: a knob's cap radius (handle_size) must be in [0.018, 0.04] m, "
+                f"got {self.handle_size}.",
+            )
+        if self.handle == "vbar":
+            _check(
+                self.handle_size >= 2 * VBAR_OVERHANG + 0.02,
+                f"{where}: a vbar needs handle_size >= {2 * VBAR_OVERHANG + 0.02} m, got {self.handle_size}.",
+            )
+        if self.handle != "lip":
+            _check(
+                front_low <= low and high <= front_high,
+                f"{where}: the handle spans z {low:.3f}..{high:.3f} m, outside the front "
+                f"({front_low:.3f}..{front_high:.3f}); move handle_height towards 0 or shrink handle_size.",
+            )
+
+    def _check_on_table(self, where: str) -> None:
+        corners = self.case_corners_xy()
+        _check(
+            bool(np.all(np.abs(corners[:, 0]) <= TABLE_X_LIMIT)),
+            f"{where}: the case reaches x = {np.abs(corners[:, 0]).max():.3f} m, off the table "
+            f"(|x| <= {TABLE_X_LIMIT}); move x towards 0 or narrow the case.",
+        )
+        _check(
+            bool(np.all((corners[:, 1] >= TABLE_Y_RANGE[0]) & (corners[:, 1] <= TABLE_Y_RANGE[1]))),
+            f"{where}: the case spans y {corners[:, 1].min():.3f}..{corners[:, 1].max():.3f} m, outside "
+            f"{TABLE_Y_RANGE} (MetaWorld's back wall stands at 0.99); move y or make the case shallower.",
+        )
+
+    def case_corners_xy(self) -> np.ndarray:
+        """World (x, y) of the four footprint corners of the case at the variant's nominal pose, (4, 2)."""
+        half = self.width / 2
+        local = np.array([[-half, 0.0], [half, 0.0], [-half, self.depth], [half, self.depth]])
+        yaw = math.radians(self.yaw)
+        rotation = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+        return local @ rotation.T + np.array([self.x, self.y])
+
+    def handle_center_z(self) -> float:
+        """Height of the handle centre above the case bottom (case frame, without elevation)."""
+        if self.handle == "lip":
+            return self.height + LIP_TAB_HEIGHT / 2 - 0.003
+        return self.height / 2 + self.handle_height * (self.height / 2 - 0.003)
+
+    def handle_extent_z(self) -> tuple[float, float]:
+        """World z range of the handle at the nominal pose."""
+        center = self.elevation + self.handle_center_z()
+        half = {
+            "bar": BAR_RADIUS,
+            "knob": self.handle_size,
+            "lip": LIP_TAB_HEIGHT / 2,
+            "vbar": self.handle_size / 2 + BAR_RADIUS,
+        }[self.handle]
+        return center - half, center + half
+
+    def parameter_vector(self) -> np.ndarray:
+        """Numeric description (handle one-hot, then every geometric and physical parameter)."""
+        one_hot = [float(self.handle == h) for h in HANDLE_TYPES]
+        numbers = [
+            self.handle_size,
+            self.handle_height,
+            self.handle_clearance,
+            self.width,
+            self.height,
+            self.depth,
+            self.travel,
+            self.damping,
+            self.friction,
+            self.x,
+            self.y,
+            self.yaw,
+            self.elevation,
+        ]
+        return np.asarray(one_hot + numbers + list(self.front_rgba), dtype=np.float64)

@@ -1,0 +1,30 @@
+"""Experts: the ``Expert`` protocol, adapters for other policies, and the registry of each suite's.
+
+``make_expert(suite, task_name)`` gives the expert of a task (see ``registry``). The scripted experts
+of the built-in suites are registered by entry point and imported on first use: MetaWorld's policies
+(``metaworld``), the drawer controller (``drawers``) and the toy suite's optimal controller (``toy``).
+Experts depend on the suites (they read the privileged state layout); suites never import experts.
+"""
+
+from lerobot_mtdagger.experts.base import (
+    ActionCheckedExpert,
+    CallableExpert,
+    Expert,
+    ExpertEpisode,
+    LeRobotPolicyExpert,
+    run_expert_episode,
+)
+from lerobot_mtdagger.experts.registry import ANY_TASK, make_expert, register_expert, registered_experts
+
+__all__ = [
+    "ANY_TASK",
+    "ActionCheckedExpert",
+    "CallableExpert",
+    "Expert",
+    "ExpertEpisode",
+    "LeRobotPolicyExpert",
+    "make_expert",
+    "register_expert",
+    "registered_experts",
+    "run_expert_episode",
+]

@@ -1,0 +1,92 @@
+"""The expert registry: which expert labels a task, keyed by suite family and task name.
+
+Suites know nothing of experts (``envs`` does not import ``experts``); a factory is registered for a
+suite family (``TaskSuite.expert_family``: ``metaworld``, ``drawers``, ``toy``), for all its tasks or
+for one task, as a callable or as a ``"module:attribute"`` entry point imported on first use (the
+built-in suites' scripted experts are registered that way, so using the toy suite never imports
+MetaWorld)::
+
+    register_expert("metaworld", lambda suite, task: MyPPOExpert(task), task="push-v3")
+
+``make_expert(suite, task)`` then returns, in order of precedence, the expert the suite was given
+with ``suite.with_experts({...})``, the factory registered for ``(family, task)``, or the one
+registered for the whole family; always wrapped in ``ActionCheckedExpert``, so an expert with the
+wrong action size fails on its first action naming the task.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from typing import Any
+
+from lerobot_mtdagger.experts.base import ActionCheckedExpert, Expert
+
+ANY_TASK = "*"
+"""Task key of a factory that serves every task of its suite family."""
+
+ExpertFactory = Callable[[Any, str], Expert]
+"""``factory(suite, task_name) -> Expert``."""
+
+_FACTORIES: dict[tuple[str, str], ExpertFactory | str] = {
+    ("metaworld", ANY_TASK): "lerobot_mtdagger.experts.metaworld:scripted_expert",
+    ("drawers", ANY_TASK): "lerobot_mtdagger.experts.drawers:scripted_expert",
+    ("toy", ANY_TASK): "lerobot_mtdagger.experts.toy:scripted_expert",
+}
+
+
+def register_expert(suite_family: str, factory: ExpertFactory | str, task: str = ANY_TASK) -> None:
+    """Registers the expert factory of a suite family's task (``ANY_TASK``: every task).
+
+    Args:
+        suite_family: The suites' ``expert_family``.
+        factory: ``factory(suite, task_name) -> Expert``, or its ``"module:attribute"`` entry point.
+        task: One task name, or ``ANY_TASK``.
+
+    Raises:
+        TypeError: If ``factory`` is neither callable nor an entry-point string.
+    """
+    if not (callable(factory) or (isinstance(factory, str) and ":" in factory)):
+        raise TypeError(
+            f"The expert factory for {suite_family}/{task} must be callable or a 'module:attribute' string, "
+            f"got {factory!r}."
+        )
+    _FACTORIES[(suite_family, task)] = factory
+
+
+def _resolve(factory: ExpertFactory | str) -> ExpertFactory:
+    """The callable behind an entry point (a callable is returned as it is)."""
+    if callable(factory):
+        return factory
+    module_name, _, attribute = factory.partition(":")
+    return getattr(importlib.import_module(module_name), attribute)
+
+
+def registered_experts() -> list[tuple[str, str]]:
+    """The registered ``(suite_family, task)`` keys, sorted."""
+    return sorted(_FACTORIES)
+
+
+def make_expert(suite: Any, task_name: str) -> ActionCheckedExpert:
+    """The expert of one task of ``suite``, action-size checked.
+
+    Args:
+        suite: A ``TaskSuite``.
+        task_name: One of its tasks or held-out tasks.
+
+    Raises:
+        ValueError: If the suite does not build the task or no expert is registered for it.
+    """
+    suite.check_buildable(task_name)
+    expert = suite.expert_overrides.get(task_name)
+    if expert is None:
+        family = suite.expert_family
+        factory = _FACTORIES.get((family, task_name)) or _FACTORIES.get((family, ANY_TASK))
+        if factory is None:
+            raise ValueError(
+                f"No expert is registered for task {task_name!r} of suite family {family!r}; register one "
+                "with lerobot_mtdagger.experts.register_expert(family, factory) or give the suite one with "
+                "suite.with_experts({task: expert})."
+            )
+        expert = _resolve(factory)(suite, task_name)
+    return ActionCheckedExpert(expert, task_name, suite.action_dim)

@@ -1,0 +1,227 @@
+"""What an experiment writes about itself: DAgger frame columns, round records and phase records.
+
+Every committed round dataset carries a ``RoundRecord`` under the key ``"mtdagger"`` of its
+``meta/info.json``; every committed training phase carries a ``PhaseRecord`` in
+``policies/round-XXX/training.json``. Both are written and read only through these classes
+(``to_dict`` / ``from_dict``), so the field list below is the on-disk format::
+
+    rounds/round-002/meta/info.json
+        {..., "mtdagger": {"round": 2, "method": "need", "episodes_per_task": [...],
+                           "allocation": {...}, "scheduler_state": {...}, ..., "format_version": 1,
+                           "committed": true}}
+    policies/round-002/training.json
+        {"round": 2, "loss_start": [...], "loss_end": [...], "gain": [...], "eval": {...}, ...}
+
+Lists are aligned with ``task_names`` (the experiment's task vocabulary, in task-index order).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+RECORD_KEY = "mtdagger"
+"""Key of the round record in a round dataset's ``meta/info.json``."""
+
+FORMAT_VERSION = 1
+"""Version of the round record format."""
+
+# -------------------------------------------------------------------------------------------------
+# DAgger frame columns
+# -------------------------------------------------------------------------------------------------
+
+EXECUTED_ACTION = "executed_action"
+"""Per frame: the action the env executed (the expert's or the learner's); ``action`` is the label."""
+
+LEARNER_ACTED = "learner_acted"
+"""Per frame: whether the learner's action was executed (bool, shape (1,))."""
+
+DAGGER_ROUND = "dagger_round"
+"""Per frame: the DAgger round the frame was collected in (int64, shape (1,))."""
+
+# The names avoid the "action" and "observation" prefixes, which LeRobot would turn into policy
+# outputs and inputs.
+_FLAG_FEATURES: dict[str, dict[str, Any]] = {
+    LEARNER_ACTED: {"dtype": "bool", "shape": (1,), "names": None},
+    DAGGER_ROUND: {"dtype": "int64", "shape": (1,), "names": None},
+}
+
+
+def round_features(suite_features: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """The features of a round dataset: the suite's, ``executed_action`` and the DAgger flags."""
+    action = suite_features["action"]
+    executed = {"dtype": action["dtype"], "shape": tuple(action["shape"]), "names": action["names"]}
+    return {**suite_features, EXECUTED_ACTION: executed, **_FLAG_FEATURES}
+
+
+def dagger_columns(executed_action: np.ndarray, learner_acted: bool, round_index: int) -> dict[str, Any]:
+    """The DAgger columns of one frame (added beside the observation and the expert's ``action``)."""
+    return {
+        EXECUTED_ACTION: np.asarray(executed_action, dtype=np.float32),
+        LEARNER_ACTED: np.array([learner_acted]),
+        DAGGER_ROUND: np.array([round_index], dtype=np.int64),
+    }
+
+
+# -------------------------------------------------------------------------------------------------
+# Records
+# -------------------------------------------------------------------------------------------------
+
+
+def _from_mapping(cls: type, values: Mapping[str, Any], where: str) -> Any:
+    """Builds dataclass ``cls`` from ``values``, naming missing keys; unknown keys are ignored."""
+    fields = dataclasses.fields(cls)
+    required = [
+        f.name
+        for f in fields
+        if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING  # type: ignore[misc]
+    ]
+    missing = [name for name in required if name not in values]
+    if missing:
+        raise ValueError(f"{where} is missing the field(s) {missing}; it was not written by this version.")
+    return cls(**{f.name: values[f.name] for f in fields if f.name in values})
+
+
+@dataclass
+class RoundRecord:
+    """The record of one committed round (``meta/info.json["mtdagger"]``).
+
+    Attributes:
+        task_names: The experiment's task vocabulary (task index i is ``task_names[i]``).
+        round: Round index k (0: expert demonstrations).
+        method: ``bc`` or the scheduling method (``uniform``, ``need``, ``need_raw``, ``gain``, ...).
+        beta: Probability of executing the expert's action at a step (1 in round 0).
+        seed: Experiment seed.
+        budget: Episodes collected in the round.
+        temperature: The scheduler's softmax temperature.
+        n_min: The scheduler's minimum episodes per task.
+        episodes_per_task: Episodes collected per task.
+        demos_so_far: Expert-labelled episodes per task in rounds 0..k.
+        rollout_success: Success rate per task of this round's rollouts (None in round 0 and where a
+            task had no episode); what the next round's task need is measured from.
+        rollout_episodes: Episodes behind ``rollout_success``.
+        expert_success: Round 0 only: the experts' success rate per task.
+        learner_steps: Steps where the learner's action was executed.
+        frames: Frames stored.
+        config: The run config (``RunConfig.to_dict``).
+        success_rate: Scheduler input: the measured success rate it was fed (the previous round's).
+        episodes: Scheduler input: the rollouts behind ``success_rate``.
+        gain: Scheduler input: the previous training phase's performance gain.
+        kalman_prior: Kalman state before this round's update (``{"p": None, "P": None}`` in round 0).
+        kalman_posterior: Kalman state after it.
+        metric: The method's metric per task (None in round 0).
+        score: Rank-normalised metric.
+        probability: Softmax probabilities.
+        eval_success: Evaluation success per task of the policy that collected this round.
+        allocation: The full ``Allocation.to_dict()`` (None in round 0); ``verify`` recomputes it.
+        scheduler_state: ``Scheduler.state_dict()`` after this round's allocation (resume restores it).
+        notes: Human-readable remarks.
+        format_version: ``FORMAT_VERSION``.
+        committed: True once the round is committed (a record without it is never read).
+    """
+
+    task_names: list[str]
+    round: int
+    method: str
+    beta: float
+    seed: int
+    budget: int
+    temperature: float
+    n_min: int
+    episodes_per_task: list[int]
+    demos_so_far: list[int]
+    rollout_success: list[float | None] | None
+    rollout_episodes: list[int]
+    expert_success: list[float | None] | None
+    learner_steps: int
+    frames: int
+    config: dict[str, Any]
+    success_rate: list[float | None] | None
+    episodes: list[int] | None
+    gain: list[float] | None
+    kalman_prior: dict[str, Any]
+    kalman_posterior: dict[str, Any]
+    metric: list[float] | None
+    score: list[float] | None
+    probability: list[float] | None
+    eval_success: list[float] | None
+    allocation: dict[str, Any] | None
+    scheduler_state: dict[str, Any] | None
+    notes: list[str]
+    format_version: int = FORMAT_VERSION
+    committed: bool = False
+
+    @property
+    def is_dagger_round(self) -> bool:
+        """Whether the round was scheduled (it has an allocation)."""
+        return self.allocation is not None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form, as stored in ``meta/info.json``."""
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, values: Mapping[str, Any], where: str = "round record") -> RoundRecord:
+        """Reads a stored record.
+
+        Raises:
+            ValueError: If a field is missing, naming it and ``where``.
+        """
+        return _from_mapping(cls, values, where)
+
+
+@dataclass
+class PhaseRecord:
+    """The record of one committed training phase (``policies/round-XXX/training.json``).
+
+    Attributes:
+        round: k: the policy was trained on rounds 0..k.
+        trained_on_rounds: ``[0, ..., k]``.
+        frames: Training frames (all of D(k)).
+        steps: Optimiser steps.
+        gain_split: Where the per-task loss was measured (``train`` or ``heldout``).
+        loss_start: Per-task loss before training (None where a task had no sample).
+        loss_end: Per-task loss after training.
+        gain: ``max(0, loss_start - loss_end)`` per task (the next round's performance gain).
+        loss_samples: Frames per task behind the losses.
+        final_train_loss: The last training losses.
+        eval: ``EvalResult.to_dict()`` of the trained policy (None when not evaluated).
+        demos_per_task: Expert-labelled episodes per task in D(k).
+        timings: Seconds per part of the round (collect_s, write_s, load_s, train_s, eval_s).
+    """
+
+    round: int
+    trained_on_rounds: list[int]
+    frames: int
+    steps: int
+    gain_split: str
+    loss_start: list[float | None]
+    loss_end: list[float | None]
+    gain: list[float]
+    loss_samples: list[int]
+    final_train_loss: list[float]
+    eval: dict[str, Any] | None
+    demos_per_task: list[int]
+    timings: dict[str, float]
+
+    @property
+    def eval_mean(self) -> float | None:
+        """Average evaluation success over tasks (None when not evaluated)."""
+        return None if self.eval is None else float(self.eval["mean"])
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form, as stored in ``training.json``."""
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, values: Mapping[str, Any], where: str = "training record") -> PhaseRecord:
+        """Reads a stored record.
+
+        Raises:
+            ValueError: If a field is missing, naming it and ``where``.
+        """
+        return _from_mapping(cls, values, where)

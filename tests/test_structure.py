@@ -1,0 +1,144 @@
+"""The package's structure: no import cycle anywhere, every module importable alone, envs free of experts."""
+
+from __future__ import annotations
+
+import ast
+import functools
+import pkgutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import lerobot_mtdagger
+
+PACKAGE_ROOT = Path(lerobot_mtdagger.__file__).parent
+# Third-party packages the modules import; loaded once in the parent so that each forked child
+# imports only our module (and the parts of our package it needs) from scratch.
+THIRD_PARTY = [
+    "numpy",
+    "torch",
+    "gymnasium",
+    "mujoco",
+    "metaworld",
+    "draccus",
+    "datasets",
+    "lerobot.policies.factory",
+]
+
+
+@functools.cache
+def package_modules() -> list[str]:
+    """Every module of the package, by dotted name."""
+    names = ["lerobot_mtdagger"]
+    for info in pkgutil.walk_packages([str(PACKAGE_ROOT)], prefix="lerobot_mtdagger."):
+        names.append(info.name)
+    return sorted(names)
+
+
+def module_path(name: str) -> Path:
+    relative = Path(*name.split(".")[1:])
+    package = PACKAGE_ROOT / relative / "__init__.py"
+    return package if package.exists() else (PACKAGE_ROOT / relative).with_suffix(".py")
+
+
+def module_level_imports(name: str) -> set[str]:
+    """Our modules imported at module level by ``name`` (function bodies are not module level)."""
+    tree = ast.parse(module_path(name).read_text())
+    imported: set[str] = set()
+    is_package = module_path(name).name == "__init__.py"
+    for node in tree.body:  # module level only; nested imports run on call
+        targets = []
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = name.split(".")
+                parent = parts if is_package else parts[:-1]
+                base = ".".join(parent[: len(parent) - node.level + 1] + ([base] if base else []))
+            targets = [base] + [f"{base}.{alias.name}" for alias in node.names]
+        imported |= {t for t in targets if t.startswith("lerobot_mtdagger")}
+    modules = set(package_modules())
+    return {t for t in imported if t in modules and t != name}
+
+
+def test_module_level_imports_have_no_cycle():
+    graph = {name: module_level_imports(name) for name in package_modules()}
+    # A package's __init__ imported by its own submodules is not a cycle we can avoid: Python imports
+    # the parent package first; cycles between distinct modules are what break.
+    for name, targets in graph.items():
+        targets -= {p for p in targets if name.startswith(p + ".")}
+    visiting, done, cycles = set(), set(), []
+
+    def visit(node: str, path: list[str]) -> None:
+        visiting.add(node)
+        for target in sorted(graph[node]):
+            if target in visiting:
+                cycles.append(path[path.index(target) :] + [target])
+            elif target not in done:
+                visit(target, [*path, target])
+        visiting.discard(node)
+        done.add(node)
+
+    for name in sorted(graph):
+        if name not in done:
+            visit(name, [name])
+    assert cycles == [], cycles
+
+
+def test_envs_never_import_experts_at_module_level():
+    envs = [name for name in package_modules() if name.startswith("lerobot_mtdagger.envs")]
+    offending = {name: sorted(t for t in module_level_imports(name) if ".experts" in t) for name in envs}
+    assert {k: v for k, v in offending.items() if v} == {}
+
+
+@pytest.mark.parametrize("module", ["variants", "catalogue"])
+def test_drawer_variants_and_catalogue_do_not_import_a_simulator(module):
+    tree = ast.parse(module_path(f"lerobot_mtdagger.envs.drawers.{module}").read_text())
+    roots = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            roots |= {alias.name.split(".")[0] for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            roots.add(node.module.split(".")[0])
+    assert not roots & {"mujoco", "metaworld", "gymnasium"}, roots
+
+
+IMPORT_EACH_ALONE = """
+import importlib, os, sys, traceback
+for third_party in sys.argv[1].split(","):
+    importlib.import_module(third_party)
+assert not any(m.startswith("lerobot_mtdagger") for m in sys.modules), "imported ours too early"
+failed = 0
+for name in sys.argv[2:]:
+    pid = os.fork()
+    if pid == 0:  # the child imports one module first, with none of ours loaded
+        try:
+            importlib.import_module(name)
+        except BaseException:
+            print(f"FAILED {name}:", traceback.format_exc(limit=4), flush=True)
+            os._exit(1)
+        os._exit(0)
+    _, status = os.waitpid(pid, 0)
+    failed += status != 0
+print(f"{failed} failed")
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="forks a child per module")
+def test_every_module_imports_alone_in_a_fresh_process():
+    """A fresh interpreter loads the third-party packages, then forks one child per module of ours,
+    which imports that module first (so an import-order cycle fails there)."""
+    modules = package_modules()
+    result = subprocess.run(
+        [sys.executable, "-c", IMPORT_EACH_ALONE, ",".join(THIRD_PARTY), *modules],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert result.returncode == 0 and result.stdout.strip().endswith("0 failed"), (
+        result.stdout + result.stderr
+    )
+    assert {"lerobot_mtdagger.envs.drawers.variants", "lerobot_mtdagger.experts.drawers"} <= set(modules)

@@ -1,0 +1,329 @@
+"""Fast tests on the toy suite (no MuJoCo): the suite itself, collection, the loss split, staging and
+commit of rounds, and the whole runner end to end in seconds."""
+
+from __future__ import annotations
+
+import json
+
+import draccus
+import numpy as np
+import pytest
+import torch
+
+from lerobot_mtdagger.collect import COLLECT_STREAM, EVAL_STREAM, episode_seed, run_episodes, success_by_task
+from lerobot_mtdagger.configs import RunConfig
+from lerobot_mtdagger.dagger import run
+from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs.toy import MAX_EPISODE_STEPS, TOY_TASKS
+from lerobot_mtdagger.experts import make_expert
+from lerobot_mtdagger.records import DAGGER_ROUND, EXECUTED_ACTION, LEARNER_ACTED, RoundRecord, round_features
+from lerobot_mtdagger.rounds import STAGING_DIR, ExperimentDir
+from lerobot_mtdagger.scheduler import scheduling_methods
+from lerobot_mtdagger.train import LOSS_SAMPLES_PER_TASK, TrainingData, loss_split
+from lerobot_mtdagger.verify import verify_experiment
+
+TASKS = list(TOY_TASKS)
+
+
+@pytest.fixture(scope="module")
+def suite():
+    return make_suite("toy")
+
+
+def zero_learner(observations, tasks):
+    """A learner that never moves: it drifts with the wind and never succeeds."""
+    return np.zeros((len(observations), 2), dtype=np.float32)
+
+
+def collect(suite, counts, beta, policy=zero_learner, seed=0, max_steps=MAX_EPISODE_STEPS, after=0):
+    envs = [suite.make_env(t) for t in suite.task_names]
+    return run_episodes(
+        suite,
+        envs,
+        counts,
+        policy=policy,
+        beta=beta,
+        seed=seed,
+        round_index=1,
+        stream=COLLECT_STREAM,
+        record=True,
+        max_steps=max_steps,
+        steps_after_success=after,
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# The toy suite
+# ---------------------------------------------------------------------------------------------
+
+
+def test_toy_expert_always_succeeds_and_a_zero_learner_never_does(suite):
+    experts = collect(suite, [20, 20, 20], beta=1.0)
+    learners = collect(suite, [20, 20, 20], beta=0.0)
+    assert success_by_task(experts, 3)[0] == [1.0, 1.0, 1.0]
+    assert success_by_task(learners, 3)[0] == [0.0, 0.0, 0.0]
+    assert all(e.steps == MAX_EPISODE_STEPS for e in learners), "failures run to truncation"
+
+
+def test_toy_reset_is_seeded_and_observations_match_the_features(suite):
+    env = suite.make_env("toy-left")
+    first, info = env.reset(seed=3)
+    again, _ = env.reset(seed=3)
+    other, _ = env.reset(seed=4)
+    np.testing.assert_array_equal(first["observation.state"], again["observation.state"])
+    assert not np.array_equal(first["observation.state"], other["observation.state"])
+    assert set(first) | {"action"} == set(suite.features)
+    assert first["observation.state"].shape == suite.features["observation.state"]["shape"]
+    assert info["privileged_state"].shape == (6,)
+
+
+def test_toy_suite_refuses_visual_modes_and_unknown_tasks():
+    with pytest.raises(ValueError, match="state observations only"):
+        make_suite("toy", obs_mode="rgb")
+    with pytest.raises(ValueError, match="Unknown toy task"):
+        make_suite("toy", tasks=["toy-down"])
+
+
+def test_toy_needs_no_mujoco():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; import lerobot_mtdagger.envs.toy, lerobot_mtdagger.experts.toy; "
+        "from lerobot_mtdagger.envs import make_suite; make_suite('toy').make_env('toy-left').reset(seed=0); "
+        "print('mujoco' in sys.modules, 'lerobot_mtdagger.envs.metaworld' in sys.modules)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.split() == ["False", "False"], "the toy suite loads neither MuJoCo nor MetaWorld"
+
+
+# ---------------------------------------------------------------------------------------------
+# Collection
+# ---------------------------------------------------------------------------------------------
+
+
+def frames_of(episodes, key):
+    return np.concatenate([np.stack([np.asarray(f[key]).reshape(-1) for f in e.frames]) for e in episodes])
+
+
+@pytest.mark.parametrize("beta", [0.0, 0.5, 1.0])
+def test_the_stored_label_is_always_the_experts(suite, beta):
+    episodes = collect(suite, [2, 2, 2], beta=beta)
+    expert = make_expert(suite, "toy-left")
+    for episode in episodes:
+        for frame in episode.frames:
+            # The toy expert is stateless, so it can re-label the stored position after the fact.
+            state = np.concatenate([frame["observation.state"], TOY_TASKS[TASKS[episode.task_index]].goal])
+            state = np.concatenate([state, TOY_TASKS[TASKS[episode.task_index]].wind]).astype(np.float32)
+            np.testing.assert_allclose(frame["action"], expert.act(state), atol=1e-6)
+    learner = frames_of(episodes, LEARNER_ACTED).astype(bool).reshape(-1)
+    executed, label = frames_of(episodes, EXECUTED_ACTION), frames_of(episodes, "action")
+    np.testing.assert_array_equal(executed[~learner], label[~learner])
+    np.testing.assert_array_equal(executed[learner], 0.0)  # the zero learner's action
+    assert set(frames_of(episodes, DAGGER_ROUND).reshape(-1).tolist()) == {1}
+    fraction = learner.mean()
+    if beta == 1.0:
+        assert fraction == 0.0
+    elif beta == 0.0:
+        assert fraction == 1.0
+    else:
+        assert 0.3 < fraction < 0.7, fraction
+
+
+def test_steps_after_success_and_max_steps_end_episodes(suite):
+    at_success = collect(suite, [2, 2, 2], beta=1.0, after=0)
+    assert all(e.success and e.steps == len(e.frames) < MAX_EPISODE_STEPS for e in at_success)
+    later = collect(suite, [2, 2, 2], beta=1.0, after=3)
+    assert [e.steps + 3 for e in at_success] == [e.steps for e in later], "same seeds, 3 more steps"
+    capped = collect(suite, [2, 2, 2], beta=0.0, max_steps=7)
+    assert all(e.steps == len(e.frames) == 7 and not e.success for e in capped)
+
+
+def test_collection_is_reproducible_under_its_seed(suite):
+    first, again, other = (collect(suite, [2, 2, 2], beta=0.5, seed=s) for s in (0, 0, 1))
+    assert [e.seed for e in first] == [e.seed for e in again]
+    np.testing.assert_array_equal(frames_of(first, EXECUTED_ACTION), frames_of(again, EXECUTED_ACTION))
+    assert [e.seed for e in first] != [e.seed for e in other]
+
+
+def test_collection_and_evaluation_seeds_never_overlap():
+    collection = {
+        episode_seed(0, COLLECT_STREAM, r, t, e) for r in range(3) for t in range(3) for e in range(5)
+    }
+    evaluation = {episode_seed(0, EVAL_STREAM, 0, t, e) for t in range(3) for e in range(5)}
+    assert not collection & evaluation and max(collection) < 2**31 <= min(evaluation)
+
+
+def test_collection_without_a_learner_below_beta_1_is_refused(suite):
+    with pytest.raises(ValueError, match="needs a learner policy"):
+        collect(suite, [1, 1, 1], beta=0.5, policy=None)
+
+
+# ---------------------------------------------------------------------------------------------
+# Loss split
+# ---------------------------------------------------------------------------------------------
+
+
+def training_data(episodes_per_task: int = 5, frames_per_episode: int = 400) -> TrainingData:
+    episode_id = torch.arange(3 * episodes_per_task).repeat_interleave(frames_per_episode)
+    size = len(episode_id)
+    return TrainingData(
+        inputs={"observation.state": torch.zeros(size, 2)},
+        action=torch.zeros(size, 2),
+        task_index=episode_id // episodes_per_task,
+        episode_id=episode_id,
+    )
+
+
+def test_train_split_trains_on_everything_and_measures_a_capped_sample_per_task():
+    data = training_data()
+    train_index, measure = loss_split(data, "train", 0.2, seed=0)
+    assert len(train_index) == len(data)
+    counts = torch.bincount(data.task_index[measure], minlength=3).tolist()
+    assert counts == [LOSS_SAMPLES_PER_TASK] * 3
+    assert torch.equal(measure, loss_split(data, "train", 0.2, seed=0)[1])
+
+
+def test_heldout_split_holds_out_whole_episodes_of_every_task():
+    data = training_data()
+    train_index, heldout = loss_split(data, "heldout", 0.2, seed=0)
+    assert len(train_index) + len(heldout) == len(data)
+    held_episodes = set(data.episode_id[heldout].tolist())
+    assert not held_episodes & set(data.episode_id[train_index].tolist())
+    assert sorted(data.task_index[heldout].unique().tolist()) == [0, 1, 2]
+    assert len(held_episodes) == 3, "20% of 5 episodes = 1 per task"
+
+
+# ---------------------------------------------------------------------------------------------
+# Staging and commit
+# ---------------------------------------------------------------------------------------------
+
+
+def minimal_record(round_index: int, counts: list[int]) -> RoundRecord:
+    blank = {"p": None, "P": None}
+    return RoundRecord(
+        task_names=TASKS,
+        round=round_index,
+        method="uniform",
+        beta=1.0,
+        seed=0,
+        budget=sum(counts),
+        temperature=0.5,
+        n_min=1,
+        episodes_per_task=counts,
+        demos_so_far=counts,
+        rollout_success=None,
+        rollout_episodes=counts,
+        expert_success=None,
+        learner_steps=0,
+        frames=0,
+        config={},
+        success_rate=None,
+        episodes=None,
+        gain=None,
+        kalman_prior=blank,
+        kalman_posterior=blank,
+        metric=None,
+        score=None,
+        probability=None,
+        eval_success=None,
+        allocation=None,
+        scheduler_state=None,
+        notes=[],
+    )
+
+
+def test_a_round_is_invisible_until_committed_and_immutable_after(tmp_path, suite):
+    experiment = ExperimentDir(tmp_path / "exp")
+    experiment.initialise({"seed": 0})
+    dataset = experiment.create_round(0, round_features(suite.features), TASKS)
+    for episode in collect(suite, [1, 1, 1], beta=1.0):
+        for frame in episode.frames:
+            dataset.add_frame({**frame, "task": TASKS[episode.task_index]})
+        dataset.save_episode()
+    assert experiment.committed_rounds() == [], "a staged round is never read"
+    experiment.commit_round(0, dataset, minimal_record(0, [1, 1, 1]))
+    assert experiment.committed_rounds() == [0]
+    record = experiment.read_round_record(0)
+    assert record.committed and record.episodes_per_task == [1, 1, 1]
+    with pytest.raises(FileExistsError, match="immutable"):
+        experiment.commit_round(0, dataset, minimal_record(0, [1, 1, 1]))
+    staged = experiment.create_round(1, round_features(suite.features), TASKS)
+    assert (experiment.rounds / STAGING_DIR / "round-001").exists() and staged is not None
+    experiment.clear_staging()
+    assert not (experiment.rounds / STAGING_DIR).exists() and experiment.committed_rounds() == [0]
+
+
+def test_a_record_missing_a_field_is_a_clear_error():
+    stored = minimal_record(0, [1, 1, 1]).to_dict()
+    del stored["demos_so_far"]
+    with pytest.raises(ValueError, match=r"missing the field\(s\) \['demos_so_far'\]"):
+        RoundRecord.from_dict(stored)
+
+
+# ---------------------------------------------------------------------------------------------
+# The runner end to end
+# ---------------------------------------------------------------------------------------------
+
+TOY_RUN = [
+    "--suite=toy",
+    "--rounds=2",
+    "--initial_demos=1",
+    "--budget_per_task=2",
+    "--steps_per_round=30",
+    "--eval_episodes=2",
+    "--max_rollout_steps=40",
+    "--policy.batch_size=32",
+    "--policy.state_hidden_dims=[32]",
+    "--policy.head_hidden_dims=[32]",
+    "--progress=false",
+]
+
+
+def toy_config(output_dir, *extra: str) -> RunConfig:
+    return draccus.parse(RunConfig, args=[*TOY_RUN, f"--output_dir={output_dir}", *extra])
+
+
+@pytest.mark.parametrize("method", scheduling_methods())
+def test_every_method_runs_end_to_end_and_verifies(tmp_path, method):
+    lines = run(toy_config(tmp_path / method, f"--scheduler.type={method}"))
+    experiment = ExperimentDir(tmp_path / method)
+    assert len(lines) == 3 and experiment.committed_phases() == [0, 1, 2]
+    assert verify_experiment(experiment) == (3, [])
+    records = [experiment.read_round_record(k) for k in range(3)]
+    assert [r.method for r in records] == [method] * 3
+    assert [sum(r.episodes_per_task) for r in records] == [3, 6, 6]
+    assert records[2].allocation["method"] == method
+
+
+def test_bc_mode_runs_one_round_with_the_same_budget_and_compute(tmp_path):
+    lines = run(toy_config(tmp_path / "bc", "--mode=bc"))
+    experiment = ExperimentDir(tmp_path / "bc")
+    record = experiment.read_round_record(0)
+    assert len(lines) == 1 and experiment.committed_rounds() == [0]
+    assert record.method == "bc" and record.episodes_per_task == [1 + 2 * 2] * 3
+    assert experiment.read_phase_record(0).steps == 3 * 30
+    assert json.loads((tmp_path / "bc" / "config.json").read_text())["mode"] == "bc"
+
+
+def test_a_run_cut_after_a_phase_resumes_to_the_same_rounds_and_weights(tmp_path):
+    import shutil
+
+    from lerobot_mtdagger.policies import MTDAggerPolicy
+
+    reference = tmp_path / "reference"
+    run(toy_config(reference))
+    cut = tmp_path / "cut"
+    shutil.copytree(reference, cut)
+    shutil.rmtree(cut / "rounds" / "round-002")  # as if killed right after phase 1 was committed
+    shutil.rmtree(cut / "policies" / "round-002")
+    run(toy_config(cut, "--resume=true"))
+    records = [[ExperimentDir(root).read_round_record(k) for k in range(3)] for root in (reference, cut)]
+    strip = [[{**r.to_dict(), "config": None} for r in rs] for rs in records]  # config holds output_dir
+    assert strip[0] == strip[1]
+    weights = [
+        MTDAggerPolicy.from_pretrained(str(ExperimentDir(r).policy_root(2))).state_dict()
+        for r in (reference, cut)
+    ]
+    for name, tensor in weights[0].items():
+        torch.testing.assert_close(tensor, weights[1][name], rtol=0, atol=0)
