@@ -53,8 +53,7 @@ neither MuJoCo, MetaWorld nor gymnasium):
 
 Every public name is re-exported here (``from lerobot_mtdagger.envs.drawers import DrawerSuite``),
 lazily: a name's module is imported on first access, so importing ``variants`` or ``catalogue``
-(as the scripted expert does while ``lerobot_mtdagger.experts`` loads) does not pull in ``suite``,
-which itself imports ``lerobot_mtdagger.envs.base`` and, through it, the experts.
+(as the drawer expert does) loads neither the MuJoCo scene nor MetaWorld.
 """
 
 from __future__ import annotations
