@@ -1,0 +1,91 @@
+"""Compares two experiment folders: same allocations, same episodes, same metrics?
+
+Usage::
+
+    .venv/bin/python scripts/compare_experiments.py OLD_DIR NEW_DIR [--ignore-config KEY ...]
+
+Reads the stored JSON directly (no class of this package), so it also compares folders written by
+older versions. Per round it compares the ``mtdagger`` record of ``meta/info.json`` (every field except
+``config``, compared separately minus ``output_dir`` and the ``--ignore-config`` keys), the data
+files (sha256 of each parquet file's decoded table), and per training phase ``training.json``
+(everything but ``timings``) and the policy weights. Prints one line per difference and exits 1 if
+there is any.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import sys
+from pathlib import Path
+
+import pyarrow.parquet as pq
+from safetensors.numpy import load_file
+
+
+def table_digest(path: Path) -> str:
+    """sha256 of a parquet file's rows (the encoded file may differ in metadata only)."""
+    table = pq.read_table(path)
+    return hashlib.sha256(table.to_pandas().to_json().encode()).hexdigest()
+
+
+def compare_dicts(old: dict, new: dict, where: str, skip: set[str]) -> list[str]:
+    """One line per key whose value differs."""
+    keys = sorted((set(old) | set(new)) - skip)
+    return [f"{where}.{k}: {old.get(k)!r} != {new.get(k)!r}" for k in keys if old.get(k) != new.get(k)]
+
+
+def compare_round(old: Path, new: Path, ignore_config: set[str]) -> list[str]:
+    """Differences of one round's record and data."""
+    records = [json.loads((p / "meta" / "info.json").read_text())["mtdagger"] for p in (old, new)]
+    problems = compare_dicts(records[0], records[1], old.name, {"config"})
+    configs = [r["config"] for r in records]
+    problems += compare_dicts(configs[0], configs[1], f"{old.name}.config", {"output_dir", *ignore_config})
+    files = [sorted(p.relative_to(root) for p in (root / "data").rglob("*.parquet")) for root in (old, new)]
+    if files[0] != files[1]:
+        problems.append(f"{old.name}: data files {files[0]} != {files[1]}")
+    for relative in files[0]:
+        if relative in files[1] and table_digest(old / relative) != table_digest(new / relative):
+            problems.append(f"{old.name}: frames of {relative} differ")
+    return problems
+
+
+def compare_phase(old: Path, new: Path) -> list[str]:
+    """Differences of one training phase's record and weights."""
+    records = [json.loads((p / "training.json").read_text()) for p in (old, new)]
+    problems = compare_dicts(records[0], records[1], f"policy {old.name}", {"timings"})
+    weights = [load_file(str(p / "model.safetensors")) for p in (old, new)]
+    for name in sorted(set(weights[0]) | set(weights[1])):
+        if name not in weights[0] or name not in weights[1] or (weights[0][name] != weights[1][name]).any():
+            problems.append(f"policy {old.name}: weight {name} differs")
+    return problems
+
+
+def main() -> int:
+    """Parses the arguments, prints the differences, returns the exit status."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("old", type=Path)
+    parser.add_argument("new", type=Path)
+    parser.add_argument("--ignore-config", nargs="*", default=[], help="config keys renamed on purpose")
+    args = parser.parse_args()
+    problems = []
+    rounds = [sorted(p.name for p in (root / "rounds").glob("round-*")) for root in (args.old, args.new)]
+    phases = [sorted(p.name for p in (root / "policies").glob("round-*")) for root in (args.old, args.new)]
+    if rounds[0] != rounds[1] or phases[0] != phases[1]:
+        problems.append(f"committed rounds/phases differ: {rounds} {phases}")
+    for name in rounds[0]:
+        problems += compare_round(
+            args.old / "rounds" / name, args.new / "rounds" / name, set(args.ignore_config)
+        )
+    for name in phases[0]:
+        problems += compare_phase(args.old / "policies" / name, args.new / "policies" / name)
+    for problem in problems:
+        print(problem)
+    counts = f"{len(rounds[0])} rounds, {len(phases[0])} phases"
+    print(f"{args.old} vs {args.new}: {counts}, {len(problems)} difference(s)")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
