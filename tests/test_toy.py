@@ -327,3 +327,23 @@ def test_a_run_cut_after_a_phase_resumes_to_the_same_rounds_and_weights(tmp_path
     ]
     for name, tensor in weights[0].items():
         torch.testing.assert_close(tensor, weights[1][name], rtol=0, atol=0)
+
+
+def test_nan_loss_is_an_error_and_committed_rounds_survive(tmp_path, monkeypatch):
+    import math
+
+    from lerobot_mtdagger.policies import MTDAggerPolicy
+
+    def nan_forward(self, batch):
+        loss = self.predict(batch).sum() * math.nan
+        return loss, {}
+
+    monkeypatch.setattr(MTDAggerPolicy, "forward", nan_forward)
+    with pytest.raises(FloatingPointError, match="Training loss became nan"):
+        run(toy_config(tmp_path / "exp", "--rounds=1"))
+    experiment = ExperimentDir(tmp_path / "exp")
+    assert experiment.committed_rounds() == [0]
+    assert experiment.committed_phases() == []
+    monkeypatch.undo()
+    run(toy_config(tmp_path / "exp", "--rounds=1", "--resume=true"))
+    assert experiment.committed_phases() == [0, 1]
