@@ -155,11 +155,6 @@ class RoundRecord:
     format_version: int = FORMAT_VERSION
     committed: bool = False
 
-    @property
-    def is_dagger_round(self) -> bool:
-        """Whether the round was scheduled (it has an allocation)."""
-        return self.allocation is not None
-
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form, as stored in ``meta/info.json``."""
         return dataclasses.asdict(self)

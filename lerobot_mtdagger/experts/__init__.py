@@ -14,7 +14,7 @@ from lerobot_mtdagger.experts.base import (
     LeRobotPolicyExpert,
     run_expert_episode,
 )
-from lerobot_mtdagger.experts.registry import ANY_TASK, make_expert, register_expert, registered_experts
+from lerobot_mtdagger.experts.registry import ANY_TASK, make_expert, register_expert
 
 __all__ = [
     "ANY_TASK",
@@ -25,6 +25,5 @@ __all__ = [
     "LeRobotPolicyExpert",
     "make_expert",
     "register_expert",
-    "registered_experts",
     "run_expert_episode",
 ]

@@ -62,11 +62,6 @@ def _resolve(factory: ExpertFactory | str) -> ExpertFactory:
     return getattr(importlib.import_module(module_name), attribute)
 
 
-def registered_experts() -> list[tuple[str, str]]:
-    """The registered ``(suite_family, task)`` keys, sorted."""
-    return sorted(_FACTORIES)
-
-
 def make_expert(suite: Any, task_name: str) -> ActionCheckedExpert:
     """The expert of one task of ``suite``, action-size checked.
 
