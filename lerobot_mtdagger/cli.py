@@ -29,7 +29,7 @@ from pathlib import Path
 import draccus
 import numpy as np
 
-from lerobot_mtdagger.configs import RunConfig, renamed_option_error
+from lerobot_mtdagger.configs import RunConfig, default_worker_count, renamed_option_error
 from lerobot_mtdagger.hub import PushConfig, push_command
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
 from lerobot_mtdagger.simulate import SyntheticTasks, simulate
@@ -105,11 +105,8 @@ def run_experiment(config: RunConfig) -> list[str]:
     from lerobot_mtdagger.dagger import run
 
     datasets.disable_progress_bars()  # one "Map" bar per episode otherwise
-    lines = run(config)
-    print(f"experiment {config.output_dir} ({config.method}, seed {config.seed}):")
-    for line in lines:
-        print(line)
-    return lines
+    print(f"experiment {config.output_dir} ({config.method}, seed {config.seed}):", flush=True)
+    return run(config, on_summary=lambda line: print(line, flush=True))
 
 
 @dataclass
@@ -190,6 +187,7 @@ class EvalConfig:
         num_points: Points per cloud.
         image_size: Image side.
         output: Optional JSON file for the results.
+        workers: Env worker processes (None: one per core; 0: in this process).
     """
 
     policy_path: str | None = None
@@ -201,8 +199,16 @@ class EvalConfig:
     num_points: int = 1024
     image_size: int = 84
     output: Path | None = None
+    workers: int | None = None
+
+    @property
+    def worker_count(self) -> int:
+        """Env worker processes to start."""
+        return default_worker_count() if self.workers is None else self.workers
 
     def __post_init__(self) -> None:
+        if self.workers is not None and self.workers < 0:
+            raise ValueError(f"workers must be >= 0 (0: envs in this process), got {self.workers}.")
         if self.policy_path is None:
             raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
         if self.episodes <= 0:
@@ -213,15 +219,12 @@ def eval_command(config: EvalConfig) -> dict:
     """Evaluates a pretrained policy per task with the pure policy acting."""
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.evaluate import PolicyRunner, evaluate
+    from lerobot_mtdagger.workers import EnvWorkers
 
     suite = suite_from_config(config)
     runner = PolicyRunner.from_pretrained(config.policy_path)
-    envs = [suite.make_env(task) for task in suite.task_names]
-    try:
-        result, _ = evaluate(suite, envs, runner, config.episodes, config.seed)
-    finally:
-        for env in envs:
-            env.close()
+    with EnvWorkers(suite, config.worker_count) as workers:
+        result, _ = evaluate(workers, runner, config.episodes, config.seed)
     for task, success in zip(result.task_names, result.success, strict=True):
         print(f"{task:<32} {success:.3f}")
     print(f"{'mean':<32} {result.mean:.3f}")

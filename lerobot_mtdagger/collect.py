@@ -5,9 +5,9 @@ EXPERT's action is executed, otherwise the learner's. The expert's label is alwa
 ``action``; the executed action and whether the learner acted are stored beside it. ``beta = 1`` is
 pure expert demonstration (round 0, BC); evaluation runs the pure policy (``beta = 0``, no expert).
 
-One env per task is stepped in lock-step with the other tasks' envs, so the policy is queried once
-per step for all active tasks (a batch-1 torch call costs ~0.1-1 ms). Episodes of a task run one
-after another in that task's env. Every episode has its own seed, derived from
+The envs live in env workers (``workers.EnvWorkers``: worker processes, one per core by default);
+the policy stays in the main process and is queried once per step for every running episode (a
+batch-1 torch call costs ~0.1-1 ms, a batch of 50 hardly more). Every episode has its own seed, derived from
 ``(seed, stream, round, task, episode)``: collection seeds lie in [0, 2^31) and evaluation seeds in
 [2^31, 2^32), so they never overlap, and evaluation uses the same seeds after every round.
 
@@ -18,21 +18,25 @@ persist), at ``max_steps``, or when the env truncates.
 from __future__ import annotations
 
 import logging
+from collections import deque
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
-from lerobot_mtdagger.envs.base import TaskSuite
-from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.records import dagger_columns
+from lerobot_mtdagger.workers import (
+    BETA_STREAM,
+    EnvWorkers,
+    Episode,
+    EpisodeSpec,
+    RolloutRules,
+    limited_torch_threads,
+)
 
 logger = logging.getLogger(__name__)
 
 COLLECT_STREAM = 0
 EVAL_STREAM = 1
-BETA_STREAM = 2
 
 PolicyFn = Callable[[list[dict[str, np.ndarray]], list[str]], np.ndarray]
 """Maps a batch of observations and their task names to actions, (B, action_dim)."""
@@ -46,46 +50,53 @@ def episode_seed(seed: int, stream: int, round_index: int, task_index: int, epis
 
 
 @dataclass
-class Episode:
-    """One finished rollout.
+class _Lane:
+    """One of the episodes that run at the same time (one lane per task, see ``run_episodes``).
 
     Attributes:
-        task_index: Index of the task in the suite.
-        episode: Index of the episode within its task and round.
-        seed: Reset seed.
-        success: Whether ``info["success"]`` was true at any step.
-        frames: Recorded frames (empty when not recording).
-        learner_steps: Steps where the learner's action was executed.
-        steps: Episode length.
+        home_task: The task whose episodes the lane runs first.
+        task_index: Task of the running episode (None: idle).
+        worker: Worker running the episode.
+        observation: Its latest observation (None until the worker has reset the env).
+        start: The episode to start in the next message (None once started).
     """
 
-    task_index: int
-    episode: int
-    seed: int
-    success: bool = False
-    frames: list[dict[str, Any]] = field(default_factory=list)
-    learner_steps: int = 0
-    steps: int = 0
+    home_task: int
+    task_index: int | None = None
+    worker: int = 0
+    observation: dict[str, np.ndarray] | None = None
+    start: EpisodeSpec | None = None
 
 
 @dataclass
-class _Slot:
-    """The episode currently running in one task's env."""
+class _Schedule:
+    """Which episode each lane runs next: its own task's first, then the task with most left."""
 
-    task_index: int
-    env: Any
-    expert: Any
-    queue: list[int]
-    episode: Episode | None = None
-    observation: dict[str, np.ndarray] | None = None
-    privileged: np.ndarray | None = None
-    steps_since_success: int = -1
-    rng: np.random.Generator | None = None
+    queues: list[deque[int]]
+    seed: int
+    round_index: int
+    stream: int
+
+    def next_episode(self, lane: _Lane, handle: int) -> EpisodeSpec | None:
+        """The next episode for ``lane`` (None when every queue is empty)."""
+        task = lane.home_task
+        if not self.queues[task]:
+            remaining = [len(queue) for queue in self.queues]
+            if max(remaining) == 0:
+                return None
+            task = int(np.argmax(remaining))  # ties: the lowest task index
+        episode = self.queues[task].popleft()
+        return EpisodeSpec(
+            handle=handle,
+            task_index=task,
+            episode=episode,
+            reset_seed=episode_seed(self.seed, self.stream, self.round_index, task, episode),
+            beta_seed=(self.seed, BETA_STREAM, self.round_index, task, episode),
+        )
 
 
 def run_episodes(
-    suite: TaskSuite,
-    envs: Sequence[Any],
+    workers: EnvWorkers,
     episodes_per_task: Sequence[int],
     *,
     policy: PolicyFn | None,
@@ -94,15 +105,19 @@ def run_episodes(
     round_index: int,
     stream: int,
     record: bool,
-    max_steps: int,
+    max_steps: int | None,
     steps_after_success: int,
     progress: Callable[[Episode], None] | None = None,
 ) -> list[Episode]:
-    """Runs ``episodes_per_task[i]`` episodes of task i in ``envs[i]``, all tasks in lock-step.
+    """Runs ``episodes_per_task[i]`` episodes of task i on the env workers, in lock-step.
+
+    There is one lane per task; a lane runs its own task's episodes, then helps the task with most
+    episodes left. Every step, the learner acts once for all lanes with an observation (lane
+    order), then every worker steps its episodes. Lanes, batches and seeds do not depend on the
+    number of workers, so neither does any result.
 
     Args:
-        suite: The suite (experts, task names).
-        envs: One env per task of the suite, in task order (reused across episodes).
+        workers: The run's env workers (their suite gives experts and task names).
         episodes_per_task: Episodes to run per task.
         policy: The learner (None only when ``beta == 1``).
         beta: Probability of executing the expert's action at a step.
@@ -110,7 +125,7 @@ def run_episodes(
         round_index: DAgger round (part of the episode seeds).
         stream: ``COLLECT_STREAM`` or ``EVAL_STREAM``.
         record: Keep the frames (observation, expert label, executed action, learner flag).
-        max_steps: Longest episode.
+        max_steps: Longest episode (None: the env's own truncation).
         steps_after_success: Steps kept after the first success.
         progress: Called with each finished episode.
 
@@ -118,94 +133,81 @@ def run_episodes(
         The episodes, ordered by (task, episode).
 
     Raises:
-        ValueError: If ``policy`` is None while ``beta < 1``.
+        ValueError: If ``policy`` is None while ``beta < 1``, or the counts do not match the tasks.
     """
+    task_names = workers.suite.task_names
     if policy is None and beta < 1.0:
         raise ValueError(f"beta={beta} < 1 needs a learner policy.")
-    need_expert = record or beta > 0.0
-    slots = []
-    for task_index, (env, count) in enumerate(zip(envs, episodes_per_task, strict=True)):
-        expert = make_expert(suite, suite.task_names[task_index]) if need_expert else None
-        slots.append(_Slot(task_index, env, expert, queue=list(range(int(count)))))
+    if len(episodes_per_task) != len(task_names):
+        raise ValueError(f"Got {len(episodes_per_task)} episode counts for {len(task_names)} tasks.")
+    learner = policy is not None and beta < 1.0
+    workers.set_rules(
+        RolloutRules(
+            beta=beta,
+            learner=learner,
+            record=record,
+            round_index=round_index,
+            max_steps=max_steps,
+            steps_after_success=steps_after_success,
+        )
+    )
+    schedule = _Schedule([deque(range(int(n))) for n in episodes_per_task], seed, round_index, stream)
+    lanes = [_Lane(home_task=task) for task in range(len(task_names))]
+    for handle in range(len(lanes)):
+        _assign(lanes, handle, schedule, workers.slots)
     finished: list[Episode] = []
-    for slot in slots:
-        _start_next(slot, seed, round_index, stream)
-    while any(slot.episode is not None for slot in slots):
-        active = [slot for slot in slots if slot.episode is not None]
-        learner_actions = _learner_actions(policy, active, suite, beta)
-        for position, slot in enumerate(active):
-            done = _step(
-                slot, learner_actions, position, beta, round_index, record, max_steps, steps_after_success
-            )
-            if done:
-                finished.append(slot.episode)
+    with limited_torch_threads(1 if workers.workers else None):
+        while any(lane.task_index is not None for lane in lanes):
+            actions = _learner_actions(policy if learner else None, lanes, task_names)
+            commands: list[tuple[list[EpisodeSpec], dict[int, np.ndarray | None]]] = [
+                ([], {}) for _ in range(workers.slots)
+            ]
+            for handle, lane in enumerate(lanes):
+                if lane.start is not None:
+                    commands[lane.worker][0].append(lane.start)
+                    lane.start = None
+                elif handle in actions:
+                    commands[lane.worker][1][handle] = actions[handle]
+            done: list[tuple[int, Episode]] = []
+            for observations, ended in workers.iterate(commands):
+                for handle, observation in observations.items():
+                    lanes[handle].observation = observation
+                done += ended
+            for handle, episode in sorted(done, key=lambda item: item[0]):
+                finished.append(episode)
                 if progress is not None:
-                    progress(slot.episode)
-                slot.episode = None
-                _start_next(slot, seed, round_index, stream)
+                    progress(episode)
+                _assign(lanes, handle, schedule, workers.slots)
     finished.sort(key=lambda e: (e.task_index, e.episode))
     return finished
 
 
-def _start_next(slot: _Slot, seed: int, round_index: int, stream: int) -> None:
-    if not slot.queue:
+def _assign(lanes: list[_Lane], handle: int, schedule: _Schedule, worker_count: int) -> None:
+    """Gives lane ``handle`` its next episode, on the worker running the fewest episodes."""
+    lane = lanes[handle]
+    lane.observation = None
+    spec = schedule.next_episode(lane, handle)
+    if spec is None:
+        lane.task_index = None
         return
-    episode_index = slot.queue.pop(0)
-    reset_seed = episode_seed(seed, stream, round_index, slot.task_index, episode_index)
-    slot.observation, info = slot.env.reset(seed=reset_seed)
-    slot.privileged = info["privileged_state"]
-    slot.episode = Episode(task_index=slot.task_index, episode=episode_index, seed=reset_seed)
-    slot.steps_since_success = -1
-    slot.rng = np.random.default_rng(
-        np.random.SeedSequence([seed, BETA_STREAM, round_index, slot.task_index, episode_index])
-    )
-    if slot.expert is not None:
-        slot.expert.reset()
+    load = [0] * worker_count
+    for other in lanes:
+        if other.task_index is not None and other is not lane:
+            load[other.worker] += 1
+    lane.task_index, lane.worker, lane.start = spec.task_index, int(np.argmin(load)), spec
 
 
 def _learner_actions(
-    policy: PolicyFn | None, active: list[_Slot], suite: TaskSuite, beta: float
-) -> np.ndarray | None:
-    if policy is None or beta >= 1.0:
-        return None
-    observations = [slot.observation for slot in active]
-    tasks = [suite.task_names[slot.task_index] for slot in active]
-    return np.asarray(policy(observations, tasks), dtype=np.float32)
-
-
-def _step(
-    slot: _Slot,
-    learner_actions: np.ndarray | None,
-    position: int,
-    beta: float,
-    round_index: int,
-    record: bool,
-    max_steps: int,
-    steps_after_success: int,
-) -> bool:
-    """Steps one slot; returns whether its episode ended."""
-    episode = slot.episode
-    expert_action = slot.expert.act(slot.privileged) if slot.expert is not None else None
-    expert_acts = learner_actions is None or (beta > 0.0 and slot.rng.random() < beta)
-    executed = expert_action if expert_acts else learner_actions[position]
-    if record:
-        columns = dagger_columns(executed, learner_acted=not expert_acts, round_index=round_index)
-        episode.frames.append({**slot.observation, "action": expert_action, **columns})
-    slot.observation, _, terminated, truncated, info = slot.env.step(executed)
-    slot.privileged = info["privileged_state"]
-    episode.steps += 1
-    episode.learner_steps += int(not expert_acts)
-    if info["success"] and not episode.success:
-        episode.success = True
-        slot.steps_since_success = 0
-    elif episode.success:
-        slot.steps_since_success += 1
-    return (
-        terminated
-        or truncated
-        or episode.steps >= max_steps
-        or (episode.success and slot.steps_since_success >= steps_after_success)
-    )
+    policy: PolicyFn | None, lanes: list[_Lane], task_names: Sequence[str]
+) -> dict[int, np.ndarray | None]:
+    """The learner's action for every lane with an observation (None for each without a learner)."""
+    ready = [handle for handle, lane in enumerate(lanes) if lane.observation is not None]
+    if policy is None or not ready:
+        return dict.fromkeys(ready)
+    observations = [lanes[handle].observation for handle in ready]
+    tasks = [task_names[lanes[handle].task_index] for handle in ready]
+    actions = np.asarray(policy(observations, tasks), dtype=np.float32)
+    return {handle: actions[position] for position, handle in enumerate(ready)}
 
 
 def success_by_task(episodes: Sequence[Episode], num_tasks: int) -> tuple[list[float | None], list[int]]:

@@ -23,6 +23,7 @@ a step (classic DAgger; the paper's text is ambiguous): 0.5 in the first DAgger 
 from __future__ import annotations
 
 import dataclasses
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -152,7 +153,10 @@ class RunConfig:
             ``outputs/mtdagger/<preset>-<method>-seed<seed>``.
         seed: Seed of everything (collection, evaluation, training).
         resume: Continue the experiment in ``output_dir`` from its last committed round.
-        progress: Show progress bars (only on a terminal).
+        progress: Show progress bars (only on a terminal); the summary line of each round is
+            always printed.
+        workers: Env worker processes for collection and evaluation (None: one per core; 0: step
+            the envs in the main process). Never changes a result.
     """
 
     preset: str = "small"
@@ -182,6 +186,7 @@ class RunConfig:
     seed: int = 0
     resume: bool = False
     progress: bool = True
+    workers: int | None = None
 
     def __post_init__(self) -> None:
         if self.preset not in PRESETS:
@@ -208,6 +213,8 @@ class RunConfig:
         for name in ("rounds", "initial_demos", "eval_episodes", "steps_after_success"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}.")
+        if self.workers is not None and self.workers < 0:
+            raise ValueError(f"workers must be >= 0 (0: envs in the main process), got {self.workers}.")
         for name in ("steps_per_round", "budget_per_task", "max_rollout_steps"):
             if getattr(self, name) <= 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}.")
@@ -238,6 +245,11 @@ class RunConfig:
         """The experiment's method as reports name it: ``bc`` or the scheduling method."""
         return "bc" if self.is_bc else self.scheduler.type
 
+    @property
+    def worker_count(self) -> int:
+        """Env worker processes to start (``workers``, or one per core)."""
+        return default_worker_count() if self.workers is None else self.workers
+
     def budget_for(self, num_tasks: int) -> int:
         """Expert episodes per DAgger round."""
         return self.budget if self.budget is not None else self.budget_per_task * num_tasks
@@ -248,6 +260,13 @@ class RunConfig:
         record["output_dir"] = str(self.output_dir)
         record["scheduler"] = {"type": self.scheduler.type, **self.scheduler.hyperparameters()}
         return record
+
+
+def default_worker_count() -> int:
+    """One env worker per core this process may run on."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
 
 
 def renamed_option_error(args: list[str]) -> str | None:

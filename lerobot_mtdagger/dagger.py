@@ -28,6 +28,7 @@ from __future__ import annotations
 import logging
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -54,6 +55,7 @@ from lerobot_mtdagger.train import (
     save_policy,
     train_phase,
 )
+from lerobot_mtdagger.workers import EnvWorkers
 
 logger = logging.getLogger(__name__)
 
@@ -65,7 +67,7 @@ class RunContext:
     config: RunConfig
     suite: TaskSuite
     experiment: ExperimentDir
-    envs: list[Any]
+    workers: EnvWorkers
     show_progress: bool
     timings: dict[int, dict[str, float]] = field(default_factory=dict)
 
@@ -133,8 +135,7 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
     if round_index == 0:
         scheduler, allocation = None, None
         # Expert demonstrations run to the env's own truncation (they end soon after success).
-        max_steps = max(env.max_episode_steps for env in ctx.envs)
-        counts, runner, beta = initial_allocation(ctx), None, 1.0
+        counts, runner, beta, max_steps = initial_allocation(ctx), None, 1.0, None
     else:
         scheduler, allocation = schedule_round(ctx, round_index)
         counts = allocation.episodes_per_task
@@ -146,8 +147,7 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
         total=sum(counts), desc=f"round {round_index} collect", leave=False, disable=not ctx.show_progress
     ) as bar:
         episodes = run_episodes(
-            ctx.suite,
-            ctx.envs,
+            ctx.workers,
             counts,
             policy=runner,
             beta=beta,
@@ -323,7 +323,15 @@ def evaluate_phase(ctx: RunContext, runner: PolicyRunner) -> EvalResult | None:
     """Evaluates the freshly trained policy (None when eval_episodes is 0)."""
     if ctx.config.eval_episodes == 0:
         return None
-    result, _ = evaluate(ctx.suite, ctx.envs, runner, ctx.config.eval_episodes, ctx.config.seed)
+    episodes = ctx.config.eval_episodes * len(ctx.task_names)
+    with tqdm(total=episodes, desc="eval", leave=False, disable=not ctx.show_progress) as bar:
+        result, _ = evaluate(
+            ctx.workers,
+            runner,
+            ctx.config.eval_episodes,
+            ctx.config.seed,
+            progress=lambda _: bar.update(1),
+        )
     return result
 
 
@@ -360,13 +368,18 @@ def check_budget(config: RunConfig, num_tasks: int) -> None:
         )
 
 
-def run(config: RunConfig) -> list[str]:
+def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> list[str]:
     """Runs (or resumes) one experiment; returns the per-round summary lines.
+
+    Args:
+        config: The run's options.
+        on_summary: Called with each round's summary line as soon as the round is done.
 
     Raises:
         FileExistsError: If the output directory exists and ``resume`` is false.
         ValueError: On a bad config or a foreign/corrupt output directory (left untouched).
         FloatingPointError: If training diverges.
+        WorkerDiedError: If an env worker process dies.
     """
     suite = suite_from_config(config)
     check_budget(config, len(suite.task_names))
@@ -380,22 +393,24 @@ def run(config: RunConfig) -> list[str]:
     handler = logging.FileHandler(experiment.root / "run.log")
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     logging.getLogger("lerobot_mtdagger").addHandler(handler)
-    envs = [suite.make_env(task) for task in suite.task_names]
     show = config.progress and sys.stderr.isatty()
-    ctx = RunContext(config=config, suite=suite, experiment=experiment, envs=envs, show_progress=show)
     lines = []
     rounds_done, phases_done = set(experiment.committed_rounds()), set(experiment.committed_phases())
     try:
-        for round_index in tqdm(range(ctx.last_round + 1), desc="rounds", disable=not show):
-            if round_index not in rounds_done:
-                collect_round(ctx, round_index)
-            if round_index not in phases_done:
-                train_round(ctx, round_index)
-            lines.append(summary_line(ctx, round_index))
-            logger.info(lines[-1])
+        with EnvWorkers(suite, config.worker_count) as workers:
+            ctx = RunContext(
+                config=config, suite=suite, experiment=experiment, workers=workers, show_progress=show
+            )
+            for round_index in range(ctx.last_round + 1):
+                if round_index not in rounds_done:
+                    collect_round(ctx, round_index)
+                if round_index not in phases_done:
+                    train_round(ctx, round_index)
+                lines.append(summary_line(ctx, round_index))
+                logger.info(lines[-1])
+                if on_summary is not None:
+                    on_summary(lines[-1])
     finally:
-        for env in envs:
-            env.close()
         logging.getLogger("lerobot_mtdagger").removeHandler(handler)
         handler.close()
     return lines

@@ -7,7 +7,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -16,9 +16,9 @@ import numpy as np
 import torch
 from lerobot.policies.factory import make_pre_post_processors
 
-from lerobot_mtdagger.collect import EVAL_STREAM, Episode, run_episodes, success_by_task
-from lerobot_mtdagger.envs.base import TaskSuite
+from lerobot_mtdagger.collect import EVAL_STREAM, PolicyFn, run_episodes, success_by_task
 from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.workers import EnvWorkers, Episode
 
 
 class PolicyRunner:
@@ -86,32 +86,40 @@ class EvalResult:
 
 
 def evaluate(
-    suite: TaskSuite,
-    envs: Sequence[Any],
-    runner: PolicyRunner,
+    workers: EnvWorkers,
+    runner: PolicyFn,
     episodes_per_task: int,
     seed: int,
     steps_after_success: int = 0,
+    progress: Callable[[Episode], None] | None = None,
 ) -> tuple[EvalResult, list[Episode]]:
     """Runs ``episodes_per_task`` pure-policy episodes per task on the evaluation seeds.
 
     Episodes end at the first success or when the env truncates (its max episode length). The
     evaluation seeds do not depend on the round, so every round is evaluated on the same episodes.
+
+    Args:
+        workers: The env workers (their suite gives the tasks).
+        runner: The policy.
+        episodes_per_task: Episodes per task.
+        seed: Experiment seed (the evaluation seeds derive from it).
+        steps_after_success: Steps run after the first success.
+        progress: Called with each finished episode.
     """
-    max_steps = max(getattr(env, "max_episode_steps", 500) for env in envs)
+    suite = workers.suite
     episodes = run_episodes(
-        suite,
-        envs,
-        [episodes_per_task] * len(envs),
+        workers,
+        [episodes_per_task] * len(suite.task_names),
         policy=runner,
         beta=0.0,
         seed=seed,
         round_index=0,
         stream=EVAL_STREAM,
         record=False,
-        max_steps=max_steps,
+        max_steps=None,
         steps_after_success=steps_after_success,
+        progress=progress,
     )
-    rates, counts = success_by_task(episodes, len(envs))
+    rates, counts = success_by_task(episodes, len(suite.task_names))
     result = EvalResult(list(suite.task_names), [r if r is not None else 0.0 for r in rates], counts)
     return result, episodes

@@ -92,7 +92,7 @@ class ExperimentDir:
         write_json_atomic(self.root / CONFIG_FILE, config)
 
     def check_resumable(
-        self, config: dict[str, Any], ignore: Sequence[str] = ("resume", "progress", "output_dir")
+        self, config: dict[str, Any], ignore: Sequence[str] = ("resume", "progress", "output_dir", "workers")
     ) -> None:
         """Checks that ``root`` holds an experiment started with the same config.
 

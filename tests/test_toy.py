@@ -21,6 +21,7 @@ from lerobot_mtdagger.rounds import STAGING_DIR, ExperimentDir
 from lerobot_mtdagger.scheduler import scheduling_methods
 from lerobot_mtdagger.train import LOSS_SAMPLES_PER_TASK, TrainingData, loss_split
 from lerobot_mtdagger.verify import verify_experiment
+from lerobot_mtdagger.workers import EnvWorkers
 
 TASKS = list(TOY_TASKS)
 
@@ -35,21 +36,22 @@ def zero_learner(observations, tasks):
     return np.zeros((len(observations), 2), dtype=np.float32)
 
 
-def collect(suite, counts, beta, policy=zero_learner, seed=0, max_steps=MAX_EPISODE_STEPS, after=0):
-    envs = [suite.make_env(t) for t in suite.task_names]
-    return run_episodes(
-        suite,
-        envs,
-        counts,
-        policy=policy,
-        beta=beta,
-        seed=seed,
-        round_index=1,
-        stream=COLLECT_STREAM,
-        record=True,
-        max_steps=max_steps,
-        steps_after_success=after,
-    )
+def collect(
+    suite, counts, beta, policy=zero_learner, seed=0, max_steps=MAX_EPISODE_STEPS, after=0, workers=0
+):
+    with EnvWorkers(suite, workers) as env_workers:
+        return run_episodes(
+            env_workers,
+            counts,
+            policy=policy,
+            beta=beta,
+            seed=seed,
+            round_index=1,
+            stream=COLLECT_STREAM,
+            record=True,
+            max_steps=max_steps,
+            steps_after_success=after,
+        )
 
 
 # ---------------------------------------------------------------------------------------------

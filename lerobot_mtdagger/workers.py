@@ -1,0 +1,442 @@
+"""Env workers: the simulators of a run stepped in worker processes, one per core by default.
+
+A ``RolloutWorker`` owns envs and experts and runs the per-episode logic of a rollout (reset, the
+expert's label, the beta coin, the env step, recording, the end-of-episode rules). The main process
+keeps the policy and talks to the workers in lock-step (see ``collect.run_episodes``): one message
+per worker per step carrying the learner's actions for that worker's episodes and the episodes to
+start, one reply carrying the new observations and the finished episodes.
+
+``EnvWorkers(suite, workers=0)`` runs the worker in the calling process (no IPC); ``workers=N >= 1``
+forks N processes that live until ``close``. Everything an episode does depends only on its seeds
+and on the learner's actions, never on which worker ran it or on which env of that worker's pool it
+reused, so the worker count never changes a result.
+
+A worker that dies (killed, out of memory) is noticed on the next reply and raises
+``WorkerDiedError`` in the main process; an exception inside a worker is sent back and re-raised
+in the main process with the worker's traceback. Workers exit when the main process goes away
+(their pipe closes), so a killed run leaves no orphan.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import logging
+import multiprocessing
+import pickle
+import signal
+import sys
+import traceback
+from collections import defaultdict
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from multiprocessing.connection import Connection, wait
+from typing import Any
+
+import numpy as np
+
+from lerobot_mtdagger.envs.base import TaskSuite
+from lerobot_mtdagger.experts import make_expert
+from lerobot_mtdagger.records import dagger_columns
+
+logger = logging.getLogger(__name__)
+
+BETA_STREAM = 2
+
+
+@contextlib.contextmanager
+def limited_torch_threads(threads: int | None) -> Iterator[None]:
+    """Caps torch's intra-op threads inside the block (no-op for None or when torch is not loaded).
+
+    While the env workers keep every core busy, the main process's policy calls would only fight
+    them for the cores.
+    """
+    torch = sys.modules.get("torch")
+    if threads is None or torch is None:
+        yield
+        return
+    previous = torch.get_num_threads()
+    torch.set_num_threads(threads)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(previous)
+
+
+class WorkerDiedError(RuntimeError):
+    """An env worker process ended without answering."""
+
+
+class RemoteWorkerError(Exception):
+    """The traceback of an exception raised inside a worker (attached as ``__cause__``)."""
+
+    def __init__(self, text: str) -> None:
+        """Keeps the formatted traceback."""
+        super().__init__(text)
+        self.text = text
+
+    def __str__(self) -> str:
+        return f"\n\nTraceback in the env worker:\n{self.text}"
+
+
+@dataclass
+class Episode:
+    """One finished rollout.
+
+    Attributes:
+        task_index: Index of the task in the suite.
+        episode: Index of the episode within its task and round.
+        seed: Reset seed.
+        success: Whether ``info["success"]`` was true at any step.
+        frames: Recorded frames (empty when not recording).
+        learner_steps: Steps where the learner's action was executed.
+        steps: Episode length.
+    """
+
+    task_index: int
+    episode: int
+    seed: int
+    success: bool = False
+    frames: list[dict[str, Any]] = field(default_factory=list)
+    learner_steps: int = 0
+    steps: int = 0
+
+
+@dataclass(frozen=True)
+class EpisodeSpec:
+    """What a worker needs to start an episode.
+
+    Attributes:
+        handle: The main process's id of the running episode (unique while it runs).
+        task_index: Task of the episode.
+        episode: Index of the episode within its task and round.
+        reset_seed: Seed of the env reset.
+        beta_seed: Entropy of the episode's beta coin (expert or learner at each step).
+    """
+
+    handle: int
+    task_index: int
+    episode: int
+    reset_seed: int
+    beta_seed: tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class RolloutRules:
+    """How the episodes of one ``run_episodes`` call behave (the same for every episode).
+
+    Attributes:
+        beta: Probability of executing the expert's action at a step.
+        learner: Whether a learner acts at all (False: the expert always acts).
+        record: Keep the frames (observation, expert label, executed action, learner flag).
+        round_index: DAgger round written into the recorded frames.
+        max_steps: Longest episode (None: the env's own truncation).
+        steps_after_success: Steps kept after the first success.
+    """
+
+    beta: float
+    learner: bool
+    record: bool
+    round_index: int
+    max_steps: int | None
+    steps_after_success: int
+
+    @property
+    def need_expert(self) -> bool:
+        """The expert is queried when its labels are stored or it may act."""
+        return self.record or self.beta > 0.0 or not self.learner
+
+
+@dataclass
+class _Running:
+    """An episode running in one env of a worker."""
+
+    spec: EpisodeSpec
+    env: Any
+    expert: Any
+    episode: Episode
+    rng: np.random.Generator
+    observation: dict[str, np.ndarray]
+    privileged: np.ndarray
+    steps_since_success: int = -1
+
+
+class RolloutWorker:
+    """The env side of rollouts: a pool of envs per task, their experts and the running episodes."""
+
+    def __init__(self, suite: TaskSuite) -> None:
+        """Holds no env until an episode of a task starts."""
+        self.suite = suite
+        self.free_envs: dict[int, list[Any]] = defaultdict(list)
+        self.experts: dict[int, list[Any]] = defaultdict(list)
+        self.first_experts: dict[int, Any] = {}
+        self.running: dict[int, _Running] = {}
+        self.rules: RolloutRules | None = None
+
+    def handle(self, command: tuple[str, Any]) -> Any:
+        """Executes one command of the main process and returns its reply."""
+        name, payload = command
+        if name == "rules":
+            self.rules = payload
+            return None
+        if name == "iterate":
+            starts, actions = payload
+            return self.iterate(starts, actions)
+        raise ValueError(f"Unknown worker command {name!r}.")
+
+    def iterate(
+        self, starts: list[EpisodeSpec], actions: dict[int, np.ndarray | None]
+    ) -> tuple[dict[int, dict[str, np.ndarray]], list[tuple[int, Episode]]]:
+        """Steps the episodes in ``actions``, then starts ``starts``.
+
+        Args:
+            starts: Episodes to start (their first observation is returned).
+            actions: Learner action per running episode handle (None: no learner this call).
+
+        Returns:
+            The observation of every episode still running that was stepped or started, and the
+            finished episodes by handle.
+        """
+        observations: dict[int, dict[str, np.ndarray]] = {}
+        finished: list[tuple[int, Episode]] = []
+        for handle, action in actions.items():
+            running = self.running[handle]
+            if self._step(running, action):
+                finished.append((handle, running.episode))
+                self._release(self.running.pop(handle))
+            else:
+                observations[handle] = running.observation
+        for spec in starts:
+            running = self._start(spec)
+            self.running[spec.handle] = running
+            observations[spec.handle] = running.observation
+        return observations, finished
+
+    def close(self) -> None:
+        """Closes every env."""
+        for envs in self.free_envs.values():
+            for env in envs:
+                env.close()
+        for running in self.running.values():
+            running.env.close()
+        self.free_envs.clear()
+        self.running.clear()
+
+    def _start(self, spec: EpisodeSpec) -> _Running:
+        task_name = self.suite.task_names[spec.task_index]
+        pool = self.free_envs[spec.task_index]
+        env = pool.pop() if pool else self.suite.make_env(task_name)
+        expert = self._expert(spec.task_index) if self.rules.need_expert else None
+        observation, info = env.reset(seed=spec.reset_seed)
+        return _Running(
+            spec=spec,
+            env=env,
+            expert=expert,
+            episode=Episode(task_index=spec.task_index, episode=spec.episode, seed=spec.reset_seed),
+            rng=np.random.default_rng(np.random.SeedSequence(list(spec.beta_seed))),
+            observation=observation,
+            privileged=info["privileged_state"],
+        )
+
+    def _expert(self, task_index: int) -> Any:
+        """A reset expert of the task that no running episode uses.
+
+        The first one comes from ``make_expert``; more (for episodes of the same task running at
+        once) are deep copies of it, so an expert given as an instance (``suite.with_experts``) is
+        never shared by two episodes.
+        """
+        free = self.experts[task_index]
+        if free:
+            expert = free.pop()
+        elif task_index not in self.first_experts:
+            expert = self.first_experts[task_index] = make_expert(
+                self.suite, self.suite.task_names[task_index]
+            )
+        else:
+            expert = copy.deepcopy(self.first_experts[task_index])
+        expert.reset()
+        return expert
+
+    def _release(self, running: _Running) -> None:
+        self.free_envs[running.spec.task_index].append(running.env)
+        if running.expert is not None:
+            self.experts[running.spec.task_index].append(running.expert)
+
+    def _step(self, running: _Running, learner_action: np.ndarray | None) -> bool:
+        """Steps one episode; returns whether it ended."""
+        rules = self.rules
+        episode = running.episode
+        expert_action = running.expert.act(running.privileged) if running.expert is not None else None
+        expert_acts = learner_action is None or (rules.beta > 0.0 and running.rng.random() < rules.beta)
+        executed = expert_action if expert_acts else learner_action
+        if rules.record:
+            columns = dagger_columns(executed, learner_acted=not expert_acts, round_index=rules.round_index)
+            episode.frames.append({**running.observation, "action": expert_action, **columns})
+        running.observation, _, terminated, truncated, info = running.env.step(executed)
+        running.privileged = info["privileged_state"]
+        episode.steps += 1
+        episode.learner_steps += int(not expert_acts)
+        if info["success"] and not episode.success:
+            episode.success = True
+            running.steps_since_success = 0
+        elif episode.success:
+            running.steps_since_success += 1
+        return bool(
+            terminated
+            or truncated
+            or (rules.max_steps is not None and episode.steps >= rules.max_steps)
+            or (episode.success and running.steps_since_success >= rules.steps_after_success)
+        )
+
+
+def _worker_loop(connection: Connection, suite: TaskSuite) -> None:
+    """Body of a worker process: answers commands until told to close or the main process is gone."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the main process's to handle
+    if "torch" in sys.modules:
+        sys.modules["torch"].set_num_threads(1)
+    worker = RolloutWorker(suite)
+    try:
+        while True:
+            try:
+                command = connection.recv()
+            except EOFError:
+                return
+            if command[0] == "close":
+                return
+            try:
+                reply = ("ok", worker.handle(command))
+            except Exception as error:  # noqa: BLE001 - re-raised in the main process (``_receive``)
+                reply = ("error", (_picklable(error), traceback.format_exc()))
+            connection.send(reply)
+    finally:
+        worker.close()
+
+
+def _picklable(error: Exception) -> Exception:
+    """``error`` itself when it survives pickling, else a RuntimeError with its message."""
+    try:
+        pickle.loads(pickle.dumps(error))
+    except (pickle.PicklingError, TypeError, AttributeError):
+        return RuntimeError(f"{type(error).__name__}: {error}")
+    return error
+
+
+class EnvWorkers:
+    """The envs of a run, in ``workers`` processes (0: in the calling process).
+
+    Use as a context manager, or call ``close``.
+    """
+
+    def __init__(self, suite: TaskSuite, workers: int) -> None:
+        """Starts the worker processes (forked: they inherit the suite and registered experts).
+
+        Raises:
+            ValueError: If ``workers`` is negative.
+        """
+        if workers < 0:
+            raise ValueError(f"workers must be >= 0 (0: in this process), got {workers}.")
+        self.suite = suite
+        self.workers = workers
+        self._local = RolloutWorker(suite) if workers == 0 else None
+        self._processes: list[Any] = []
+        self._connections: list[Connection] = []
+        if workers:
+            self._start_processes(workers)
+
+    @property
+    def slots(self) -> int:
+        """How many workers episodes are spread over (1 when in-process)."""
+        return max(self.workers, 1)
+
+    def _start_processes(self, workers: int) -> None:
+        context = multiprocessing.get_context("fork")
+        for index in range(workers):
+            parent_end, child_end = context.Pipe()
+            process = context.Process(
+                target=_worker_loop,
+                args=(child_end, self.suite),
+                name=f"mtdagger-env-worker-{index}",
+                daemon=True,
+            )
+            process.start()
+            child_end.close()
+            self._processes.append(process)
+            self._connections.append(parent_end)
+        logger.debug("started %d env workers: %s", workers, [p.pid for p in self._processes])
+
+    def set_rules(self, rules: RolloutRules) -> None:
+        """Sets the rules of the episodes started from now on."""
+        if self._local is not None:
+            self._local.handle(("rules", rules))
+            return
+        for index in range(self.workers):
+            self._connections[index].send(("rules", rules))
+        for index in range(self.workers):
+            self._receive(index)
+
+    def iterate(
+        self, commands: list[tuple[list[EpisodeSpec], dict[int, np.ndarray | None]]]
+    ) -> list[tuple[dict[int, dict[str, np.ndarray]], list[tuple[int, Episode]]]]:
+        """Sends each worker its (starts, actions) and returns the replies in worker order."""
+        if self._local is not None:
+            return [self._local.iterate(*commands[0])]
+        busy = [index for index, (starts, actions) in enumerate(commands) if starts or actions]
+        for index in busy:
+            self._connections[index].send(("iterate", commands[index]))
+        replies: list[Any] = [({}, []) for _ in commands]
+        for index in busy:
+            replies[index] = self._receive(index)
+        return replies
+
+    def _receive(self, index: int) -> Any:
+        """The reply of worker ``index``.
+
+        Raises:
+            WorkerDiedError: If the worker process ended.
+            Exception: The worker's own exception, with its traceback as the cause.
+        """
+        connection, process = self._connections[index], self._processes[index]
+        ready = wait([connection, process.sentinel])
+        if connection not in ready:
+            process.join(timeout=1.0)
+            raise WorkerDiedError(
+                f"Env worker {index} (pid {process.pid}) died with exit code {process.exitcode} "
+                "(killed, or out of memory?); nothing of the running round was committed. Rerun "
+                "with --resume=true to continue from the last committed round."
+            )
+        try:
+            status, payload = connection.recv()
+        except EOFError as error:
+            raise WorkerDiedError(
+                f"Env worker {index} (pid {process.pid}) closed its pipe without answering."
+            ) from error
+        if status == "error":
+            error, text = payload
+            raise error from RemoteWorkerError(text)
+        return payload
+
+    def close(self) -> None:
+        """Stops the workers and closes every env."""
+        if self._local is not None:
+            self._local.close()
+            return
+        for connection in self._connections:
+            try:
+                connection.send(("close", None))
+            except (BrokenPipeError, OSError):
+                logger.debug("env worker pipe already closed")
+        for process in self._processes:
+            process.join(timeout=5.0)
+            if process.is_alive():
+                process.terminate()
+                process.join(timeout=1.0)
+        for connection in self._connections:
+            connection.close()
+        self._processes.clear()
+        self._connections.clear()
+
+    def __enter__(self) -> EnvWorkers:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
