@@ -156,7 +156,7 @@ def run_episodes(
     for handle in range(len(lanes)):
         _assign(lanes, handle, schedule, workers.slots)
     finished: list[Episode] = []
-    with limited_torch_threads(1 if workers.workers else None):
+    with limited_torch_threads(1):
         while any(lane.task_index is not None for lane in lanes):
             actions = _learner_actions(policy if learner else None, lanes, task_names)
             commands: list[tuple[list[EpisodeSpec], dict[int, np.ndarray | None]]] = [

@@ -289,8 +289,17 @@ class RolloutWorker:
         )
 
 
-def _worker_loop(connection: Connection, suite: TaskSuite) -> None:
-    """Body of a worker process: answers commands until told to close or the main process is gone."""
+def _worker_loop(connection: Connection, suite: TaskSuite, inherited: list[Connection]) -> None:
+    """Body of a worker process: answers commands until told to close or the main process is gone.
+
+    Args:
+        connection: This worker's end of its pipe.
+        suite: The suite (forked, so registered experts come along).
+        inherited: The main process's ends of this and the earlier workers' pipes, closed here so each
+            pipe closes when the main process dies.
+    """
+    for other in inherited:
+        other.close()
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the main process's to handle
     if "torch" in sys.modules:
         sys.modules["torch"].set_num_threads(1)
@@ -354,7 +363,7 @@ class EnvWorkers:
             parent_end, child_end = context.Pipe()
             process = context.Process(
                 target=_worker_loop,
-                args=(child_end, self.suite),
+                args=(child_end, self.suite, [*self._connections, parent_end]),
                 name=f"mtdagger-env-worker-{index}",
                 daemon=True,
             )

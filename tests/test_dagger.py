@@ -228,9 +228,32 @@ def _cli(output_dir: Path, *extra: str) -> list[str]:
         str(Path(sys.executable).parent / "lerobot-mtdagger"),
         "run",
         *TINY,
+        "--workers=2",
         f"--output_dir={output_dir}",
         *extra,
     ]
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids whose parent is ``pid`` (Linux /proc)."""
+    children = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            children.append(int(stat.parent.name))
+    return children
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` exists and is not a zombie waiting to be reaped."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
 
 
 def _allocations(root: Path) -> list:
@@ -245,6 +268,8 @@ def _allocations(root: Path) -> list:
     "kill_when",
     [
         "policies/.staging/round-001",  # during training phase 1
+        "policies/round-000/training.json",  # as round 1's parallel collection starts
+        pytest.param("policies/.staging/round-001/model.safetensors", marks=pytest.mark.slow),  # eval
         pytest.param("rounds/round-001", marks=pytest.mark.slow),  # right after round 1's commit
     ],
 )
@@ -259,8 +284,14 @@ def test_kill_9_and_resume_gives_the_same_allocations(tmp_path, kill_when):
     while not (killed / kill_when).exists() and process.poll() is None and time.time() < deadline:
         time.sleep(0.05)
     assert process.poll() is None, "the run finished before it could be killed"
+    workers = _children(process.pid)
+    assert len(workers) == 2, "the run should have its two env workers"
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
+    deadline = time.time() + 20
+    while any(_running(pid) for pid in workers) and time.time() < deadline:
+        time.sleep(0.1)
+    assert not any(_running(pid) for pid in workers), "env workers outlived the run"
     subprocess.run(_cli(killed, "--scheduler.type=need", "--resume=true"), check=True, capture_output=True)
     assert _allocations(killed) == _allocations(reference)
     assert verify_experiment(ExperimentDir(killed)) == (3, [])

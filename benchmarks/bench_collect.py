@@ -1,0 +1,151 @@
+"""DAgger collection and evaluation throughput with env workers, against raw MetaWorld steps.
+
+Run: ``.venv/bin/python benchmarks/bench_collect.py`` (options: ``--workers 1 2``, ``--episodes``,
+``--eval-episodes``, ``--repeats``). On MetaWorld MT10 with state observations, in ONE run:
+
+- ``raw``: the single-env step rate of MetaWorld's own env (``SawyerXYZEnv.step``, random actions,
+  one process), the per-core reference;
+- ``collect``: a DAgger round as the runner collects it: the learner acting at every step
+  (``beta = 0``; an untrained ``mtdagger`` policy with its LeRobot processors, batched in the main
+  process), the expert labelling every step, frames recorded, rollouts cut at 200 steps, with each
+  worker count; recorded steps per second of wall time;
+- ``eval``: evaluation episodes per second (the pure policy, to the env's 500-step truncation).
+
+The workers (and their envs) are started and warmed up before the clock starts: in a run they live
+for the whole experiment. Raw and collection measurements are interleaved over ``--repeats`` and
+the medians are compared. Target: collection with N workers >= 0.7 x N x the raw single-env rate.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+
+from lerobot_mtdagger.collect import COLLECT_STREAM, run_episodes
+from lerobot_mtdagger.configs import PolicyOptions
+from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs.metaworld import _make_raw_env
+from lerobot_mtdagger.evaluate import PolicyRunner, evaluate
+from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.train import build_processors, policy_config
+from lerobot_mtdagger.workers import EnvWorkers
+
+TARGET = 0.7
+RAW_STEPS = 2000
+
+
+def raw_rate(tasks: list[str], steps: int) -> float:
+    """Single-process raw MetaWorld steps/s over ``tasks`` (construction and resets untimed)."""
+    rng = np.random.default_rng(0)
+    total_time, total_steps = 0.0, 0
+    for task in tasks:
+        env = _make_raw_env(task)
+        env.seed(0)
+        env.reset()
+        actions = rng.uniform(-1, 1, (steps // len(tasks), 4)).astype(np.float32)
+        for index, action in enumerate(actions):
+            if index and index % 400 == 0:
+                env.reset()
+            start = time.perf_counter()
+            env.step(action)
+            total_time += time.perf_counter() - start
+        total_steps += len(actions)
+        env.close()
+    return total_steps / total_time
+
+
+def untrained_runner(suite) -> PolicyRunner:
+    """An untrained default-size policy with its processors (identity normalisation)."""
+    options = PolicyOptions(batch_size=256, lr=3e-4)
+    config = policy_config(suite.features, suite.task_names, options)
+    stats = {
+        key: {
+            "mean": np.zeros(shape, np.float32),
+            "std": np.ones(shape, np.float32),
+            "min": -np.ones(shape, np.float32),
+            "max": np.ones(shape, np.float32),
+        }
+        for key, shape in (("observation.state", 39), ("action", 4))
+    }
+    preprocessor, postprocessor = build_processors(config, stats)
+    return PolicyRunner(MTDAggerPolicy(config), preprocessor, postprocessor)
+
+
+def collect_rate(workers: EnvWorkers, runner: PolicyRunner, episodes: int, seed: int) -> float:
+    """Recorded steps per second of a DAgger round with the learner acting."""
+    start = time.perf_counter()
+    result = run_episodes(
+        workers,
+        [episodes] * len(workers.suite.task_names),
+        policy=runner,
+        beta=0.0,
+        seed=seed,
+        round_index=1,
+        stream=COLLECT_STREAM,
+        record=True,
+        max_steps=200,
+        steps_after_success=10,
+    )
+    return sum(e.steps for e in result) / (time.perf_counter() - start)
+
+
+def eval_rate(workers: EnvWorkers, runner: PolicyRunner, episodes: int) -> float:
+    """Evaluation episodes per second."""
+    start = time.perf_counter()
+    _, result = evaluate(workers, runner, episodes, seed=0)
+    return len(result) / (time.perf_counter() - start)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    parser.add_argument("--episodes", type=int, default=2, help="collection episodes per task")
+    parser.add_argument("--eval-episodes", type=int, default=1, help="evaluation episodes per task")
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+
+    suite = make_suite("metaworld-mt10")
+    runner = untrained_runner(suite)
+    raw: list[float] = []
+    collect: dict[int, list[float]] = {n: [] for n in args.workers}
+    evals: dict[int, list[float]] = {n: [] for n in args.workers}
+    started = time.perf_counter()
+    pools = {n: EnvWorkers(suite, n) for n in args.workers}
+    try:
+        for pool in pools.values():  # warm-up: every worker builds its envs
+            collect_rate(pool, runner, 1, seed=999)
+        for repeat in range(args.repeats):
+            raw.append(raw_rate(list(suite.task_names), RAW_STEPS))
+            for n, pool in pools.items():
+                collect[n].append(collect_rate(pool, runner, args.episodes, seed=repeat))
+                evals[n].append(eval_rate(pool, runner, args.eval_episodes))
+    finally:
+        for pool in pools.values():
+            pool.close()
+    raw_median = statistics.median(raw)
+    print(f"MetaWorld MT10, state; repeats: {args.repeats}; wall time {time.perf_counter() - started:.0f} s")
+    print(f"raw single-env MetaWorld step rate (one process): {raw_median:.0f} steps/s")
+    print("| workers | collect steps/s | ratio to workers x raw | eval episodes/s | eval speed-up |")
+    print("|--------:|----------------:|-----------------------:|----------------:|--------------:|")
+    base_eval = statistics.median(evals[args.workers[0]])
+    ratios = {}
+    for n in args.workers:
+        rate = statistics.median(collect[n])
+        ratios[n] = rate / (n * raw_median)
+        eval_median = statistics.median(evals[n])
+        print(
+            f"| {n:7d} | {rate:15.0f} | {ratios[n]:22.3f} | {eval_median:15.2f} | "
+            f"{eval_median / base_eval:13.2f} |"
+        )
+    for n, ratio in ratios.items():
+        verdict = "PASS" if ratio >= TARGET else "FAIL"
+        print(f"{verdict}: collection with {n} worker(s) at {ratio:.3f} x {n} x raw (target >= {TARGET})")
+
+
+if __name__ == "__main__":
+    main()
