@@ -30,6 +30,7 @@ from lerobot_mtdagger.workers import (
     Episode,
     EpisodeSpec,
     RolloutRules,
+    Ticket,
     limited_torch_threads,
 )
 
@@ -37,6 +38,7 @@ logger = logging.getLogger(__name__)
 
 COLLECT_STREAM = 0
 EVAL_STREAM = 1
+LANE_GROUPS = 2
 
 PolicyFn = Callable[[list[dict[str, np.ndarray]], list[str]], np.ndarray]
 """Maps a batch of observations and their task names to actions, (B, action_dim)."""
@@ -55,6 +57,7 @@ class _Lane:
 
     Attributes:
         home_task: The task whose episodes the lane runs first.
+        group: The lane's group: the learner acts for one group while the workers step the other.
         task_index: Task of the running episode (None: idle).
         worker: Worker running the episode.
         observation: Its latest observation (None until the worker has reset the env).
@@ -62,6 +65,7 @@ class _Lane:
     """
 
     home_task: int
+    group: int
     task_index: int | None = None
     worker: int = 0
     observation: dict[str, np.ndarray] | None = None
@@ -112,9 +116,10 @@ def run_episodes(
     """Runs ``episodes_per_task[i]`` episodes of task i on the env workers, in lock-step.
 
     There is one lane per task; a lane runs its own task's episodes, then helps the task with most
-    episodes left. Every step, the learner acts once for all lanes with an observation (lane
-    order), then every worker steps its episodes. Lanes, batches and seeds do not depend on the
-    number of workers, so neither does any result.
+    episodes left. The lanes form two groups (even and odd tasks), pipelined: while the workers step
+    one group's episodes, the main process takes the other group's observations and runs the
+    learner once for all of that group's lanes (lane order). Lanes, groups, batches and seeds do
+    not depend on the number of workers, so neither does any result.
 
     Args:
         workers: The run's env workers (their suite gives experts and task names).
@@ -152,38 +157,57 @@ def run_episodes(
         )
     )
     schedule = _Schedule([deque(range(int(n))) for n in episodes_per_task], seed, round_index, stream)
-    lanes = [_Lane(home_task=task) for task in range(len(task_names))]
+    lanes = [_Lane(home_task=task, group=task % LANE_GROUPS) for task in range(len(task_names))]
     for handle in range(len(lanes)):
         _assign(lanes, handle, schedule, workers.slots)
     finished: list[Episode] = []
+    outstanding: list[Ticket | None] = [None] * LANE_GROUPS
     with limited_torch_threads(1):
-        while any(lane.task_index is not None for lane in lanes):
-            actions = _learner_actions(policy if learner else None, lanes, task_names)
-            commands: list[tuple[list[EpisodeSpec], dict[int, np.ndarray | None]]] = [
-                ([], {}) for _ in range(workers.slots)
-            ]
-            for handle, lane in enumerate(lanes):
-                if lane.start is not None:
-                    commands[lane.worker][0].append(lane.start)
-                    lane.start = None
-                elif handle in actions:
-                    commands[lane.worker][1][handle] = actions[handle]
-            done: list[tuple[int, Episode]] = []
-            for observations, ended in workers.iterate(commands):
-                for handle, observation in observations.items():
-                    lanes[handle].observation = observation
-                done += ended
-            for handle, episode in sorted(done, key=lambda item: item[0]):
-                finished.append(episode)
-                if progress is not None:
-                    progress(episode)
-                _assign(lanes, handle, schedule, workers.slots)
+        while any(lane.task_index is not None for lane in lanes) or any(t is not None for t in outstanding):
+            for group in range(LANE_GROUPS):
+                for handle, episode in _receive(workers, outstanding[group], lanes):
+                    finished.append(episode)
+                    if progress is not None:
+                        progress(episode)
+                    _assign(lanes, handle, schedule, workers.slots)
+                members = [handle for handle, lane in enumerate(lanes) if lane.group == group]
+                actions = _learner_actions(policy if learner else None, lanes, members, task_names)
+                commands = _commands(lanes, members, actions, workers.slots)
+                outstanding[group] = workers.send(commands) if any(c[0] or c[1] for c in commands) else None
     finished.sort(key=lambda e: (e.task_index, e.episode))
     return finished
 
 
+def _receive(workers: EnvWorkers, ticket: Ticket | None, lanes: list[_Lane]) -> list[tuple[int, Episode]]:
+    """Takes the replies owed for ``ticket``; returns the finished episodes by lane."""
+    done: list[tuple[int, Episode]] = []
+    for observations, ended in workers.receive(ticket):
+        for handle, observation in observations.items():
+            lanes[handle].observation = observation
+        done += ended
+    return sorted(done, key=lambda item: item[0])
+
+
+def _commands(
+    lanes: list[_Lane], members: list[int], actions: dict[int, np.ndarray | None], worker_count: int
+) -> list[tuple[list[EpisodeSpec], dict[int, np.ndarray | None]]]:
+    """Per worker: the episodes of ``members`` to start and the actions of those to step."""
+    commands: list[tuple[list[EpisodeSpec], dict[int, np.ndarray | None]]] = [
+        ([], {}) for _ in range(worker_count)
+    ]
+    for handle in members:
+        lane = lanes[handle]
+        if lane.start is not None:
+            commands[lane.worker][0].append(lane.start)
+            lane.start = None
+        elif handle in actions:
+            commands[lane.worker][1][handle] = actions[handle]
+            lane.observation = None  # consumed: the next one comes with the reply
+    return commands
+
+
 def _assign(lanes: list[_Lane], handle: int, schedule: _Schedule, worker_count: int) -> None:
-    """Gives lane ``handle`` its next episode, on the worker running the fewest episodes."""
+    """Gives lane ``handle`` its next episode, on the worker running the fewest of its group's."""
     lane = lanes[handle]
     lane.observation = None
     spec = schedule.next_episode(lane, handle)
@@ -192,16 +216,16 @@ def _assign(lanes: list[_Lane], handle: int, schedule: _Schedule, worker_count: 
         return
     load = [0] * worker_count
     for other in lanes:
-        if other.task_index is not None and other is not lane:
+        if other.task_index is not None and other is not lane and other.group == lane.group:
             load[other.worker] += 1
     lane.task_index, lane.worker, lane.start = spec.task_index, int(np.argmin(load)), spec
 
 
 def _learner_actions(
-    policy: PolicyFn | None, lanes: list[_Lane], task_names: Sequence[str]
+    policy: PolicyFn | None, lanes: list[_Lane], members: list[int], task_names: Sequence[str]
 ) -> dict[int, np.ndarray | None]:
-    """The learner's action for every lane with an observation (None for each without a learner)."""
-    ready = [handle for handle, lane in enumerate(lanes) if lane.observation is not None]
+    """The learner's action for each lane of ``members`` with an observation (None: no learner)."""
+    ready = [handle for handle in members if lanes[handle].observation is not None]
     if policy is None or not ready:
         return dict.fromkeys(ready)
     observations = [lanes[handle].observation for handle in ready]

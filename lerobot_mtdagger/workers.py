@@ -2,8 +2,8 @@
 
 A ``RolloutWorker`` owns envs and experts and runs the per-episode logic of a rollout (reset, the
 expert's label, the beta coin, the env step, recording, the end-of-episode rules). The main process
-keeps the policy and talks to the workers in lock-step (see ``collect.run_episodes``): one message
-per worker per step carrying the learner's actions for that worker's episodes and the episodes to
+keeps the policy and talks to the workers (see ``collect.run_episodes``): one message per worker
+per step of a group of episodes, carrying the learner's actions for that worker's episodes and the episodes to
 start, one reply carrying the new observations and the finished episodes.
 
 ``EnvWorkers(suite, workers=0)`` runs the worker in the calling process (no IPC); ``workers=N >= 1``
@@ -330,6 +330,19 @@ def _picklable(error: Exception) -> Exception:
     return error
 
 
+@dataclass
+class Ticket:
+    """The replies one ``EnvWorkers.send`` is owed.
+
+    Attributes:
+        busy: Workers that were sent a command.
+        local_replies: The replies already computed in-process (``workers=0``).
+    """
+
+    busy: list[int]
+    local_replies: list[Any] = field(default_factory=list)
+
+
 class EnvWorkers:
     """The envs of a run, in ``workers`` processes (0: in the calling process).
 
@@ -383,19 +396,27 @@ class EnvWorkers:
         for index in range(self.workers):
             self._receive(index)
 
-    def iterate(
-        self, commands: list[tuple[list[EpisodeSpec], dict[int, np.ndarray | None]]]
-    ) -> list[tuple[dict[int, dict[str, np.ndarray]], list[tuple[int, Episode]]]]:
-        """Sends each worker its (starts, actions) and returns the replies in worker order."""
-        if self._local is not None:
-            return [self._local.iterate(*commands[0])]
+    def send(self, commands: list[tuple[list[EpisodeSpec], dict[int, np.ndarray | None]]]) -> Ticket:
+        """Sends each worker its (starts, actions); the ticket says whose replies to ``receive``."""
         busy = [index for index, (starts, actions) in enumerate(commands) if starts or actions]
+        if self._local is not None:
+            return Ticket(busy, [self._local.iterate(*commands[0])] if busy else [])
         for index in busy:
-            self._connections[index].send(("iterate", commands[index]))
-        replies: list[Any] = [({}, []) for _ in commands]
-        for index in busy:
-            replies[index] = self._receive(index)
-        return replies
+            try:
+                self._connections[index].send(("iterate", commands[index]))
+            except OSError as error:  # BrokenPipeError, ConnectionResetError: the worker is gone
+                raise self._died(index) from error
+        return Ticket(busy)
+
+    def receive(
+        self, ticket: Ticket | None
+    ) -> list[tuple[dict[int, dict[str, np.ndarray]], list[tuple[int, Episode]]]]:
+        """The replies owed for ``ticket`` (none for None), in worker order."""
+        if ticket is None:
+            return []
+        if self._local is not None:
+            return ticket.local_replies
+        return [self._receive(index) for index in ticket.busy]
 
     def _receive(self, index: int) -> Any:
         """The reply of worker ``index``.
@@ -405,24 +426,26 @@ class EnvWorkers:
             Exception: The worker's own exception, with its traceback as the cause.
         """
         connection, process = self._connections[index], self._processes[index]
-        ready = wait([connection, process.sentinel])
-        if connection not in ready:
-            process.join(timeout=1.0)
-            raise WorkerDiedError(
-                f"Env worker {index} (pid {process.pid}) died with exit code {process.exitcode} "
-                "(killed, or out of memory?); nothing of the running round was committed. Rerun "
-                "with --resume=true to continue from the last committed round."
-            )
+        if connection not in wait([connection, process.sentinel]):
+            raise self._died(index)
         try:
             status, payload = connection.recv()
-        except EOFError as error:
-            raise WorkerDiedError(
-                f"Env worker {index} (pid {process.pid}) closed its pipe without answering."
-            ) from error
+        except (EOFError, OSError) as error:
+            raise self._died(index) from error
         if status == "error":
             error, text = payload
             raise error from RemoteWorkerError(text)
         return payload
+
+    def _died(self, index: int) -> WorkerDiedError:
+        """The error for worker ``index`` having ended without answering."""
+        process = self._processes[index]
+        process.join(timeout=1.0)
+        return WorkerDiedError(
+            f"Env worker {index} (pid {process.pid}) died with exit code {process.exitcode} "
+            "(killed, or out of memory?); nothing of the running round was committed. Rerun "
+            "with --resume=true to continue from the last committed round."
+        )
 
     def close(self) -> None:
         """Stops the workers and closes every env."""
