@@ -47,9 +47,10 @@ from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
 from lerobot_mtdagger.train import (
     NormalisedData,
+    TrainingData,
     build_processors,
     compute_stats,
-    load_rounds,
+    load_round,
     loss_split,
     policy_config,
     save_policy,
@@ -70,6 +71,7 @@ class RunContext:
     workers: EnvWorkers
     show_progress: bool
     timings: dict[int, dict[str, float]] = field(default_factory=dict)
+    rounds_in_memory: list[TrainingData] = field(default_factory=list)
 
     @property
     def task_names(self) -> list[str]:
@@ -262,11 +264,10 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     """Trains on D(round_index), evaluates and commits the phase."""
     config = ctx.config
     start = time.perf_counter()
-    roots = [ctx.experiment.round_root(i) for i in range(round_index + 1)]
     policy_cfg = policy_config(ctx.suite.features, ctx.task_names, config.policy, config.policy.device)
     input_keys = list(policy_cfg.input_features)
     image_keys = [k for k in input_keys if k.startswith(IMAGE_KEY)]
-    data = load_rounds(roots, input_keys)
+    data = rounds_in_memory(ctx, round_index, input_keys)
     phase_seed = int(np.random.SeedSequence([config.seed, 3, round_index]).generate_state(1)[0])
     train_index, loss_index = loss_split(data, config.gain_split, config.heldout_fraction, phase_seed)
     stats = compute_stats(data.subset(train_index), image_keys)
@@ -291,7 +292,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
             batch_size=config.policy.batch_size,
             lr=config.policy.lr,
             seed=phase_seed,
-            on_step=lambda step, loss: bar.update(1),
+            on_step=lambda done, loss: bar.update(done - bar.n),
         )
     trained = time.perf_counter()
     staging = ctx.experiment.staging_policy_root(round_index)
@@ -317,6 +318,13 @@ def train_round(ctx: RunContext, round_index: int) -> None:
         timings=ctx.timings[round_index],
     )
     ctx.experiment.commit_phase(round_index, staging, record)
+
+
+def rounds_in_memory(ctx: RunContext, round_index: int, input_keys: list[str]) -> TrainingData:
+    """D(round_index) in memory: rounds loaded earlier in this run are kept, only new ones are read."""
+    for k in range(len(ctx.rounds_in_memory), round_index + 1):
+        ctx.rounds_in_memory.append(load_round(ctx.experiment.round_root(k), k, input_keys))
+    return TrainingData.concat(ctx.rounds_in_memory[: round_index + 1])
 
 
 def evaluate_phase(ctx: RunContext, runner: PolicyRunner) -> EvalResult | None:

@@ -4,13 +4,20 @@ Algorithm 1, "Train Policy": train on D(k) (all committed rounds so far), record
 imitation loss at the start and at the end of the phase, on the training data itself or on a held-out
 split of episodes; the gain is ``max(0, L_start - L_end)`` per task.
 
-The rounds are loaded into memory once per phase (round datasets are small and immutable) and
-normalised with LeRobot's own pre-processor built from their statistics, the same processor that is
-saved with the checkpoint; so what we train, what we roll out and what ``lerobot-eval`` loads agree.
+Committed rounds are immutable, so a run reads each one once (``load_round``, straight from the
+dataset's parquet files) and keeps it in memory; a phase concatenates them (``TrainingData.concat``)
+and normalises the frames with LeRobot's own pre-processor built from their statistics, the same
+processor that is saved with the checkpoint; so what we train, what we roll out and what
+``lerobot-eval`` loads agree.
+
+The training loop is lean: tasks are indices mapped once, the loss is the policy's
+``imitation_loss`` and the loss history stays on the device until a log interval.
 """
 
 from __future__ import annotations
 
+import io
+import json
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -18,9 +25,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
-from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import dataset_to_policy_features
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
@@ -29,6 +37,15 @@ from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
 logger = logging.getLogger(__name__)
 
 LOSS_SAMPLES_PER_TASK = 1024
+
+LOG_INTERVAL = 100
+"""Steps between two syncs of the training loss (finiteness check, progress callback, debug log)."""
+
+FINAL_LOSSES = 10
+"""Step losses kept in ``PhaseResult.train_loss`` (the last ones of the phase)."""
+
+EPISODE_ID_STRIDE = 1_000_000
+"""``episode_id = episode_index + round_position * EPISODE_ID_STRIDE``."""
 
 
 @dataclass
@@ -59,41 +76,117 @@ class TrainingData:
             episode_id=self.episode_id[index],
         )
 
+    @staticmethod
+    def concat(parts: Sequence[TrainingData]) -> TrainingData:
+        """The frames of ``parts`` one after the other (e.g. rounds loaded once and kept in memory).
 
-def load_rounds(roots: Sequence[Path], input_keys: Sequence[str]) -> TrainingData:
-    """Loads committed round datasets into memory.
+        Raises:
+            ValueError: If ``parts`` is empty or the parts hold different input keys.
+        """
+        if not parts:
+            raise ValueError("TrainingData.concat needs at least one part.")
+        keys = list(parts[0].inputs)
+        for part in parts[1:]:
+            if set(part.inputs) != set(keys):
+                raise ValueError(f"Cannot concatenate inputs {sorted(part.inputs)} with {sorted(keys)}.")
+        return TrainingData(
+            inputs={k: torch.cat([p.inputs[k] for p in parts]) for k in keys},
+            action=torch.cat([p.action for p in parts]),
+            task_index=torch.cat([p.task_index for p in parts]),
+            episode_id=torch.cat([p.episode_id for p in parts]),
+        )
+
+
+def load_round(root: Path, round_position: int, input_keys: Sequence[str]) -> TrainingData:
+    """Loads one committed round dataset into memory, straight from its parquet files.
+
+    A LeRobot v3.0 dataset keeps its frames in ``<root>/data/chunk-XXX/file-YYY.parquet``; they are read
+    with pyarrow in the order ``LeRobotDataset`` reads them (sorted paths), which skips building the
+    dataset object and its Arrow cache. Image features (structs of PNG bytes) are decoded with PIL, as
+    ``datasets`` does.
 
     Args:
-        roots: Round dataset folders.
+        root: The round dataset folder.
+        round_position: Position of the round among those trained on; offsets the episode ids so they
+            stay unique across rounds.
+        input_keys: Observation keys the policy reads.
+
+    Returns:
+        The round's frames.
+
+    Raises:
+        FileNotFoundError: If the folder holds no parquet file.
+        KeyError: If an input key is not a feature of the dataset.
+        ValueError: If an input is stored as a video (round datasets never are).
+    """
+    root = Path(root)
+    features = json.loads((root / "meta" / "info.json").read_text())["features"]
+    missing = [key for key in [*input_keys, "action"] if key not in features]
+    if missing:
+        raise KeyError(f"Round dataset {root} has no feature(s) {missing}; it has {sorted(features)}.")
+    paths = sorted((root / "data").glob("*/*.parquet"))
+    if not paths:
+        raise FileNotFoundError(f"Round dataset {root} has no parquet file under data/.")
+    columns = list(dict.fromkeys([*input_keys, "action", "task_index", "episode_index"]))
+    table = pa.concat_tables([pq.read_table(path, columns=columns) for path in paths])
+    inputs = {}
+    for key in input_keys:
+        dtype = features[key]["dtype"]
+        if dtype == "image":
+            inputs[key] = torch.from_numpy(_decode_images(table.column(key), root))
+        elif dtype == "video":
+            raise ValueError(f"Input {key!r} of {root} is a video; round datasets store images.")
+        else:
+            inputs[key] = torch.from_numpy(_column_values(table.column(key), features[key]["shape"]))
+    episode = _column_values(table.column("episode_index"), (), np.int64)
+    return TrainingData(
+        inputs=inputs,
+        action=torch.from_numpy(_column_values(table.column("action"), features["action"]["shape"])),
+        task_index=torch.from_numpy(_column_values(table.column("task_index"), (), np.int64)),
+        episode_id=torch.from_numpy(episode + round_position * EPISODE_ID_STRIDE),
+    )
+
+
+def _column_values(column: pa.ChunkedArray, shape: Sequence[int], dtype: type = np.float32) -> np.ndarray:
+    """A numeric column (scalars or nested fixed-size lists) as an (N, *shape) array of ``dtype``."""
+    array = column.combine_chunks() if column.num_chunks != 1 else column.chunk(0)
+    if isinstance(array, pa.ExtensionArray):  # datasets' ArrayXD types
+        array = array.storage
+    while (
+        pa.types.is_list(array.type)
+        or pa.types.is_large_list(array.type)
+        or pa.types.is_fixed_size_list(array.type)
+    ):
+        array = array.flatten()
+        if isinstance(array, pa.ExtensionArray):
+            array = array.storage
+    values = np.array(array.to_numpy(zero_copy_only=False), dtype=dtype)  # owned, writable
+    return values.reshape(len(column), *shape)
+
+
+def _decode_images(column: pa.ChunkedArray, root: Path) -> np.ndarray:
+    """An image column (structs of encoded bytes and path) as uint8 (N, H, W, C)."""
+    from PIL import Image
+
+    images = []
+    for item in column.to_pylist():
+        source = io.BytesIO(item["bytes"]) if item.get("bytes") is not None else root / item["path"]
+        with Image.open(source) as image:
+            images.append(np.asarray(image, dtype=np.uint8))
+    return np.stack(images)
+
+
+def load_rounds(roots: Sequence[Path], input_keys: Sequence[str]) -> TrainingData:
+    """Loads committed round datasets into memory (``load_round`` each, then ``TrainingData.concat``).
+
+    Args:
+        roots: Round dataset folders, in round order.
         input_keys: Observation keys the policy reads.
 
     Returns:
         The concatenated frames.
     """
-    parts: dict[str, list[torch.Tensor]] = {
-        k: [] for k in [*input_keys, "action", "task_index", "episode_id"]
-    }
-    for round_position, root in enumerate(roots):
-        dataset = LeRobotDataset(f"local/{Path(root).name}", root=root)
-        table = dataset.hf_dataset.with_format("numpy")
-        for key in input_keys:
-            column = table[key]
-            if dataset.features[key]["dtype"] == "image":
-                column = np.stack([np.asarray(image, dtype=np.uint8) for image in column])
-                parts[key].append(torch.from_numpy(column))
-            else:
-                parts[key].append(torch.from_numpy(np.asarray(column, dtype=np.float32)))
-        parts["action"].append(torch.from_numpy(np.asarray(table["action"], dtype=np.float32)))
-        parts["task_index"].append(torch.from_numpy(np.asarray(table["task_index"], dtype=np.int64)))
-        episode = np.asarray(table["episode_index"], dtype=np.int64)
-        parts["episode_id"].append(torch.from_numpy(episode + round_position * 1_000_000))
-    merged = {k: torch.cat(v) for k, v in parts.items()}
-    return TrainingData(
-        inputs={k: merged[k] for k in input_keys},
-        action=merged["action"],
-        task_index=merged["task_index"],
-        episode_id=merged["episode_id"],
-    )
+    return TrainingData.concat([load_round(root, i, input_keys) for i, root in enumerate(roots)])
 
 
 def compute_stats(data: TrainingData, image_keys: Sequence[str]) -> dict[str, dict[str, np.ndarray]]:
@@ -131,25 +224,46 @@ def policy_config(
 
 
 class NormalisedData:
-    """Training frames normalised once with the policy's pre-processor; batches built on demand."""
+    """Training frames normalised once with the policy's pre-processor; batches built on demand.
+
+    Tasks are carried as indices into ``task_names`` (checked once here), never as strings per batch.
+    """
 
     def __init__(
         self, data: TrainingData, preprocessor: Any, image_keys: Sequence[str], task_names: Sequence[str]
     ):
+        """Normalises the vector inputs and the action of ``data``.
+
+        Raises:
+            ValueError: If a frame's task index is outside ``task_names``.
+        """
         self.data = data
         self.image_keys = list(image_keys)
         self.task_names = list(task_names)
+        if len(data) and (int(data.task_index.min()) < 0 or int(data.task_index.max()) >= len(task_names)):
+            raise ValueError(
+                f"Task indices {torch.unique(data.task_index).tolist()} fall outside the "
+                f"{len(task_names)} tasks {self.task_names}."
+            )
         vector = {k: v for k, v in data.inputs.items() if k not in self.image_keys} | {"action": data.action}
-        normalised = preprocessor({**vector, "task": [self.task_names[i] for i in data.task_index.tolist()]})
+        normalised = preprocessor(dict(vector))
         self.vector = {k: normalised[k] for k in vector}
+        self.device = self.vector["action"].device
+        self.task_index = data.task_index.to(self.device, dtype=torch.long)
 
-    def batch(self, index: torch.Tensor) -> dict[str, Any]:
-        """The normalised batch at ``index`` (images as float CHW in [0, 1])."""
-        batch: dict[str, Any] = {k: v[index] for k, v in self.vector.items()}
+    def batch(self, index: torch.Tensor) -> dict[str, torch.Tensor]:
+        """The normalised batch at ``index``.
+
+        Returns:
+            The vectors, the images as float CHW in [0, 1] and ``task_index`` (indices into
+            ``task_names``), all on the data's device.
+        """
+        index = index.to(self.device)
+        batch = {k: v[index] for k, v in self.vector.items()}
         for key in self.image_keys:
-            batch[key] = self.data.inputs[key][index].permute(0, 3, 1, 2).float() / 255.0
-        batch["task_index"] = self.data.task_index[index]
-        batch["task"] = [self.task_names[i] for i in batch["task_index"].tolist()]
+            images = self.data.inputs[key][index.cpu()].to(self.device)
+            batch[key] = images.permute(0, 3, 1, 2).float() / 255.0
+        batch["task_index"] = self.task_index[index]
         return batch
 
 
@@ -198,16 +312,32 @@ def per_task_loss(
 ) -> tuple[list, list]:
     """Mean MSE per task over the frames at ``index`` (None where a task has none) and the counts."""
     policy.eval()
-    sums = torch.zeros(num_tasks, dtype=torch.float64)
-    counts = torch.zeros(num_tasks, dtype=torch.float64)
+    sums = torch.zeros(num_tasks, dtype=torch.float64, device=data.device)
+    counts = torch.zeros(num_tasks, dtype=torch.float64, device=data.device)
     for chunk in torch.split(index, 4096):
         batch = data.batch(chunk)
-        errors = ((policy.predict(batch) - batch["action"]) ** 2).mean(dim=1).double()
+        prediction = policy.predict(batch, task_index=batch["task_index"])
+        errors = ((prediction - batch["action"]) ** 2).mean(dim=1).double()
         means, chunk_counts = per_task_means(errors, batch["task_index"], num_tasks)
         sums += means * chunk_counts
         counts += chunk_counts
+    sums, counts = sums.cpu(), counts.cpu()
     losses = [float(sums[i] / counts[i]) if counts[i] > 0 else None for i in range(num_tasks)]
     return losses, [int(c) for c in counts.tolist()]
+
+
+def make_optimizer(policy: MTDAggerPolicy, lr: float) -> torch.optim.AdamW:
+    """AdamW over the policy's parameters with its configured weight decay.
+
+    The update is one fused kernel per step on CPU and CUDA rather than a Python loop over tensors.
+    """
+    fused = policy.task_embedding.weight.device.type in ("cpu", "cuda")
+    return torch.optim.AdamW(
+        policy.parameters(),
+        lr=lr,
+        weight_decay=policy.config.optimizer_weight_decay,
+        fused=fused or None,
+    )
 
 
 def train_phase(
@@ -221,44 +351,106 @@ def train_phase(
     lr: float,
     seed: int,
     on_step: Callable[[int, float], None] | None = None,
+    log_interval: int = LOG_INTERVAL,
 ) -> PhaseResult:
     """Trains ``policy`` for ``steps`` AdamW steps and measures the per-task loss drop.
 
+    Each step samples ``batch_size`` frames of ``train_index`` uniformly with replacement and takes
+    one AdamW step on ``policy.imitation_loss`` with the gradient norm clipped to
+    ``config.optimizer_grad_clip_norm``. The losses stay on the device: they are read back only every
+    ``log_interval`` steps and after the last one, where they are checked for NaN/inf and reported.
+    The first step of each interval calls the full ``policy.forward`` (same loss and gradient) and
+    logs its per-task losses at debug level. The result depends only on the inputs and ``seed``
+    (not on ``log_interval``).
+
+    Args:
+        policy: The policy to train, in place; its ``task_names`` must be ``data.task_names``.
+        data: The normalised frames.
+        train_index: Frames to train on.
+        loss_index: Frames the per-task loss is measured on, before and after.
+        steps: Optimiser steps.
+        batch_size: Frames per step (capped at ``len(train_index)``).
+        lr: AdamW learning rate.
+        seed: Seed of the batch sampling.
+        on_step: Progress callback, called every ``log_interval`` steps and after the last step as
+            ``on_step(steps_done, mean_loss)``: the number of steps completed so far (1..steps) and the
+            mean training loss over the steps since the previous call.
+        log_interval: Steps between two reads of the loss.
+
+    Returns:
+        The per-task losses at the start and at the end, the gain and the last FINAL_LOSSES step
+        losses.
+
     Raises:
+        ValueError: If the policy's task vocabulary differs from the data's, or log_interval < 1.
         FloatingPointError: If the loss becomes NaN or infinite (nothing is committed then).
     """
+    if list(policy.config.task_names) != data.task_names:
+        raise ValueError(
+            f"The policy's tasks {policy.config.task_names} differ from the data's {data.task_names}."
+        )
+    if log_interval < 1:
+        raise ValueError(f"log_interval must be >= 1, got {log_interval}.")
     num_tasks = len(data.task_names)
     loss_start, _ = per_task_loss(policy, data, loss_index, num_tasks)
     generator = torch.Generator().manual_seed(seed)
-    optimizer = torch.optim.AdamW(
-        policy.parameters(), lr=lr, weight_decay=policy.config.optimizer_weight_decay
-    )
+    optimizer = make_optimizer(policy, lr)
+    parameters = [p for p in policy.parameters() if p.requires_grad]
+    clip_norm = policy.config.optimizer_grad_clip_norm
+    size = min(batch_size, len(train_index))
     policy.train()
-    history = []
+    window: list[torch.Tensor] = []
+    tail = torch.empty(0)  # the last FINAL_LOSSES step losses, on the CPU
+    picks = torch.empty(0, dtype=torch.long)
     for step in range(steps):
-        picks = train_index[
-            torch.randint(len(train_index), (min(batch_size, len(train_index)),), generator=generator)
-        ]
-        loss, _ = policy.forward(data.batch(picks))
-        if not torch.isfinite(loss):
-            raise FloatingPointError(
-                f"Training loss became {loss.item()} at step {step}; nothing was committed."
-            )
-        optimizer.zero_grad()
+        offset = step % log_interval
+        if offset == 0:
+            # One interval's batch indices at once, drawn on the CPU (device independent).
+            block = min(log_interval, steps - step)
+            picks = train_index[torch.randint(len(train_index), (block, size), generator=generator)]
+            picks = picks.to(data.device)
+        batch = data.batch(picks[offset])
+        if offset == 0:
+            loss, info = policy.forward(batch)
+            _check_finite(loss.detach().reshape(1), step)
+            info = info or {}
+            logger.debug("step %d: loss %s, per task %s", step, info.get("loss"), info.get("per_task_loss"))
+        else:
+            loss = policy.imitation_loss(batch, task_index=batch["task_index"])
+        optimizer.zero_grad(set_to_none=True)
         loss.backward()
-        torch.nn.utils.clip_grad_norm_(policy.parameters(), policy.config.optimizer_grad_clip_norm)
+        torch.nn.utils.clip_grad_norm_(parameters, clip_norm, foreach=True)
         optimizer.step()
-        history.append(loss.item())
-        if on_step is not None:
-            on_step(step, history[-1])
+        window.append(loss.detach())
+        if offset == log_interval - 1 or step == steps - 1:
+            losses = torch.stack(window).float().cpu()  # the one sync of the interval
+            _check_finite(losses, step + 1 - len(window))
+            window = []
+            tail = torch.cat([tail, losses])[-FINAL_LOSSES:]
+            if on_step is not None:
+                on_step(step + 1, float(losses.double().mean()))
     loss_end, counts = per_task_loss(policy, data, loss_index, num_tasks)
     gain = [
         max(0.0, start - end) if start is not None and end is not None else 0.0
         for start, end in zip(loss_start, loss_end, strict=True)
     ]
     return PhaseResult(
-        loss_start=loss_start, loss_end=loss_end, gain=gain, train_loss=history[-10:], loss_samples=counts
+        loss_start=loss_start,
+        loss_end=loss_end,
+        gain=gain,
+        train_loss=tail.tolist(),
+        loss_samples=counts,
     )
+
+
+def _check_finite(losses: torch.Tensor, first_step: int) -> None:
+    """Raises FloatingPointError at the first NaN/inf of ``losses`` (step ``first_step`` onwards)."""
+    finite = torch.isfinite(losses)
+    if not bool(finite.all()):
+        bad = int(torch.nonzero(~finite)[0, 0])
+        raise FloatingPointError(
+            f"Training loss became {float(losses[bad])} at step {first_step + bad}; nothing was committed."
+        )
 
 
 def save_policy(policy: MTDAggerPolicy, preprocessor: Any, postprocessor: Any, folder: Path) -> None:

@@ -158,11 +158,23 @@ class MTDAggerPolicy(PreTrainedPolicy):
     # Network
     # ---------------------------------------------------------------------------------------------
 
-    def predict(self, batch: dict[str, Any]) -> Tensor:
-        """Normalised action for a normalised observation batch, (B, action_dim)."""
-        features = [self.task_embedding(self.task_indices(batch))]
+    def predict(self, batch: dict[str, Any], *, task_index: Tensor | None = None) -> Tensor:
+        """Normalised action for a normalised observation batch, (B, action_dim).
+
+        Args:
+            batch: Normalised observations, with ``task`` strings or ``task_index``.
+            task_index: (B,) indices into ``config.task_names`` to use instead of the batch's task
+                information. Trusted: not validated, so no host-device sync (the training loop maps
+                and checks the tasks once for the whole data set).
+        """
+        if task_index is None:
+            task_index = self.task_indices(batch)
+        features = [self.task_embedding(task_index)]
         if self.state_encoder is not None:
-            state = torch.cat([batch[k].flatten(start_dim=1) for k in self.vector_keys], dim=1)
+            if len(self.vector_keys) == 1:
+                state = batch[self.vector_keys[0]].flatten(start_dim=1)
+            else:
+                state = torch.cat([batch[k].flatten(start_dim=1) for k in self.vector_keys], dim=1)
             features.append(self.state_encoder(state))
         if self.image_encoder is not None:
             features += [self.image_encoder(batch[k]) for k in self.image_keys]
@@ -174,24 +186,49 @@ class MTDAggerPolicy(PreTrainedPolicy):
                 raise ValueError(f"Batch has {feature.shape[0]} observations but {batch_size} task entries.")
         return self.head(torch.cat(features, dim=1))
 
+    def imitation_loss(self, batch: dict[str, Any], *, task_index: Tensor | None = None) -> Tensor:
+        """Mean squared error to the expert action over the batch: the training objective.
+
+        The lean path of :meth:`forward`: no per-task statistics, no Python numbers, no host-device
+        sync when ``task_index`` is given.
+
+        Args:
+            batch: Normalised observations and ``action``, with ``task`` strings or ``task_index``.
+            task_index: Trusted (B,) task indices, as in :meth:`predict`.
+
+        Returns:
+            The scalar loss (with its autograd graph).
+        """
+        loss, _ = self._imitation_terms(batch, task_index)
+        return loss
+
+    def _imitation_terms(self, batch: dict[str, Any], task_index: Tensor | None) -> tuple[Tensor, Tensor]:
+        """The loss and the prediction it was computed from."""
+        prediction = self.predict(batch, task_index=task_index)
+        return nn.functional.mse_loss(prediction, batch[ACTION]), prediction
+
     def forward(self, batch: dict[str, Any]) -> tuple[Tensor, dict[str, Any]]:
-        """MSE to the expert action, overall and per task.
+        """MSE to the expert action, overall and per task (LeRobot's training entry point).
+
+        The loss is :meth:`imitation_loss`'s; the statistics cost a few host-device syncs, so the
+        plugin's own training loop calls this only at its log intervals.
 
         Returns:
             The mean loss over the batch, and ``{"loss": float, "per_task_loss": {task: mean loss},
             "per_task_count": {task: samples}}`` for the tasks present in the batch.
         """
-        prediction = self.predict(batch)
-        per_sample = ((prediction - batch[ACTION]) ** 2).mean(dim=1)  # (B,)
-        loss = per_sample.mean()
         indices = self.task_indices(batch)
-        per_task, counts = per_task_means(per_sample.detach(), indices, len(self.config.task_names))
+        loss, prediction = self._imitation_terms(batch, indices)
+        per_sample = ((prediction.detach() - batch[ACTION]) ** 2).mean(dim=1)  # (B,)
+        per_task, counts = per_task_means(per_sample, indices, len(self.config.task_names))
         present = torch.nonzero(counts).flatten().tolist()
         names = self.config.task_names
+        per_task_values = per_task.tolist()
+        count_values = counts.tolist()
         return loss, {
             "loss": loss.item(),
-            "per_task_loss": {names[i]: per_task[i].item() for i in present},
-            "per_task_count": {names[i]: int(counts[i].item()) for i in present},
+            "per_task_loss": {names[i]: per_task_values[i] for i in present},
+            "per_task_count": {names[i]: int(count_values[i]) for i in present},
         }
 
     @torch.no_grad()
