@@ -100,11 +100,8 @@ def run_demo(config: DemoConfig) -> list[dict]:
 
 def run_experiment(config: RunConfig) -> list[str]:
     """Runs ``lerobot-mtdagger run`` and prints the per-round summary."""
-    import datasets
-
     from lerobot_mtdagger.dagger import run
 
-    datasets.disable_progress_bars()  # one "Map" bar per episode otherwise
     print(f"experiment {config.output_dir} ({config.method}, seed {config.seed}):", flush=True)
     return run(config, on_summary=lambda line: print(line, flush=True))
 
@@ -279,6 +276,18 @@ def _usage() -> str:
     return f"usage: lerobot-mtdagger <command> [--option=value ...]\ncommands: {names}\n" + (__doc__ or "")
 
 
+def configure_console_logging() -> None:
+    """Warnings and errors on the console; INFO records still reach file handlers (``run.log``).
+
+    The console shows what the commands print (one summary line per round for ``run``), never the
+    INFO chatter of the libraries underneath.
+    """
+    console = logging.StreamHandler()
+    console.setLevel(logging.WARNING)
+    console.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    logging.basicConfig(level=logging.INFO, handlers=[console])
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the console script.
 
@@ -300,7 +309,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if renamed is not None:
         print(f"lerobot-mtdagger {command}: error: {renamed}", file=sys.stderr)
         return 2
-    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    configure_console_logging()
     config_class, function = COMMANDS[command]
     try:
         config = draccus.parse(config_class=config_class, args=options, prog=f"lerobot-mtdagger {command}")

@@ -42,6 +42,7 @@ from lerobot_mtdagger.envs import IMAGE_KEY, suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.evaluate import EvalResult, PolicyRunner, evaluate
 from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.quiet import quiet_third_party
 from lerobot_mtdagger.records import PhaseRecord, RoundRecord, round_features
 from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
@@ -141,9 +142,10 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
     else:
         scheduler, allocation = schedule_round(ctx, round_index)
         counts = allocation.episodes_per_task
-        runner = PolicyRunner.from_pretrained(
-            ctx.experiment.policy_root(round_index - 1), config.policy.device
-        )
+        with quiet_third_party():  # LeRobot prints "Loading weights from local directory"
+            runner = PolicyRunner.from_pretrained(
+                ctx.experiment.policy_root(round_index - 1), config.policy.device
+            )
         beta, max_steps = beta_for_round(config, round_index), config.max_rollout_steps
     with tqdm(
         total=sum(counts), desc=f"round {round_index} collect", leave=False, disable=not ctx.show_progress
@@ -162,22 +164,17 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
             progress=lambda _: bar.update(1),
         )
     collected = time.perf_counter()
-    dataset = ctx.experiment.create_round(round_index, round_features(ctx.suite.features), ctx.task_names)
-    write_episodes(dataset, episodes, ctx.task_names)
+    dataset = ctx.experiment.write_round(
+        round_index,
+        round_features(ctx.suite.features),
+        ctx.task_names,
+        [(ctx.task_names[episode.task_index], episode.frames) for episode in episodes],
+    )
     record = round_record(ctx, round_index, counts, beta, episodes, scheduler, allocation)
     ctx.experiment.commit_round(round_index, dataset, record)
     ctx.timings.setdefault(round_index, {}).update(
         collect_s=collected - start, write_s=time.perf_counter() - collected
     )
-
-
-def write_episodes(dataset: Any, episodes: list[Episode], task_names: list[str]) -> None:
-    """Adds the recorded episodes to a round dataset, in (task, episode) order."""
-    for episode in episodes:
-        task = task_names[episode.task_index]
-        for frame in episode.frames:
-            dataset.add_frame({**frame, "task": task})
-        dataset.save_episode()
 
 
 def round_record(
@@ -274,7 +271,8 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     torch.manual_seed(phase_seed)
     policy = MTDAggerPolicy(policy_cfg)
     if config.warm_start and round_index > 0:
-        previous = MTDAggerPolicy.from_pretrained(str(ctx.experiment.policy_root(round_index - 1)))
+        with quiet_third_party():  # LeRobot prints "Loading weights from local directory"
+            previous = MTDAggerPolicy.from_pretrained(str(ctx.experiment.policy_root(round_index - 1)))
         policy.load_state_dict(previous.state_dict())
     preprocessor, postprocessor = build_processors(policy_cfg, stats)
     normalised = NormalisedData(data, preprocessor, image_keys, ctx.task_names)
@@ -389,7 +387,8 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         FloatingPointError: If training diverges.
         WorkerDiedError: If an env worker process dies.
     """
-    suite = suite_from_config(config)
+    with quiet_third_party():  # importing MetaWorld's renderer logs an OpenGL INFO line
+        suite = suite_from_config(config)
     check_budget(config, len(suite.task_names))
     experiment = ExperimentDir(config.output_dir)
     if config.resume:

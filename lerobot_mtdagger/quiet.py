@@ -1,0 +1,247 @@
+"""Silencing the third-party console noise of LeRobot calls, narrowly and only around our calls.
+
+What LeRobot 0.4.4 (and the libraries under it) print while an experiment writes and reads its rounds,
+and how each is handled here (all of it only while :func:`quiet_third_party` is active, and restored on
+exit; the user's logging configuration, progress-bar setting and warning filters are left as they were):
+
+- ``Map: 100%|...`` progress bars of the ``datasets`` library, one per episode: ``save_episode`` runs
+  ``datasets.Dataset.map`` (``lerobot.datasets.utils.embed_images``). Turned off with
+  ``datasets.disable_progress_bars()`` and put back to the previous state on exit. (LeRobot's own
+  ``SuppressProgressBars`` re-enables them unconditionally after every dataset load, which is why a
+  global ``disable_progress_bars()`` at start-up stops working after the first load.)
+  ``ExperimentDir.write_round`` does not call ``map`` at all for vector features.
+- ``INFO root: Using video codec: libsvtav1``: ``lerobot.datasets.video_utils.resolve_vcodec`` logs it
+  through the ROOT logger (``logging.info``) from every ``LeRobotDataset.create`` and every
+  ``LeRobotDataset(...)`` load, with or without videos. A :class:`logging.Filter` is attached to the
+  root logger itself (not to its handlers): a logger's filters only see records created on that
+  logger, so records of named loggers propagating to the root's handlers are not affected. It drops
+  only root-logger records from the module ``video_utils`` whose message starts with that text.
+  ``lerobot.datasets.aggregate`` (``merge_rounds``) logs its six step messages the same way; they are
+  dropped the same way (its two ``tqdm`` bars, one per phase, are left).
+- ``INFO OpenGL.acceleratesupport: No OpenGL_accelerate module loaded``: logged once when PyOpenGL is
+  first imported (by MetaWorld's renderer, when the suite is created). That logger's level is raised
+  to WARNING while active.
+- ``RuntimeWarning: Converting input from bool to <class 'numpy.uint8'>``: ``np.histogram`` in
+  ``lerobot.datasets.compute_stats`` warns on a bool feature (our ``learner_acted`` flag). Ignored by
+  message, category and module (filters other code adds inside the block are kept on exit).
+  (``ExperimentDir.write_round``
+  computes the same statistics without calling ``np.histogram`` on bools, so it never warns.)
+- ``Loading weights from local directory``: ``PreTrainedPolicy.from_pretrained`` prints it to
+  stdout. While active, ``sys.stdout`` is wrapped by a proxy that drops exactly that line and passes
+  everything else through unchanged.
+
+Example::
+
+    with quiet_third_party():
+        dataset = LeRobotDataset(repo_id, root=root)
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+import logging
+import sys
+import warnings
+from collections.abc import Iterable, Iterator, Mapping
+from typing import Any, TextIO
+
+logger = logging.getLogger(__name__)
+
+ROOT_MESSAGES: dict[str, tuple[str, ...]] = {
+    "video_utils": ("Using video codec: ",),
+    "aggregate": (
+        "Start aggregate_datasets",
+        "Find all tasks",
+        "write tasks",
+        "write info",
+        "write stats",
+        "Aggregation complete.",
+    ),
+}
+"""Root-logger messages dropped while quiet: LeRobot module (``LogRecord.module``) -> message starts.
+
+``lerobot.datasets.video_utils`` logs the codec on every dataset creation and load;
+``lerobot.datasets.aggregate`` logs its steps on every ``aggregate_datasets`` (``merge_rounds``)."""
+
+QUIETED_LOGGERS: dict[str, int] = {"OpenGL.acceleratesupport": logging.WARNING}
+"""Named third-party loggers and the level they get while quiet."""
+
+STDOUT_LINES: tuple[str, ...] = ("Loading weights from local directory",)
+"""Whole lines that third-party code prints to stdout and that are dropped while quiet."""
+
+IGNORED_WARNINGS: tuple[tuple[str, type[Warning], str], ...] = (
+    (
+        r"Converting input from bool to <class 'numpy\.uint8'> for compatibility\.",
+        RuntimeWarning,
+        r"lerobot\.datasets\.compute_stats",
+    ),
+)
+"""(message regex, category, module regex) of the warnings ignored while quiet."""
+
+
+class RootMessageFilter(logging.Filter):
+    """Drops root-logger records of given modules whose message starts with given prefixes."""
+
+    def __init__(self, messages: Mapping[str, Iterable[str]]) -> None:
+        """Matches a record whose ``module`` is a key and whose message starts with one of its values."""
+        super().__init__()
+        self.messages = {module: tuple(prefixes) for module, prefixes in messages.items()}
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        """False (drop) for a matching record, True otherwise."""
+        prefixes = self.messages.get(record.module) if record.name == "root" else None
+        return not prefixes or not record.getMessage().startswith(prefixes)
+
+
+class LineDroppingStream:
+    r"""A text stream proxy that drops exact lines written by ``print`` and forwards everything else.
+
+    ``print(text)`` writes ``text`` and then ``"\n"`` in two calls; a write equal to a dropped line
+    (with or without its newline) is swallowed together with the newline that follows it.
+    """
+
+    def __init__(self, stream: TextIO, lines: Iterable[str]) -> None:
+        """Wraps ``stream``; ``lines`` are the dropped lines, without their newline."""
+        self.stream = stream
+        self.lines = frozenset(lines)
+        self._swallow_newline = False
+
+    def write(self, text: str) -> int:
+        """Forwards ``text`` unless it is (the rest of) a dropped line."""
+        if self._swallow_newline:
+            self._swallow_newline = False
+            if text == "\n":
+                return len(text)
+        if text in self.lines:
+            self._swallow_newline = True
+            return len(text)
+        if text.endswith("\n") and text[:-1] in self.lines:
+            return len(text)
+        return self.stream.write(text)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.stream, name)
+
+
+@contextlib.contextmanager
+def warnings_ignored(
+    specs: Iterable[tuple[str, type[Warning], str]] = IGNORED_WARNINGS,
+) -> Iterator[None]:
+    """Ignores the given warnings (message regex, category, module regex) while active.
+
+    The warning filters are put back as they were on exit (:func:`warnings.catch_warnings`), except
+    that filters other code added inside the block are kept: a module imported inside the block runs
+    its import-time ``warnings.filterwarnings`` only once.
+    """
+    added: list[tuple] = []
+    try:
+        with warnings.catch_warnings():
+            for message, category, module in specs:
+                warnings.filterwarnings("ignore", message=message, category=category, module=module)
+            ours = list(warnings.filters)
+            try:
+                yield
+            finally:
+                added = [item for item in warnings.filters if item not in ours]
+    finally:
+        for action, message, category, module, lineno in reversed(added):
+            warnings.filterwarnings(
+                action,
+                message=message.pattern if message is not None else "",
+                category=category,
+                module=module.pattern if module is not None else "",
+                lineno=lineno,
+            )
+
+
+@contextlib.contextmanager
+def datasets_progress_bars_disabled() -> Iterator[None]:
+    """Disables the ``datasets`` progress bars while active, then restores the previous state.
+
+    The environment variable ``HF_DATASETS_DISABLE_PROGRESS_BARS``, when set, has priority and is
+    respected (nothing is changed then).
+    """
+    # The module: the attribute ``datasets.utils.tqdm`` is the tqdm class.
+    hf_tqdm = importlib.import_module("datasets.utils.tqdm")
+    forced = hf_tqdm.HF_DATASETS_DISABLE_PROGRESS_BARS
+    was_disabled = hf_tqdm.are_progress_bars_disabled()
+    if forced is None and not was_disabled:
+        hf_tqdm.disable_progress_bars()
+    try:
+        yield
+    finally:
+        if forced is None and hf_tqdm.are_progress_bars_disabled() != was_disabled:
+            if was_disabled:
+                hf_tqdm.disable_progress_bars()
+            else:
+                hf_tqdm.enable_progress_bars()
+
+
+@contextlib.contextmanager
+def root_messages_filtered(
+    messages: Mapping[str, Iterable[str]] = ROOT_MESSAGES,
+) -> Iterator[RootMessageFilter]:
+    """Drops matching root-logger records while active (see :class:`RootMessageFilter`)."""
+    root = logging.getLogger()
+    message_filter = RootMessageFilter(messages)
+    root.addFilter(message_filter)
+    try:
+        yield message_filter
+    finally:
+        root.removeFilter(message_filter)
+
+
+@contextlib.contextmanager
+def logger_levels(levels: dict[str, int]) -> Iterator[None]:
+    """Raises (never lowers) the level of the named loggers while active, then restores them.
+
+    A logger whose effective level is already at or above the given one is left untouched.
+    """
+    previous: dict[str, int] = {}
+    for name, level in levels.items():
+        named = logging.getLogger(name)
+        if named.getEffectiveLevel() < level:
+            previous[name] = named.level
+            named.setLevel(level)
+    try:
+        yield
+    finally:
+        for name, level in previous.items():
+            logging.getLogger(name).setLevel(level)
+
+
+@contextlib.contextmanager
+def stdout_lines_dropped(lines: Iterable[str] = STDOUT_LINES) -> Iterator[None]:
+    """Drops the given whole lines from ``sys.stdout`` while active (everything else passes)."""
+    original = sys.stdout
+    if original is None:  # no stdout at all (pythonw): nothing to drop
+        yield
+        return
+    proxy = LineDroppingStream(original, lines)
+    sys.stdout = proxy  # type: ignore[assignment]
+    try:
+        yield
+    finally:
+        if sys.stdout is proxy:
+            sys.stdout = original
+        else:  # someone replaced stdout inside the block: leave theirs in place
+            logger.debug("sys.stdout was replaced inside stdout_lines_dropped(); not restoring it")
+
+
+@contextlib.contextmanager
+def quiet_third_party() -> Iterator[None]:
+    """Silences the known per-call noise of LeRobot, ``datasets``, numpy and PyOpenGL while active.
+
+    See the module docstring for exactly what is silenced and how. Everything is restored on exit,
+    also when the block raises; nesting is fine. Like :func:`warnings.catch_warnings`, which it uses,
+    it changes process-wide state for its duration: other threads' matching noise is silenced too
+    (nothing else of theirs is).
+    """
+    with contextlib.ExitStack() as stack:
+        stack.enter_context(warnings_ignored())
+        stack.enter_context(datasets_progress_bars_disabled())
+        stack.enter_context(root_messages_filtered())
+        stack.enter_context(logger_levels(QUIETED_LOGGERS))
+        stack.enter_context(stdout_lines_dropped())
+        yield
