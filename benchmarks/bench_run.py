@@ -1,0 +1,141 @@
+"""One ``lerobot-mtdagger run`` end to end: wall time, its phase breakdown and peak memory.
+
+Run: ``.venv/bin/python benchmarks/bench_run.py`` (the README's main command: preset ``small``, MT10
+state) or, for example, ``.venv/bin/python benchmarks/bench_run.py --preset=metaworld-state
+--rounds=3`` (MT50). Every argument is passed to ``lerobot-mtdagger run``; the output goes to a
+temporary folder unless ``--output_dir`` is given.
+
+Printed:
+
+- wall time of the command (after the install: the imports and the env workers' start are in it);
+- per round, the phases the run timed itself (collect, write, load, train, eval); ``start-up and
+  the rest`` is the wall time minus their sum;
+- the load time per phase against the round index (it stays flat when only the new round is read);
+- peak memory: the largest sum, over the run's process tree (the main process and its env workers),
+  of the proportional set size (PSS: shared pages split between the processes that share them),
+  sampled every 0.1 s, and the largest RSS of a single process.
+
+Target (the default command): at most 60 s of wall time on the 2-core machine.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+TARGET_S = 60.0
+PHASES = ("collect_s", "write_s", "load_s", "train_s", "eval_s")
+
+
+def _children(pid: int) -> list[int]:
+    """Direct children of ``pid`` (Linux /proc)."""
+    path = Path(f"/proc/{pid}/task/{pid}/children")
+    try:
+        return [int(child) for child in path.read_text().split()]
+    except OSError:
+        return []
+
+
+def _tree(pid: int) -> list[int]:
+    """``pid`` and all its descendants."""
+    pids, frontier = [pid], [pid]
+    while frontier:
+        frontier = [child for parent in frontier for child in _children(parent)]
+        pids += frontier
+    return pids
+
+
+def _memory_kb(pid: int, field: str) -> int:
+    """A field of /proc/<pid>/smaps_rollup (``Pss``, ``Rss``) in kB; 0 when the process is gone."""
+    try:
+        for line in Path(f"/proc/{pid}/smaps_rollup").read_text().splitlines():
+            if line.startswith(field + ":"):
+                return int(line.split()[1])
+    except (OSError, ValueError):
+        return 0
+    return 0
+
+
+class MemorySampler(threading.Thread):
+    """Samples the PSS of a process tree until stopped; keeps the peaks."""
+
+    def __init__(self, pid: int) -> None:
+        super().__init__(daemon=True)
+        self.pid = pid
+        self.peak_pss_kb = 0
+        self.peak_rss_kb = 0
+        self.peak_processes = 0
+        self.stop = threading.Event()
+
+    def run(self) -> None:
+        while not self.stop.is_set():
+            pids = _tree(self.pid)
+            self.peak_pss_kb = max(self.peak_pss_kb, sum(_memory_kb(p, "Pss") for p in pids))
+            self.peak_rss_kb = max([self.peak_rss_kb] + [_memory_kb(p, "Rss") for p in pids])
+            self.peak_processes = max(self.peak_processes, len(pids))
+            self.stop.wait(0.1)
+
+
+def main() -> None:
+    args = sys.argv[1:]
+    if any(a in ("-h", "--help") for a in args):
+        print(__doc__)
+        return
+    with tempfile.TemporaryDirectory(prefix="bench-run-") as scratch:
+        if not any(a.startswith("--output_dir") for a in args):
+            args.append(f"--output_dir={Path(scratch) / 'run'}")
+        output = Path(next(a.split("=", 1)[1] for a in args if a.startswith("--output_dir")))
+        command = [str(Path(sys.executable).parent / "lerobot-mtdagger"), "run", "--progress=false", *args]
+        env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+        start = time.perf_counter()
+        process = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, text=True)
+        sampler = MemorySampler(process.pid)
+        sampler.start()
+        stdout, _ = process.communicate()
+        wall = time.perf_counter() - start
+        sampler.stop.set()
+        sampler.join()
+        if process.returncode != 0:
+            raise SystemExit(f"the run failed with exit status {process.returncode}")
+        report(command, stdout, wall, output, sampler)
+
+
+def report(command: list[str], stdout: str, wall: float, output: Path, sampler: MemorySampler) -> None:
+    """Prints the tables."""
+    print("$ " + " ".join(command[1:]))
+    print(stdout.rstrip())
+    rounds = sorted((output / "policies").glob("round-*"))
+    timings = [json.loads((r / "training.json").read_text())["timings"] for r in rounds]
+    print(f"\nwall time {wall:.1f} s; phases per round (s):")
+    print("| round | " + " | ".join(p.removesuffix("_s") for p in PHASES) + " | total |")
+    print("|------:|" + "------:|" * (len(PHASES) + 1))
+    totals = dict.fromkeys(PHASES, 0.0)
+    for index, timing in enumerate(timings):
+        values = [timing.get(p, 0.0) for p in PHASES]
+        for phase, value in zip(PHASES, values, strict=True):
+            totals[phase] += value
+        print(f"| {index} | " + " | ".join(f"{v:.1f}" for v in values) + f" | {sum(values):.1f} |")
+    print("| all | " + " | ".join(f"{totals[p]:.1f}" for p in PHASES) + f" | {sum(totals.values()):.1f} |")
+    print(f"start-up and the rest (imports, workers, summaries): {wall - sum(totals.values()):.1f} s")
+    loads = [t.get("load_s", 0.0) for t in timings]
+    if len(loads) > 1:
+        print(
+            f"load per phase against the round index: {[round(x, 3) for x in loads]} s "
+            f"(last / first = {loads[-1] / max(loads[0], 1e-9):.2f})"
+        )
+    print(
+        f"peak memory: {sampler.peak_pss_kb / 1024:.0f} MiB PSS summed over {sampler.peak_processes} "
+        f"processes; largest single-process RSS {sampler.peak_rss_kb / 1024:.0f} MiB"
+    )
+    verdict = "PASS" if wall <= TARGET_S else "FAIL"
+    print(f"{verdict}: wall time {wall:.1f} s (target for the default command <= {TARGET_S:.0f} s)")
+
+
+if __name__ == "__main__":
+    main()
