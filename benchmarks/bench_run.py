@@ -11,9 +11,10 @@ Printed:
 - per round, the phases the run timed itself (collect, write, load, train, eval); ``start-up and
   the rest`` is the wall time minus their sum;
 - the load time per phase against the round index (it stays flat when only the new round is read);
-- peak memory: the largest sum, over the run's process tree (the main process and its env workers),
-  of the proportional set size (PSS: shared pages split between the processes that share them),
-  sampled every 0.1 s, and the largest RSS of a single process.
+- peak memory of the run's process tree (the main process and its env workers): the largest sum of
+  RSS (sampled every 0.1 s; pages the forked workers share with the main process count once per
+  process), the largest sum of PSS (shared pages split between their sharers; sampled every 2 s,
+  reading it costs ~20 ms per process) and the largest RSS of a single process.
 
 Target (the default command): at most 60 s of wall time on the 2-core machine.
 """
@@ -62,28 +63,49 @@ def _memory_kb(pid: int, field: str) -> int:
     return 0
 
 
+def _rss_kb(pid: int) -> int:
+    """Resident set size of ``pid`` from /proc/<pid>/statm (cheap); 0 when the process is gone."""
+    try:
+        return int(Path(f"/proc/{pid}/statm").read_text().split()[1]) * os.sysconf("SC_PAGE_SIZE") // 1024
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
 class MemorySampler(threading.Thread):
-    """Samples the PSS of a process tree until stopped; keeps the peaks."""
+    """Samples the memory of a process tree until stopped; keeps the peaks.
+
+    RSS (cheap to read) every 0.1 s; PSS every ``PSS_EVERY`` samples, because reading
+    ``smaps_rollup`` of a 1 GB process costs about 20 ms and would slow the run it measures.
+    """
+
+    PSS_EVERY = 20
 
     def __init__(self, pid: int) -> None:
         super().__init__(daemon=True)
         self.pid = pid
         self.peak_pss_kb = 0
+        self.peak_rss_sum_kb = 0
         self.peak_rss_kb = 0
         self.peak_processes = 0
         self.stop = threading.Event()
 
     def run(self) -> None:
+        sample = 0
         while not self.stop.is_set():
             pids = _tree(self.pid)
-            self.peak_pss_kb = max(self.peak_pss_kb, sum(_memory_kb(p, "Pss") for p in pids))
-            self.peak_rss_kb = max([self.peak_rss_kb] + [_memory_kb(p, "Rss") for p in pids])
+            rss = [_rss_kb(p) for p in pids]
+            self.peak_rss_sum_kb = max(self.peak_rss_sum_kb, sum(rss))
+            self.peak_rss_kb = max([self.peak_rss_kb, *rss])
             self.peak_processes = max(self.peak_processes, len(pids))
+            if sample % self.PSS_EVERY == 0:
+                self.peak_pss_kb = max(self.peak_pss_kb, sum(_memory_kb(p, "Pss") for p in pids))
+            sample += 1
             self.stop.wait(0.1)
 
 
 def main() -> None:
     args = sys.argv[1:]
+    default_command = all(a.startswith("--output_dir") for a in args)
     if any(a in ("-h", "--help") for a in args):
         print(__doc__)
         return
@@ -103,11 +125,13 @@ def main() -> None:
         sampler.join()
         if process.returncode != 0:
             raise SystemExit(f"the run failed with exit status {process.returncode}")
-        report(command, stdout, wall, output, sampler)
+        report(command, stdout, wall, output, sampler, default_command)
 
 
-def report(command: list[str], stdout: str, wall: float, output: Path, sampler: MemorySampler) -> None:
-    """Prints the tables."""
+def report(
+    command: list[str], stdout: str, wall: float, output: Path, sampler: MemorySampler, default_command: bool
+) -> None:
+    """Prints the tables (and the verdict against the target for the default command)."""
     print("$ " + " ".join(command[1:]))
     print(stdout.rstrip())
     rounds = sorted((output / "policies").glob("round-*"))
@@ -124,17 +148,21 @@ def report(command: list[str], stdout: str, wall: float, output: Path, sampler: 
     print("| all | " + " | ".join(f"{totals[p]:.1f}" for p in PHASES) + f" | {sum(totals.values()):.1f} |")
     print(f"start-up and the rest (imports, workers, summaries): {wall - sum(totals.values()):.1f} s")
     loads = [t.get("load_s", 0.0) for t in timings]
-    if len(loads) > 1:
+    if len(loads) > 2:
+        # From round 1 on the load phase also reads the previous policy (warm start).
         print(
             f"load per phase against the round index: {[round(x, 3) for x in loads]} s "
-            f"(last / first = {loads[-1] / max(loads[0], 1e-9):.2f})"
+            f"(last / round 1 = {loads[-1] / max(loads[1], 1e-9):.2f})"
         )
     print(
-        f"peak memory: {sampler.peak_pss_kb / 1024:.0f} MiB PSS summed over {sampler.peak_processes} "
-        f"processes; largest single-process RSS {sampler.peak_rss_kb / 1024:.0f} MiB"
+        f"peak memory over {sampler.peak_processes} processes: "
+        f"RSS summed {sampler.peak_rss_sum_kb / 1024:.0f} "
+        f"MiB (counts shared pages once per process), PSS summed {sampler.peak_pss_kb / 1024:.0f} MiB "
+        f"(sampled every 2 s); largest single-process RSS {sampler.peak_rss_kb / 1024:.0f} MiB"
     )
-    verdict = "PASS" if wall <= TARGET_S else "FAIL"
-    print(f"{verdict}: wall time {wall:.1f} s (target for the default command <= {TARGET_S:.0f} s)")
+    if default_command:
+        verdict = "PASS" if wall <= TARGET_S else "FAIL"
+        print(f"{verdict}: wall time {wall:.1f} s (target for the default command <= {TARGET_S:.0f} s)")
 
 
 if __name__ == "__main__":

@@ -189,6 +189,9 @@ class RolloutWorker:
     ) -> tuple[dict[int, dict[str, np.ndarray]], list[tuple[int, Episode]]]:
         """Steps the episodes in ``actions``, then starts ``starts``.
 
+        Without a learner (``rules.learner`` false: the expert acts at every step) nothing depends
+        on the main process, so a started episode runs to its end here, in this one message.
+
         Args:
             starts: Episodes to start (their first observation is returned).
             actions: Learner action per running episode handle (None: no learner this call).
@@ -208,6 +211,12 @@ class RolloutWorker:
                 observations[handle] = running.observation
         for spec in starts:
             running = self._start(spec)
+            if not self.rules.learner:
+                while not self._step(running, None):
+                    pass
+                finished.append((spec.handle, running.episode))
+                self._release(running)
+                continue
             self.running[spec.handle] = running
             observations[spec.handle] = running.observation
         return observations, finished

@@ -54,10 +54,17 @@ def episode_key(episode):
     return (episode.task_index, episode.episode, episode.seed, episode.success, episode.steps, frames)
 
 
-def test_collection_is_identical_with_0_1_and_2_workers(suite):
-    results = {workers: [episode_key(e) for e in collect(suite, workers)] for workers in (0, 1, 2)}
+@pytest.mark.parametrize("beta", [0.5, 1.0])
+def test_collection_is_identical_with_0_1_and_2_workers(suite, beta):
+    """beta 1: expert demonstrations, which a worker runs to the end within one message."""
+    policy = tilted_learner if beta < 1 else None
+    results = {
+        workers: [episode_key(e) for e in collect(suite, workers, beta=beta, policy=policy)]
+        for workers in (0, 1, 2)
+    }
     assert len(results[0]) == 11
-    assert {e[3] for e in results[0]} == {True, False}, "the learner should both succeed and fail"
+    if beta < 1:
+        assert {e[3] for e in results[0]} == {True, False}, "the learner should both succeed and fail"
     assert results[1] == results[0]
     assert results[2] == results[0]
 
