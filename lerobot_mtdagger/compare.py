@@ -1,0 +1,210 @@
+"""``lerobot-mtdagger compare``: every method over many seeds, as ordinary runs in a process pool.
+
+Every (method, seed) and every (bc, seed, budget) is one ``lerobot-mtdagger run`` with the same run
+options, in its own folder under the compare folder::
+
+    <output_dir>/
+        runs/need-seed0/          an ordinary experiment folder (verify, merge, report work on it)
+        runs/bc-12demos-seed0/    BC with 12 expert demos per task
+        compare.json              what was asked (methods, seeds, budgets, run options)
+        results.csv, results.json one row per run x evaluated round (``results.py``)
+
+BC budgets are expert demos per task. The default is the cumulative demos per task of DAgger after
+each round (``initial_demos + k * budget_per_task``, k = 0..rounds), so BC has a point at every x
+where DAgger has one; BC at the budget of round k is ``run --mode=bc --rounds=k``, which also
+trains it for the same number of steps as DAgger up to round k.
+
+Runs are independent processes (``--jobs`` at once, default one per core); each gets
+``cores / jobs`` torch threads and env workers so the jobs do not oversubscribe the cores. A
+finished run is skipped, a cut-off run is resumed (``--resume=true``), so ``compare`` itself resumes.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import subprocess
+import sys
+from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import draccus
+
+from lerobot_mtdagger.configs import RunConfig, default_worker_count
+
+logger = logging.getLogger(__name__)
+
+RUNS_DIR = "runs"
+CONFIG_FILE = "config.json"  # rounds.CONFIG_FILE; rounds imports LeRobot, which the CLI loads lazily
+
+
+@dataclass
+class CompareConfig:
+    """Options of ``lerobot-mtdagger compare`` (any other ``--option`` is passed to every run).
+
+    Attributes:
+        methods: Scheduling methods and ``bc``.
+        seeds: Seeds; every method runs every seed.
+        bc_budgets: BC expert demos per task (empty: DAgger's cumulative demos after each round).
+        jobs: Runs at once (None: one per core).
+        output_dir: The compare folder.
+    """
+
+    methods: list[str] = field(default_factory=lambda: ["bc", "uniform", "need", "gain"])
+    seeds: list[int] = field(default_factory=lambda: [0, 1, 2])
+    bc_budgets: list[int] = field(default_factory=list)
+    jobs: int | None = None
+    output_dir: Path = Path("outputs/compare")
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run of the comparison."""
+
+    name: str
+    args: tuple[str, ...]
+
+
+def split_arguments(argv: Sequence[str]) -> tuple[list[str], list[str]]:
+    """Separates ``compare``'s own options from the run options passed through to every run."""
+    own_names = {f"--{name}" for name in CompareConfig.__dataclass_fields__}
+    own, passed = [], []
+    for arg in argv:
+        (own if arg.split("=", 1)[0] in own_names else passed).append(arg)
+    return own, passed
+
+
+def base_run_config(run_args: Sequence[str]) -> RunConfig:
+    """The run options every job shares, parsed once to check them and read the preset.
+
+    Raises:
+        ValueError: If the run options set what ``compare`` decides per job.
+    """
+    for arg in run_args:
+        if arg.split("=", 1)[0] in ("--seed", "--mode", "--scheduler.type", "--output_dir", "--resume"):
+            raise ValueError(f"{arg} is set per run by compare: use --methods/--seeds/--output_dir.")
+    return draccus.parse(RunConfig, args=list(run_args))
+
+
+def bc_rounds_for(config: RunConfig, budgets: Sequence[int], num_tasks: int) -> dict[int, int]:
+    """BC budget (demos per task) -> the ``--rounds`` that gives it.
+
+    Raises:
+        ValueError: On a budget that no whole number of rounds gives.
+    """
+    per_round = config.budget_for(num_tasks) / num_tasks
+    if not budgets:
+        return {int(config.initial_demos + k * per_round): k for k in range(config.rounds + 1)}
+    mapping = {}
+    for budget in budgets:
+        k = (budget - config.initial_demos) / per_round
+        if k < 0 or k != int(k):
+            valid = [int(config.initial_demos + j * per_round) for j in range(config.rounds + 4)]
+            raise ValueError(
+                f"BC budget {budget} demos per task is not initial_demos + k * budget per task "
+                f"({config.initial_demos} + k * {per_round:g}); choose among {valid}..."
+            )
+        mapping[int(budget)] = int(k)
+    return mapping
+
+
+def jobs_for(compare: CompareConfig, run_args: Sequence[str], num_tasks: int) -> list[Job]:
+    """Every run of the comparison, with the same seeds and run options for every method."""
+    config = base_run_config(run_args)
+    jobs = []
+    for seed in compare.seeds:
+        for method in compare.methods:
+            if method != "bc":
+                name = f"{method}-seed{seed}"
+                jobs.append(Job(name, (*run_args, f"--scheduler.type={method}", f"--seed={seed}")))
+                continue
+            for budget, rounds in sorted(bc_rounds_for(config, compare.bc_budgets, num_tasks).items()):
+                name = f"bc-{budget}demos-seed{seed}"
+                jobs.append(Job(name, (*run_args, "--mode=bc", f"--rounds={rounds}", f"--seed={seed}")))
+    return jobs
+
+
+def is_finished(folder: Path) -> bool:
+    """Whether the run in ``folder`` committed all its training phases."""
+    config_path = folder / CONFIG_FILE
+    if not config_path.exists():
+        return False
+    from lerobot_mtdagger.rounds import ExperimentDir
+
+    config = json.loads(config_path.read_text())
+    last = 0 if config["mode"] == "bc" else config["rounds"]
+    return last in ExperimentDir(folder).committed_phases()
+
+
+def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
+    """Runs (or resumes, or skips) one job in its own process; returns its folder.
+
+    Raises:
+        RuntimeError: If the run fails (its log is named).
+    """
+    folder = runs_dir / job.name
+    if is_finished(folder):
+        logger.info("%s: finished, skipped", job.name)
+        return folder
+    resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []
+    command = [
+        sys.executable,
+        "-m",
+        "lerobot_mtdagger.cli",
+        "run",
+        *job.args,
+        f"--output_dir={folder}",
+        f"--workers={workers}",
+        "--progress=false",
+        *resume,
+    ]
+    env = {**os.environ, "OMP_NUM_THREADS": str(threads), "MKL_NUM_THREADS": str(threads)}
+    log_path = runs_dir / f"{job.name}.log"
+    with log_path.open("a") as log:
+        status = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT, env=env, check=False)
+    if status.returncode != 0:
+        raise RuntimeError(f"Run {job.name} failed (exit {status.returncode}); see {log_path}.")
+    return folder
+
+
+def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict]:
+    """Runs every job and writes the results table; returns its rows.
+
+    Raises:
+        ValueError: On a bad option (nothing is run).
+        RuntimeError: If a run fails (the others still finish; rerun to resume).
+    """
+    if compare_config.jobs is not None and compare_config.jobs < 1:
+        raise ValueError(f"--jobs must be >= 1, got {compare_config.jobs}.")
+    if not compare_config.methods or not compare_config.seeds:
+        raise ValueError("--methods and --seeds must not be empty.")
+    from lerobot_mtdagger.envs import suite_from_config
+    from lerobot_mtdagger.results import results_rows, write_results
+
+    num_tasks = len(suite_from_config(base_run_config(run_args)).task_names)
+    jobs = jobs_for(compare_config, run_args, num_tasks)
+    cores = default_worker_count()
+    parallel = compare_config.jobs or cores
+    threads = max(1, cores // parallel)
+    workers = 0 if threads < 2 else threads
+    runs_dir = compare_config.output_dir / RUNS_DIR
+    runs_dir.mkdir(parents=True, exist_ok=True)
+    (compare_config.output_dir / "compare.json").write_text(
+        json.dumps(
+            {
+                "methods": compare_config.methods,
+                "seeds": compare_config.seeds,
+                "jobs": [job.name for job in jobs],
+                "run_args": list(run_args),
+            },
+            indent=1,
+        )
+    )
+    with ThreadPoolExecutor(max_workers=parallel) as pool:
+        folders = list(pool.map(lambda job: run_job(job, runs_dir, threads, workers), jobs))
+    rows = results_rows(folders)
+    write_results(rows, compare_config.output_dir)
+    return rows

@@ -1,0 +1,115 @@
+"""The results table of a set of experiments: one row per experiment and committed training phase.
+
+A row describes the policy trained on rounds 0..k of one run: its method and seed, the expert data
+behind it (demos and expert-labelled frames per task, cumulative), its evaluation success, the
+scheduler's signals at that point and the wall time of the round. ``write_results`` stores the rows
+as CSV (list columns as JSON) and JSON next to the runs.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow.parquet as pq
+
+from lerobot_mtdagger.rounds import ExperimentDir
+
+PHASE_TIMINGS = ("collect_s", "write_s", "load_s", "train_s", "eval_s")
+LIST_COLUMNS = (
+    "demos_per_task",
+    "expert_frames_per_task",
+    "eval_success",
+    "metric",
+    "kalman_p",
+    "raw_success",
+    "gain",
+)
+
+
+def round_frames_per_task(root: Path, num_tasks: int) -> list[int]:
+    """Frames per task stored in one round dataset (every stored frame carries an expert label)."""
+    counts = np.zeros(num_tasks, dtype=np.int64)
+    for path in sorted((root / "data").rglob("*.parquet")):
+        task_index = pq.read_table(path, columns=["task_index"]).column("task_index").to_numpy()
+        counts += np.bincount(task_index, minlength=num_tasks)[:num_tasks]
+    return counts.tolist()
+
+
+def experiment_rows(root: Path) -> list[dict[str, Any]]:
+    """The rows of one experiment, one per committed training phase with an evaluation.
+
+    Raises:
+        ValueError: If ``root`` is not an experiment with committed rounds.
+    """
+    experiment = ExperimentDir(root)
+    rounds = experiment.committed_rounds()
+    if not rounds:
+        raise ValueError(f"{root} has no committed round: is it a lerobot-mtdagger experiment?")
+    records = [experiment.read_round_record(k) for k in rounds]
+    num_tasks = len(records[0].task_names)
+    frames = np.zeros(num_tasks, dtype=np.int64)
+    rows = []
+    for k in experiment.committed_phases():
+        frames = frames + np.asarray(round_frames_per_task(experiment.round_root(k), num_tasks))
+        phase = experiment.read_phase_record(k)
+        if phase.eval is None:
+            continue
+        rows.append(_row(root, records, k, phase, frames))
+    return rows
+
+
+def _row(root: Path, records: list, k: int, phase: Any, frames: np.ndarray) -> dict[str, Any]:
+    record = records[k]
+    following = records[k + 1] if k + 1 < len(records) else None
+    config = record.config
+    demos = [int(d) for d in phase.demos_per_task]
+    return {
+        "experiment": str(root),
+        "method": record.method,
+        "seed": int(record.seed),
+        "round": int(k),
+        "preset": config.get("preset"),
+        "demos_per_task_mean": float(np.mean(demos)),
+        "demos_per_task": demos,
+        "expert_frames_per_task_mean": float(frames.mean()),
+        "expert_frames_per_task": frames.tolist(),
+        "eval_success_mean": float(phase.eval_mean),
+        "eval_success": [float(s) for s in phase.eval["success"]],
+        "eval_episodes_per_task": int(config.get("eval_episodes") or 0),
+        # The signals the scheduler saw after this phase (they decide round k+1's allocation).
+        "metric": following.metric if following is not None else None,
+        "kalman_p": following.kalman_posterior.get("p") if following is not None else None,
+        "raw_success": following.success_rate if following is not None else None,
+        "gain": [float(g) for g in phase.gain],
+        **{name: float(phase.timings.get(name, 0.0)) for name in PHASE_TIMINGS},
+    }
+
+
+def results_rows(roots: Sequence[Path]) -> list[dict[str, Any]]:
+    """The rows of every experiment, sorted by (method, seed, demos, round)."""
+    rows = [row for root in roots for row in experiment_rows(Path(root))]
+    return sorted(rows, key=lambda r: (r["method"], r["seed"], r["demos_per_task_mean"], r["round"]))
+
+
+def write_results(rows: Sequence[dict[str, Any]], folder: Path) -> tuple[Path, Path]:
+    """Writes ``results.csv`` and ``results.json`` into ``folder``; returns their paths.
+
+    Raises:
+        ValueError: If there is no row.
+    """
+    if not rows:
+        raise ValueError("No evaluated training phase in these experiments: nothing to tabulate.")
+    folder.mkdir(parents=True, exist_ok=True)
+    json_path, csv_path = folder / "results.json", folder / "results.csv"
+    json_path.write_text(json.dumps(list(rows), indent=1))
+    with csv_path.open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: json.dumps(v) if k in LIST_COLUMNS else v for k, v in row.items()})
+    return csv_path, json_path
