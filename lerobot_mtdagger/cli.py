@@ -29,6 +29,7 @@ from pathlib import Path
 import draccus
 import numpy as np
 
+from lerobot_mtdagger.compare import CompareConfig, split_arguments
 from lerobot_mtdagger.configs import RunConfig, default_worker_count, renamed_option_error
 from lerobot_mtdagger.hub import PushConfig, push_command
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
@@ -236,32 +237,73 @@ class ReportConfig:
 
     Attributes:
         experiments: Experiment directories (several seeds of several methods).
+        compare_dir: A ``compare`` folder (its runs are the experiments); instead of ``experiments``.
+        output_dir: Folder for the figures and ``report.md`` (default ``<compare_dir>/report``; with
+            ``experiments`` only, no figures unless given).
         output: Optional markdown file for the table.
+        levels: Success levels of the "demos to reach" and "time to reach" figures.
     """
 
     experiments: list[Path] = field(default_factory=list)
+    compare_dir: Path | None = None
+    output_dir: Path | None = None
     output: Path | None = None
+    levels: list[float] = field(default_factory=lambda: [0.5, 0.6, 0.7, 0.8])
 
     def __post_init__(self) -> None:
-        if not self.experiments:
+        if not self.experiments and self.compare_dir is None:
             raise ValueError(
-                "--experiments is required, e.g. --experiments='[outputs/need-s0,outputs/bc-s0]'."
+                "--experiments or --compare_dir is required, e.g. "
+                "--experiments='[outputs/need-s0,outputs/bc-s0]' or --compare_dir=outputs/compare."
             )
+        if self.compare_dir is not None and not (self.compare_dir / "runs").is_dir():
+            raise ValueError(f"{self.compare_dir} is not a compare folder (no runs/ in it).")
+        if self.compare_dir is not None and self.output_dir is None:
+            self.output_dir = self.compare_dir / "report"
+
+    @property
+    def experiment_dirs(self) -> list[Path]:
+        """The experiments to report on."""
+        if self.compare_dir is None:
+            return list(self.experiments)
+        runs = sorted(p for p in (self.compare_dir / "runs").iterdir() if p.is_dir())
+        return [*self.experiments, *runs]
 
 
 def report_command(config: ReportConfig) -> str:
-    """Prints the learning curves (mean and std over seeds) of the given experiments."""
+    """Prints the learning curves (mean and std over seeds); writes the figures and summary."""
     from lerobot_mtdagger.report import learning_curves, markdown_table
 
-    table = markdown_table(learning_curves(config.experiments))
+    table = markdown_table(learning_curves(config.experiment_dirs))
     print(table)
     if config.output is not None:
         config.output.write_text(table + "\n")
+    if config.output_dir is not None:
+        from lerobot_mtdagger.figures import write_report
+        from lerobot_mtdagger.results import results_rows, write_results
+        from lerobot_mtdagger.rounds import ExperimentDir
+
+        rows = results_rows(config.experiment_dirs)
+        task_names = ExperimentDir(config.experiment_dirs[0]).read_round_record(0).task_names
+        write_results(rows, config.output_dir)
+        path = write_report(rows, task_names, config.output_dir, levels=config.levels)
+        print(f"figures and summary: {path}")
     return table
+
+
+def compare_command(config: CompareConfig, run_args: list[str]) -> list[dict]:
+    """Runs every method over every seed (and BC at every budget) and writes the results table."""
+    from lerobot_mtdagger.compare import compare
+
+    rows = compare(config, run_args)
+    runs = len({row["experiment"] for row in rows})
+    print(f"{runs} runs, {len(rows)} evaluated rounds: {config.output_dir / 'results.csv'}")
+    return rows
 
 
 COMMANDS: dict[str, tuple[type, Callable]] = {
     "run": (RunConfig, run_experiment),
+    "compare": (CompareConfig, compare_command),
     "eval": (EvalConfig, eval_command),
     "verify": (VerifyConfig, verify_command),
     "merge": (MergeConfig, merge_command),
@@ -311,6 +353,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     configure_console_logging()
     config_class, function = COMMANDS[command]
+    passed: list[str] = []
+    if command == "compare":  # compare's own options; every other option goes to each run
+        options, passed = split_arguments(options)
     try:
         config = draccus.parse(config_class=config_class, args=options, prog=f"lerobot-mtdagger {command}")
     except draccus.utils.ParsingError as error:
@@ -318,7 +363,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         cause = error.__cause__ if error.__cause__ is not None else error
         print(f"lerobot-mtdagger {command}: error: {cause}", file=sys.stderr)
         return 2
-    function(config)
+    function(config, passed) if command == "compare" else function(config)
     return 0
 
 

@@ -40,7 +40,10 @@ def experiment_curve(root: Path) -> tuple[str, int, list[tuple[int, float, float
         phase = experiment.read_phase_record(round_index)
         if phase.eval_mean is not None:
             points.append((round_index, float(np.mean(phase.demos_per_task)), phase.eval_mean))
-    return record.method, record.seed, points
+    method = record.method
+    if method == "bc":  # BC at several budgets: one group per budget (a point each)
+        method = f"bc ({np.mean(record.demos_so_far):g} demos/task)"
+    return method, record.seed, points
 
 
 def learning_curves(roots: Sequence[Path]) -> list[CurvePoint]:

@@ -1,0 +1,400 @@
+"""The paper's figures and a markdown summary, from a results table (``results.py``).
+
+Every curve is the mean over seeds with a 95% t confidence band (``stats.mean_interval``); BC runs
+are points (one per data budget) with 95% error bars. Figures, each a PNG in the report folder:
+
+1. ``success_vs_demos.png``: average evaluation success against expert demos per task;
+   ``success_vs_frames.png``: the same against expert-labelled frames per task (expert queries);
+2. ``demos_to_reach.png``: demos per task needed to reach each success level (interpolated per
+   seed; seeds that never reach a level are counted in the bar label, never dropped silently);
+3. ``metrics_vs_success.png``: the task-need estimate (1 - Kalman p) and the performance gain per
+   task after the last scheduled round, against the final evaluated success, with Pearson's r;
+4. ``hardest_tasks.png``: success curves on the two hardest tasks (lowest BC success at the largest
+   budget; lowest final success over all runs when there is no BC);
+5. ``kalman_ablation.png``: task need with (``need``) and without (``need_raw``) the Kalman filter;
+6. ``time_to_reach.png``: wall time (collection + training + evaluation) to reach each level.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lerobot_mtdagger.stats import Interval, correlation, demos_to_reach, mean_interval, paired_difference
+
+LEVELS = (0.5, 0.6, 0.7, 0.8)
+PHASE_TIMINGS = ("collect_s", "write_s", "load_s", "train_s", "eval_s")
+BASELINES = ("uniform", "bc")
+Row = dict[str, Any]
+
+
+# -------------------------------------------------------------------------------------------------
+# Curves from rows
+# -------------------------------------------------------------------------------------------------
+
+
+def runs_by_method(rows: Sequence[Row]) -> dict[str, dict[int, list[Row]]]:
+    """Method -> seed -> that seed's rows as one curve, ordered by demos.
+
+    A DAgger run is one curve (its rounds); BC runs of one seed at several budgets form one curve
+    (one point per budget).
+    """
+    grouped: dict[str, dict[int, list[Row]]] = defaultdict(lambda: defaultdict(list))
+    for row in rows:
+        grouped[row["method"]][row["seed"]].append(row)
+    for seeds in grouped.values():
+        for seed, curve in seeds.items():
+            seeds[seed] = sorted(curve, key=lambda r: (r["demos_per_task_mean"], r["round"]))
+    return {method: dict(seeds) for method, seeds in sorted(grouped.items())}
+
+
+def curve_points(seeds: dict[int, list[Row]], x_key: str, y_of=None) -> list[tuple[float, Interval]]:
+    """Mean x and the interval of y over seeds, point by point (the k-th point of every seed).
+
+    Raises:
+        ValueError: If the seeds' curves have different lengths (different budgets or rounds).
+    """
+    y_of = y_of or (lambda row: row["eval_success_mean"])
+    lengths = {len(curve) for curve in seeds.values()}
+    if len(lengths) != 1:
+        raise ValueError(
+            f"Seeds with different numbers of points {sorted(lengths)}: rerun compare to finish."
+        )
+    points = []
+    for k in range(lengths.pop()):
+        column = [curve[k] for curve in seeds.values()]
+        points.append((float(np.mean([r[x_key] for r in column])), mean_interval([y_of(r) for r in column])))
+    return points
+
+
+def seed_reach(curve: Sequence[Row], level: float, x_values) -> float | None:
+    """The demos, frames or seconds at which one seed's curve first reaches ``level``.
+
+    Interpolated along the curve when x increases along it; otherwise (the run times of BC runs at
+    several budgets) the smallest x among the points that reach the level.
+    """
+    xs = list(x_values(curve))
+    success = [row["eval_success_mean"] for row in curve]
+    if all(b > a for a, b in zip(xs, xs[1:], strict=False)):
+        return demos_to_reach(xs, success, level)
+    reached = [x for x, s in zip(xs, success, strict=True) if s >= level]
+    return min(reached) if reached else None
+
+
+def demos_of(curve: Sequence[Row]) -> list[float]:
+    """Mean expert demos per task at each point of a curve."""
+    return [row["demos_per_task_mean"] for row in curve]
+
+
+def cumulative_seconds(curve: Sequence[Row]) -> list[float]:
+    """Wall time spent up to each point of a DAgger curve (BC: each point's own run)."""
+    if curve and curve[0]["method"] == "bc":
+        return [sum(row[name] for name in PHASE_TIMINGS) for row in curve]
+    return list(np.cumsum([sum(row[name] for name in PHASE_TIMINGS) for row in curve]))
+
+
+# -------------------------------------------------------------------------------------------------
+# Figures
+# -------------------------------------------------------------------------------------------------
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _caption(rows: Sequence[Row]) -> str:
+    seeds = len({row["seed"] for row in rows})
+    episodes = sorted({row["eval_episodes_per_task"] for row in rows})
+    return f"mean over {seeds} seeds, 95% t interval; {'/'.join(map(str, episodes))} eval episodes per task"
+
+
+def plot_success(rows: Sequence[Row], x_key: str, x_label: str, path: Path, methods=None) -> Path:
+    """Figure 1 (and 5 with ``methods``): success against demos or frames, one curve per method."""
+    plt = _pyplot()
+    figure, axis = plt.subplots(figsize=(7, 4.5))
+    for method, seeds in runs_by_method(rows).items():
+        if methods is not None and method not in methods:
+            continue
+        points = curve_points(seeds, x_key)
+        x = [p for p, _ in points]
+        mean = np.array([i.mean for _, i in points])
+        # Success is a fraction: the band is drawn within [0, 1] (a t interval over few seeds is wide).
+        low = np.clip([i.low for _, i in points], 0.0, 1.0)
+        high = np.clip([i.high for _, i in points], 0.0, 1.0)
+        if method == "bc":
+            error = np.nan_to_num(np.vstack([mean - low, high - mean]))
+            axis.errorbar(x, mean, yerr=error, fmt="s", capsize=3, label="BC (one round)", color="black")
+        else:
+            (line,) = axis.plot(x, mean, marker="o", label=method)
+            axis.fill_between(x, low, high, alpha=0.2, color=line.get_color())
+    axis.set_xlabel(x_label)
+    axis.set_ylabel("average evaluation success (fraction of episodes)")
+    axis.set_ylim(-0.02, 1.02)
+    axis.set_title("Success against expert data" if methods is None else "Task need with and without Kalman")
+    _legend(axis)
+    axis.grid(alpha=0.3)
+    figure.text(0.01, 0.01, _caption(rows), fontsize=8)
+    return _save(figure, path)
+
+
+def plot_reach(
+    rows: Sequence[Row], levels: Sequence[float], path: Path, x_values, x_label: str, title: str
+) -> Path:
+    """Figures 2 and 6: x needed to reach each level, per method (bars: mean, whiskers: 95%)."""
+    plt = _pyplot()
+    figure, axis = plt.subplots(figsize=(8, 4.5))
+    grouped = runs_by_method(rows)
+    width = 0.8 / max(len(grouped), 1)
+    for position, (method, seeds) in enumerate(grouped.items()):
+        for level_index, level in enumerate(levels):
+            reached = [seed_reach(curve, level, x_values) for curve in seeds.values()]
+            values = [v for v in reached if v is not None]
+            x = level_index + (position - (len(grouped) - 1) / 2) * width
+            missing = len(reached) - len(values)
+            if values:
+                interval = mean_interval(values)
+                error = 0.0 if math.isnan(interval.half_width) else interval.half_width
+                axis.bar(
+                    x,
+                    interval.mean,
+                    width,
+                    yerr=error,
+                    capsize=2,
+                    color=f"C{position}",
+                    label=method if level_index == 0 else None,
+                )
+            label = f"{len(values)}/{len(reached)}" if missing else ""
+            axis.text(x, 0, label or "", ha="center", va="bottom", fontsize=7, rotation=90)
+    axis.set_xticks(range(len(levels)), [f"{level:.0%}" for level in levels])
+    axis.set_xlabel("average success level (bars marked k/n: only k of n seeds reached it)")
+    axis.set_ylabel(x_label)
+    axis.set_title(title)
+    _legend(axis)
+    axis.grid(alpha=0.3, axis="y")
+    figure.text(0.01, 0.01, _caption(rows), fontsize=8)
+    return _save(figure, path)
+
+
+def plot_metrics(rows: Sequence[Row], path: Path) -> tuple[Path, dict[str, float]]:
+    """Figure 3: task need (1 - Kalman p) and gain per task, last scheduled round, vs final success."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(1, 2, figsize=(10, 4.5))
+    coefficients = {}
+    for axis, (method, key, label) in zip(
+        axes,
+        [("need", "kalman_p", "task need 1 - p (Kalman)"), ("gain", "gain", "performance gain")],
+        strict=True,
+    ):
+        x_all, y_all = [], []
+        for curve in runs_by_method(rows).get(method, {}).values():
+            scheduled = [row for row in curve if row.get(key)]
+            if not scheduled:
+                continue
+            values = np.asarray(scheduled[-1][key], dtype=float)
+            x_all += (1.0 - values if key == "kalman_p" else values).tolist()
+            y_all += curve[-1]["eval_success"]
+        coefficients[method] = correlation(x_all, y_all)
+        axis.scatter(x_all, y_all, alpha=0.6)
+        axis.set_xlabel(f"{label} per task, last scheduled round")
+        axis.set_ylabel("final evaluation success per task")
+        axis.set_title(f"{method}: r = {coefficients[method]:.2f} ({len(x_all)} task-seeds)")
+        axis.grid(alpha=0.3)
+    figure.text(0.01, 0.01, _caption(rows), fontsize=8)
+    return _save(figure, path), coefficients
+
+
+def hardest_tasks(rows: Sequence[Row], count: int = 2) -> list[int]:
+    """Task indices with the lowest BC success at the largest budget (else lowest final success)."""
+    bc = [row for row in rows if row["method"] == "bc"]
+    if bc:
+        largest = max(row["demos_per_task_mean"] for row in bc)
+        pool = [row for row in bc if row["demos_per_task_mean"] == largest]
+    else:
+        last = max(row["round"] for row in rows)
+        pool = [row for row in rows if row["round"] == last]
+    success = np.mean([row["eval_success"] for row in pool], axis=0)
+    return [int(i) for i in np.argsort(success, kind="stable")[:count]]
+
+
+def plot_hardest(rows: Sequence[Row], task_names: Sequence[str], path: Path) -> tuple[Path, list[int]]:
+    """Figure 4: success curves of every method on the two hardest tasks."""
+    plt = _pyplot()
+    tasks = hardest_tasks(rows)
+    figure, axes = plt.subplots(1, len(tasks), figsize=(5 * len(tasks), 4.5), squeeze=False)
+    for axis, task in zip(axes[0], tasks, strict=True):
+        for method, seeds in runs_by_method(rows).items():
+            points = curve_points(
+                seeds, "demos_per_task_mean", y_of=lambda row, t=task: row["eval_success"][t]
+            )
+            x = [np.mean([c[k]["demos_per_task"][task] for c in seeds.values()]) for k in range(len(points))]
+            mean = [i.mean for _, i in points]
+            style = "s" if method == "bc" else "o-"
+            axis.plot(x, mean, style, label=method)
+            low, high = [i.low for _, i in points], [i.high for _, i in points]
+            if method != "bc":
+                axis.fill_between(x, low, high, alpha=0.15)
+        axis.set_title(f"{task_names[task]}")
+        axis.set_xlabel("expert demos of this task")
+        axis.set_ylabel("evaluation success on this task")
+        axis.set_ylim(-0.02, 1.02)
+        axis.grid(alpha=0.3)
+        _legend(axis)
+    figure.suptitle("The two hardest tasks")
+    figure.text(0.01, 0.01, _caption(rows), fontsize=8)
+    return _save(figure, path), tasks
+
+
+def _legend(axis) -> None:
+    """A legend when something on the axis has a label (a level no seed reached draws nothing)."""
+    if axis.get_legend_handles_labels()[0]:
+        axis.legend()
+
+
+def _save(figure, path: Path) -> Path:
+    figure.tight_layout(rect=(0, 0.04, 1, 1))
+    figure.savefig(path, dpi=110)
+    import matplotlib.pyplot as plt
+
+    plt.close(figure)
+    return path
+
+
+# -------------------------------------------------------------------------------------------------
+# Summary
+# -------------------------------------------------------------------------------------------------
+
+
+def paired_rows(rows: Sequence[Row], method: str, baseline: str) -> list[tuple[float, Interval]]:
+    """Paired differences (method - baseline) of success over the seeds both ran, at every common budget."""
+    grouped = runs_by_method(rows)
+    if method not in grouped or baseline not in grouped:
+        return []
+    seeds = sorted(set(grouped[method]) & set(grouped[baseline]))
+    comparisons = []
+    budgets = sorted({r["demos_per_task_mean"] for r in rows if r["method"] == method})
+    for budget in budgets:
+        pairs = []
+        for seed in seeds:
+            a = [r for r in grouped[method][seed] if r["demos_per_task_mean"] == budget]
+            b = [r for r in grouped[baseline][seed] if r["demos_per_task_mean"] == budget]
+            if a and b:
+                pairs.append((a[0]["eval_success_mean"], b[0]["eval_success_mean"]))
+        if pairs:
+            comparisons.append((budget, paired_difference([p[0] for p in pairs], [p[1] for p in pairs])))
+    return comparisons
+
+
+def demos_ratio(
+    rows: Sequence[Row], method: str, baseline: str, level: float
+) -> tuple[float | None, int, int]:
+    """Mean over paired seeds of demos(method) / demos(baseline) to reach ``level``; pairs; seeds."""
+    grouped = runs_by_method(rows)
+    seeds = sorted(set(grouped.get(method, {})) & set(grouped.get(baseline, {})))
+    ratios = []
+    for seed in seeds:
+        a = seed_reach(grouped[method][seed], level, demos_of)
+        b = seed_reach(grouped[baseline][seed], level, demos_of)
+        if a is not None and b is not None:
+            ratios.append(a / b)
+    return (float(np.mean(ratios)) if ratios else None), len(ratios), len(seeds)
+
+
+def _format(interval: Interval) -> str:
+    if math.isnan(interval.low):
+        return f"{interval.mean:+.3f} (one seed, no interval)"
+    mark = " *" if interval.excludes_zero() else ""
+    return f"{interval.mean:+.3f} [{interval.low:+.3f}, {interval.high:+.3f}]{mark}"
+
+
+def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[str, Any], levels) -> str:
+    """The report: figures embedded, paired differences and demo ratios per pair of methods."""
+    lines = ["# Method comparison", "", _caption(rows) + ".", ""]
+    for title, path in figures.items():
+        lines += [f"## {title}", "", f"![{title}]({path.name})", ""]
+    lines += [f"Pearson r, metric vs final success: {notes['correlations']}.", ""]
+    lines += [f"Hardest tasks: {notes['hardest']}.", ""]
+    lines += ["## Paired differences of average success (method - baseline), 95% t interval over seeds", ""]
+    lines += ["`*`: the interval excludes 0.", "", "| method | baseline | demos per task | difference |"]
+    lines += ["|---|---|---:|---|"]
+    methods = [m for m in runs_by_method(rows) if m not in BASELINES]
+    pairs = [(m, b) for m in methods for b in BASELINES] + [("uniform", "bc")]
+    for method, baseline in pairs:
+        for budget, interval in paired_rows(rows, method, baseline):
+            lines.append(f"| {method} | {baseline} | {budget:.1f} | {_format(interval)} |")
+    lines += ["", "## Demos needed to reach a level, ratio method / baseline (mean over paired seeds)", ""]
+    lines += [
+        "| method | baseline | level | ratio | seeds where both reached it |",
+        "|---|---|---:|---:|---:|",
+    ]
+    for method, baseline in pairs:
+        for level in levels:
+            ratio, paired, seeds = demos_ratio(rows, method, baseline, level)
+            shown = "n/a" if ratio is None else f"{ratio:.2f}"
+            lines.append(f"| {method} | {baseline} | {level:.0%} | {shown} | {paired}/{seeds} |")
+    return "\n".join(lines) + "\n"
+
+
+def write_report(rows: Sequence[Row], task_names: Sequence[str], folder: Path, levels=LEVELS) -> Path:
+    """Writes every figure and ``report.md`` into ``folder``; returns the markdown path.
+
+    Raises:
+        ValueError: If there is no row.
+    """
+    if not rows:
+        raise ValueError("No evaluated round in these experiments: nothing to report.")
+    folder.mkdir(parents=True, exist_ok=True)
+    figures = {
+        "Success against expert demos": plot_success(
+            rows, "demos_per_task_mean", "expert demos per task (episodes)", folder / "success_vs_demos.png"
+        ),
+        "Success against expert-labelled frames": plot_success(
+            rows,
+            "expert_frames_per_task_mean",
+            "expert-labelled frames per task",
+            folder / "success_vs_frames.png",
+        ),
+        "Demos needed to reach a level": plot_reach(
+            rows,
+            levels,
+            folder / "demos_to_reach.png",
+            demos_of,
+            "expert demos per task",
+            "Demos to reach a level",
+        ),
+        "Wall time to reach a level": plot_reach(
+            rows,
+            levels,
+            folder / "time_to_reach.png",
+            cumulative_seconds,
+            "wall time (s: collect + write + load + train + eval)",
+            "Time to reach a level",
+        ),
+    }
+    metrics_path, correlations = plot_metrics(rows, folder / "metrics_vs_success.png")
+    hardest_path, hardest = plot_hardest(rows, task_names, folder / "hardest_tasks.png")
+    figures["Scheduler metrics against final success"] = metrics_path
+    figures["The two hardest tasks"] = hardest_path
+    figures["Task need with and without the Kalman filter"] = plot_success(
+        rows,
+        "demos_per_task_mean",
+        "expert demos per task (episodes)",
+        folder / "kalman_ablation.png",
+        methods={"need", "need_raw"},
+    )
+    notes = {
+        "correlations": {k: round(v, 3) for k, v in correlations.items()},
+        "hardest": [task_names[t] for t in hardest],
+    }
+    path = folder / "report.md"
+    path.write_text(summary_markdown(rows, figures, notes, levels))
+    return path

@@ -1,0 +1,118 @@
+"""``compare`` and ``report`` end to end on the toy suite: every method x seed x round in the table,
+BC at every budget, every figure written; plus the helpers' arithmetic and bad input."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+
+from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.compare import CompareConfig, bc_rounds_for, jobs_for, split_arguments
+from lerobot_mtdagger.configs import RunConfig
+from lerobot_mtdagger.figures import hardest_tasks, seed_reach
+
+TINY = [
+    "--suite=toy",
+    "--rounds=2",
+    "--initial_demos=1",
+    "--budget_per_task=2",
+    "--steps_per_round=20",
+    "--eval_episodes=2",
+    "--policy.batch_size=32",
+    "--policy.state_hidden_dims=[32]",
+    "--policy.head_hidden_dims=[32]",
+]
+FIGURES = [
+    "success_vs_demos.png",
+    "success_vs_frames.png",
+    "demos_to_reach.png",
+    "time_to_reach.png",
+    "metrics_vs_success.png",
+    "hardest_tasks.png",
+    "kalman_ablation.png",
+]
+
+
+@pytest.fixture(scope="module")
+def compared(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("compare") / "cmp"
+    args = ["compare", "--methods=[bc,uniform,need,need_raw,gain]", "--seeds=[0,1]", f"--output_dir={folder}"]
+    assert main([*args, "--jobs=2", *TINY]) == 0
+    return folder, args
+
+
+def test_the_table_holds_every_method_seed_and_round_and_bc_at_every_budget(compared):
+    folder, _ = compared
+    rows = json.loads((folder / "results.json").read_text())
+    dagger = {(r["method"], r["seed"], r["round"]) for r in rows if r["method"] != "bc"}
+    assert dagger == {
+        (m, s, k) for m in ("uniform", "need", "need_raw", "gain") for s in (0, 1) for k in (0, 1, 2)
+    }
+    bc = {(r["seed"], r["demos_per_task_mean"]) for r in rows if r["method"] == "bc"}
+    assert bc == {(s, d) for s in (0, 1) for d in (1.0, 3.0, 5.0)}  # DAgger's demos after each round
+    need = [r for r in rows if r["method"] == "need" and r["seed"] == 0]
+    assert [r["demos_per_task_mean"] for r in need] == [1.0, 3.0, 5.0]
+    frames = [r["expert_frames_per_task_mean"] for r in need]
+    assert frames == sorted(frames) and frames[0] > 0
+    assert need[0]["kalman_p"] is not None and len(need[0]["eval_success"]) == 3
+    with (folder / "results.csv").open() as handle:
+        assert len(list(csv.DictReader(handle))) == len(rows)
+
+
+def test_a_second_compare_skips_finished_runs(compared):
+    folder, args = compared
+    before = {p.name: p.stat().st_mtime_ns for p in (folder / "runs").glob("*/policies/round-*")}
+    assert main([*args, "--jobs=1", *TINY]) == 0
+    after = {p.name: p.stat().st_mtime_ns for p in (folder / "runs").glob("*/policies/round-*")}
+    assert before == after
+
+
+def test_report_writes_every_figure_and_the_paired_differences(compared, capsys):
+    folder, _ = compared
+    assert main(["report", f"--compare_dir={folder}"]) == 0
+    report = folder / "report"
+    for name in FIGURES:
+        assert (report / name).stat().st_size > 10_000, name
+    summary = (report / "report.md").read_text()
+    for name in FIGURES:
+        assert f"]({name})" in summary
+    assert "| need | uniform | 3.0 |" in summary and "| gain | bc | 5.0 |" in summary
+    assert "mean over 2 seeds, 95% t interval; 2 eval episodes per task" in summary
+    assert "bc (1 demos/task)" in capsys.readouterr().out  # the table keeps BC budgets apart
+
+
+def test_bc_budgets_map_to_rounds_and_bad_ones_are_refused():
+    config = RunConfig(suite="toy", rounds=2, initial_demos=1, budget_per_task=2)
+    assert bc_rounds_for(config, [], 3) == {1: 0, 3: 1, 5: 2}
+    assert bc_rounds_for(config, [7], 3) == {7: 3}
+    with pytest.raises(ValueError, match="not initial_demos \\+ k"):
+        bc_rounds_for(config, [4], 3)
+
+
+def test_every_method_gets_the_same_seeds_and_run_options():
+    own, passed = split_arguments(["--methods=[need,bc]", "--seeds=[3]", *TINY])
+    assert own == ["--methods=[need,bc]", "--seeds=[3]"] and passed == TINY
+    jobs = jobs_for(CompareConfig(methods=["need", "bc"], seeds=[3], bc_budgets=[3]), passed, 3)
+    assert [job.name for job in jobs] == ["need-seed3", "bc-3demos-seed3"]
+    assert all("--seed=3" in job.args and set(TINY) <= set(job.args) for job in jobs)
+    with pytest.raises(ValueError, match="set per run by compare"):
+        jobs_for(CompareConfig(), [*TINY, "--seed=1"], 3)
+
+
+def test_reach_interpolates_along_dagger_and_takes_the_cheapest_bc_run():
+    curve = [{"eval_success_mean": s, "x": x} for x, s in [(1, 0.2), (3, 0.6), (5, 0.9)]]
+    assert seed_reach(curve, 0.5, lambda c: [r["x"] for r in c]) == pytest.approx(2.5)
+    times = [10.0, 8.0, 12.0]  # BC runs at growing budgets need not take growing times
+    assert seed_reach(curve, 0.5, lambda c: times) == 8.0
+    assert seed_reach(curve, 0.95, lambda c: times) is None
+
+
+def test_hardest_tasks_are_those_bc_fails_most_at_its_largest_budget():
+    rows = [
+        {"method": "bc", "demos_per_task_mean": 1.0, "round": 0, "eval_success": [0.0, 0.0, 0.0]},
+        {"method": "bc", "demos_per_task_mean": 5.0, "round": 0, "eval_success": [0.9, 0.2, 0.5]},
+        {"method": "need", "demos_per_task_mean": 5.0, "round": 2, "eval_success": [0.0, 1.0, 1.0]},
+    ]
+    assert hardest_tasks(rows) == [1, 2]
