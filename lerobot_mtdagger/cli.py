@@ -10,7 +10,12 @@ Commands:
     eval: success per task of a pretrained policy (``--policy_path``, ``--suite``, ``--episodes``).
     verify: recompute every round's allocation from its record (``--experiment_dir``).
     merge: rounds 0..k as one LeRobotDataset (``--experiment_dir``, ``--output``).
-    report: eval success against expert demos per method, mean and std over seeds (``--experiments``).
+    compare: every method over every seed, and BC at every budget, as runs in a process pool, then
+        the results table (``--methods``, ``--seeds``, ``--bc_budgets``, ``--jobs``, ``--output_dir``;
+        any other option goes to every run).
+    report: eval success against expert demos per method, mean and std over seeds (``--experiments``
+        or ``--compare_dir``); with ``--output_dir`` (default for a compare folder) also the figures
+        and a summary with paired differences.
     push: round datasets (tag ``round-{k:03d}`` each) and round policies to the Hub
         (``--experiment_dir``, ``--repo_id``, ``--policy_repo_id``).
     demo: run the performance-aware scheduler on synthetic tasks and print each round's allocation
