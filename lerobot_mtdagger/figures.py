@@ -137,6 +137,10 @@ def plot_success(rows: Sequence[Row], x_key: str, x_label: str, path: Path, meth
         else:
             (line,) = axis.plot(x, mean, marker="o", label=method)
             axis.fill_between(x, low, high, alpha=0.2, color=line.get_color())
+    if not axis.lines and not axis.collections:
+        wanted = "any method" if methods is None else " or ".join(sorted(methods))
+        message = f"no runs of {wanted} in these experiments"
+        axis.text(0.5, 0.5, message, ha="center", transform=axis.transAxes)
     axis.set_xlabel(x_label)
     axis.set_ylabel("average evaluation success (fraction of episodes)")
     axis.set_ylim(-0.02, 1.02)
