@@ -25,10 +25,10 @@ from typing import Any
 
 import numpy as np
 
+from lerobot_mtdagger.results import PHASE_TIMINGS
 from lerobot_mtdagger.stats import Interval, correlation, demos_to_reach, mean_interval, paired_difference
 
 LEVELS = (0.5, 0.6, 0.7, 0.8)
-PHASE_TIMINGS = ("collect_s", "write_s", "load_s", "train_s", "eval_s")
 BASELINES = ("uniform", "bc")
 Row = dict[str, Any]
 
