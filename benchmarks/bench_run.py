@@ -30,8 +30,9 @@ import threading
 import time
 from pathlib import Path
 
+from lerobot_mtdagger.results import PHASE_TIMINGS as PHASES
+
 TARGET_S = 60.0
-PHASES = ("collect_s", "write_s", "load_s", "train_s", "eval_s")
 
 
 def _children(pid: int) -> list[int]:

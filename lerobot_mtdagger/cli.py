@@ -35,7 +35,7 @@ import draccus
 import numpy as np
 
 from lerobot_mtdagger.compare import CompareConfig, split_arguments
-from lerobot_mtdagger.configs import RunConfig, default_worker_count, renamed_option_error
+from lerobot_mtdagger.configs import RunConfig, renamed_option_error, resolve_workers
 from lerobot_mtdagger.hub import PushConfig, push_command
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
 from lerobot_mtdagger.simulate import SyntheticTasks, simulate
@@ -207,11 +207,10 @@ class EvalConfig:
     @property
     def worker_count(self) -> int:
         """Env worker processes to start."""
-        return default_worker_count() if self.workers is None else self.workers
+        return resolve_workers(self.workers)
 
     def __post_init__(self) -> None:
-        if self.workers is not None and self.workers < 0:
-            raise ValueError(f"workers must be >= 0 (0: envs in this process), got {self.workers}.")
+        resolve_workers(self.workers)  # refuses a negative count before anything runs
         if self.policy_path is None:
             raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
         if self.episodes <= 0:

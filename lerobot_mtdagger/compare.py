@@ -38,7 +38,6 @@ from lerobot_mtdagger.configs import RunConfig, default_worker_count
 logger = logging.getLogger(__name__)
 
 RUNS_DIR = "runs"
-CONFIG_FILE = "config.json"  # rounds.CONFIG_FILE; rounds imports LeRobot, which the CLI loads lazily
 
 
 @dataclass
@@ -129,11 +128,11 @@ def jobs_for(compare: CompareConfig, run_args: Sequence[str], num_tasks: int) ->
 
 def is_finished(folder: Path) -> bool:
     """Whether the run in ``folder`` committed all its training phases."""
+    from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir  # LeRobot: loaded only when needed
+
     config_path = folder / CONFIG_FILE
     if not config_path.exists():
         return False
-    from lerobot_mtdagger.rounds import ExperimentDir
-
     config = json.loads(config_path.read_text())
     last = 0 if config["mode"] == "bc" else config["rounds"]
     return last in ExperimentDir(folder).committed_phases()
@@ -145,6 +144,8 @@ def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
     Raises:
         RuntimeError: If the run fails (its log is named).
     """
+    from lerobot_mtdagger.rounds import CONFIG_FILE
+
     folder = runs_dir / job.name
     if is_finished(folder):
         logger.info("%s: finished, skipped", job.name)

@@ -213,8 +213,7 @@ class RunConfig:
         for name in ("rounds", "initial_demos", "eval_episodes", "steps_after_success"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}.")
-        if self.workers is not None and self.workers < 0:
-            raise ValueError(f"workers must be >= 0 (0: envs in the main process), got {self.workers}.")
+        resolve_workers(self.workers)  # refuses a negative count before anything runs
         for name in ("steps_per_round", "budget_per_task", "max_rollout_steps"):
             if getattr(self, name) <= 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}.")
@@ -248,7 +247,7 @@ class RunConfig:
     @property
     def worker_count(self) -> int:
         """Env worker processes to start (``workers``, or one per core)."""
-        return default_worker_count() if self.workers is None else self.workers
+        return resolve_workers(self.workers)
 
     def budget_for(self, num_tasks: int) -> int:
         """Expert episodes per DAgger round."""
@@ -260,6 +259,17 @@ class RunConfig:
         record["output_dir"] = str(self.output_dir)
         record["scheduler"] = {"type": self.scheduler.type, **self.scheduler.hyperparameters()}
         return record
+
+
+def resolve_workers(workers: int | None) -> int:
+    """The env worker count an option asks for: one per core for None, else ``workers``.
+
+    Raises:
+        ValueError: If ``workers`` is negative.
+    """
+    if workers is not None and workers < 0:
+        raise ValueError(f"workers must be >= 0 (0: envs in the main process), got {workers}.")
+    return default_worker_count() if workers is None else workers
 
 
 def default_worker_count() -> int:
