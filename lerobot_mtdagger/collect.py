@@ -1,9 +1,13 @@
 """Rollouts with DAgger's beta-mixing, batched over tasks (Algorithm 1, "collect").
 
 At every step of a DAgger rollout the expert labels the state; with probability ``beta`` the
-EXPERT's action is executed, otherwise the learner's. The expert's label is always stored as
-``action``; the executed action and whether the learner acted are stored beside it. ``beta = 1`` is
-pure expert demonstration (round 0, BC); evaluation runs the pure policy (``beta = 0``, no expert).
+EXPERT's action is executed, otherwise the learner's: the coin is tossed at every step
+(``mixing="step"``, classic DAgger) or once per episode (``mixing="episode"``: the expert or the
+learner acts throughout). Only the episodes where the learner executed every action measure the
+learner's success (``learner_success_by_task``): under step mixing the expert does part of the work.
+The expert's label is always stored as ``action``; the executed action and whether the learner
+acted are stored beside it. ``beta = 1`` is pure expert demonstration (round 0, BC); evaluation
+runs the pure policy (``beta = 0``, no expert).
 
 The envs live in env workers (``workers.EnvWorkers``: worker processes, one per core by default);
 the policy stays in the main process and is queried once per step for every running episode (a
@@ -112,6 +116,7 @@ def run_episodes(
     max_steps: int | None,
     steps_after_success: int,
     progress: Callable[[Episode], None] | None = None,
+    mixing: str = "step",
 ) -> list[Episode]:
     """Runs ``episodes_per_task[i]`` episodes of task i on the env workers, in lock-step.
 
@@ -133,6 +138,7 @@ def run_episodes(
         max_steps: Longest episode (None: the env's own truncation).
         steps_after_success: Steps kept after the first success.
         progress: Called with each finished episode.
+        mixing: ``step`` (a beta coin per step) or ``episode`` (one per episode).
 
     Returns:
         The episodes, ordered by (task, episode).
@@ -154,6 +160,7 @@ def run_episodes(
             round_index=round_index,
             max_steps=max_steps,
             steps_after_success=steps_after_success,
+            mixing=mixing,
         )
     )
     schedule = _Schedule([deque(range(int(n))) for n in episodes_per_task], seed, round_index, stream)
@@ -243,3 +250,14 @@ def success_by_task(episodes: Sequence[Episode], num_tasks: int) -> tuple[list[f
         successes[episode.task_index] += int(episode.success)
     rates = [successes[i] / counts[i] if counts[i] else None for i in range(num_tasks)]
     return rates, counts
+
+
+def learner_success_by_task(
+    episodes: Sequence[Episode], num_tasks: int
+) -> tuple[list[float | None], list[int]]:
+    """Success rate and count per task of the episodes where only the learner acted.
+
+    This is what task need measures: an episode where the expert executed some actions may succeed
+    because of them (under step mixing at beta 0.5 a learner that outputs zeros succeeds on reach).
+    """
+    return success_by_task([episode for episode in episodes if episode.learner_only], num_tasks)

@@ -23,6 +23,7 @@ a step (classic DAgger; the paper's text is ambiguous): 0.5 in the first DAgger 
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -55,6 +56,15 @@ class PolicyOptions:
 
 
 RUN_MODES: tuple[str, ...] = ("dagger", "bc")
+MIXING_MODES: tuple[str, ...] = ("episode", "step")
+"""``episode``: one beta coin per episode (the expert or the learner acts throughout); ``step``: a coin
+at every step (classic DAgger)."""
+NORMALISATIONS: tuple[str, ...] = ("fixed", "recompute")
+"""``fixed``: statistics of round 0's training frames, kept for every phase; ``recompute``: of D(k)."""
+STEPS_RULES: tuple[str, ...] = ("fixed", "epochs")
+"""``fixed``: ``steps_per_round`` per phase; ``epochs``: ``epochs`` passes over the phase's frames."""
+SAMPLINGS: tuple[str, ...] = ("uniform", "balanced")
+"""``uniform``: frames uniformly; ``balanced``: a task uniformly, then one of its frames."""
 """``dagger``: Algorithm 1 with the chosen scheduler; ``bc``: the one-round behaviour-cloning baseline."""
 
 PRESETS: dict[str, dict[str, Any]] = {
@@ -123,8 +133,8 @@ class RunConfig:
         preset: One of ``PRESETS``; fills every option of ``PRESET_FIELDS`` left unset (None).
         mode: ``dagger`` (Algorithm 1 with ``scheduler``) or ``bc``: ONE round of expert
             demonstrations with the same data budget (``initial_demos + rounds * budget / num_tasks``
-            per task, split uniformly) and the same training compute (``(rounds + 1) *
-            steps_per_round`` steps); the scheduler is unused.
+            per task, split uniformly), trained like a DAgger phase (``phase_steps``); the scheduler
+            is unused.
         suite: Task suite (``make_suite`` name).
         tasks: Subset of the suite's tasks (all when empty).
         obs_mode: ``state``, ``rgb`` or ``pointcloud``.
@@ -139,11 +149,22 @@ class RunConfig:
         beta: Probability of executing the expert's action in the first DAgger round.
         beta_decay: Subtracted from beta after every DAgger round.
         beta_min: Floor of beta.
+        mixing: ``episode`` (one beta coin per episode: the expert or the learner acts throughout)
+            or ``step`` (a coin at every step). Task need is measured on the episodes where only the
+            learner acted, so under ``step`` mixing with beta > 0 a round measures nothing.
         warm_start: Continue from the previous round's weights (else retrain from scratch).
+        steps_rule: ``fixed`` (``steps_per_round`` steps per phase) or ``epochs`` (``epochs`` passes
+            over the phase's training frames, at least one step).
+        epochs: Passes over the training frames per phase when ``steps_rule=epochs``.
+        normalisation: ``fixed`` (statistics of round 0's training frames for every phase: a warm
+            start sees inputs normalised as before) or ``recompute`` (statistics of D(k) each phase).
+        sampling: ``uniform`` (frames uniformly) or ``balanced`` (a task uniformly, then one of its
+            frames).
         gain_split: ``train`` (per-task loss on the training data) or ``heldout`` (on held-out episodes).
-        heldout_fraction: Fraction of each task's episodes held out when ``gain_split=heldout``.
-        max_rollout_steps: Steps after which a DAgger rollout is cut (failed rollouts of 500 steps
-            flood the data with far-off states).
+        heldout_fraction: Fraction of each task's episodes of a round held out when
+            ``gain_split=heldout`` (decided once per round, so an episode never changes side).
+        max_rollout_steps: Steps after which a DAgger rollout is cut (None: the env's own horizon,
+            the one evaluation runs to).
         steps_after_success: Steps recorded after the first success before an episode ends.
         num_points: Points per cloud (pointcloud mode).
         image_size: Image side (rgb mode).
@@ -174,10 +195,15 @@ class RunConfig:
     beta: float = 0.5
     beta_decay: float = 0.5
     beta_min: float = 0.0
+    mixing: str = "episode"
     warm_start: bool = True
+    steps_rule: str = "fixed"
+    epochs: float = 100.0
+    normalisation: str = "fixed"
+    sampling: str = "uniform"
     gain_split: str = "train"
     heldout_fraction: float = 0.2
-    max_rollout_steps: int = 200
+    max_rollout_steps: int | None = None
     steps_after_success: int = 10
     num_points: int = 1024
     image_size: int = 84
@@ -214,9 +240,17 @@ class RunConfig:
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}.")
         resolve_workers(self.workers)  # refuses a negative count before anything runs
-        for name in ("steps_per_round", "budget_per_task", "max_rollout_steps"):
-            if getattr(self, name) <= 0:
+        for name in ("steps_per_round", "budget_per_task", "max_rollout_steps", "epochs"):
+            if getattr(self, name) is not None and not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}.")
+        for name, choices in (
+            ("mixing", MIXING_MODES),
+            ("steps_rule", STEPS_RULES),
+            ("normalisation", NORMALISATIONS),
+            ("sampling", SAMPLINGS),
+        ):
+            if getattr(self, name) not in choices:
+                raise ValueError(f"{name} must be one of {list(choices)}, got {getattr(self, name)!r}.")
         if self.initial_demos == 0:
             raise ValueError("initial_demos must be > 0: round 0 trains the first policy on expert demos.")
         if not 0.0 <= self.beta_min <= self.beta <= 1.0 or self.beta_decay < 0:
@@ -248,6 +282,20 @@ class RunConfig:
     def worker_count(self) -> int:
         """Env worker processes to start (``workers``, or one per core)."""
         return resolve_workers(self.workers)
+
+    def phase_steps(self, frames: int) -> int:
+        """Optimiser steps of one training phase on ``frames`` training frames.
+
+        A DAgger phase takes ``steps_per_round`` steps (``steps_rule=fixed``) or ``epochs`` passes
+        over its frames (``steps_rule=epochs``). BC trains once, on its final data, by the same rule,
+        except with fixed steps and a warm start: the final DAgger policy has then taken
+        ``(rounds + 1) * steps_per_round`` steps in all, and so does BC.
+        """
+        if self.steps_rule == "epochs":
+            return max(1, math.ceil(self.epochs * frames / self.policy.batch_size))
+        if self.is_bc and self.warm_start:
+            return self.steps_per_round * (self.rounds + 1)
+        return self.steps_per_round
 
     def budget_for(self, num_tasks: int) -> int:
         """Expert episodes per DAgger round."""

@@ -12,11 +12,24 @@ The loop, with round k's dataset committed before the policy trained on it::
 
 This is the paper's ordering ("round k: train on D(k-1), then schedule and collect") with the
 training of round k+1 stored beside round k. ``--mode=bc`` (the baseline) runs round 0 only, with the
-whole budget ``n0 + rounds * B / N`` per task, and trains ``rounds + 1`` phases' worth of steps.
+whole budget ``n0 + rounds * B / N`` per task, trained like a DAgger phase (``RunConfig.phase_steps``).
 
-What the scheduler is fed is what its method declares it measures (``SchedulerConfig.measurements``)
-plus everything else the records show: the success of the previous round's rollouts (from round 2 on;
-round 1's rollouts are the first the learner took part in) and the gain of the previous phase.
+The scheduler is fed two measurements, both of the learner alone:
+
+- task need: the success of the previous round's episodes where ONLY the learner acted (round 1's
+  are the first; under step mixing with beta > 0 there are none, and the Kalman filter only
+  predicts). An episode where the expert executed some actions may succeed because of them.
+- performance gain: ``max(0, L_previous - L_end)`` per task, where ``L_previous`` is the loss of the
+  policy that collected the round (the previous phase's) and ``L_end`` that of the newly trained
+  one, on the same frames in the same normalisation. With a warm start and fixed normalisation
+  ``L_previous`` is the loss at the start of training (the paper's ``L_start``); unlike the latter
+  it stays meaningful when a phase retrains from scratch or renormalises. Phase 0 has no previous
+  policy, so round 1 is allocated by the prior (a loss drop from random weights would rank the tasks
+  by the scale of their actions).
+
+Normalisation statistics come from round 0's training frames and stay fixed (``normalisation``), so
+a warm-started policy sees its inputs as before; held-out episodes (``gain_split=heldout``) are
+chosen once per round and stay held out.
 
 Resuming: committed rounds and phases are immutable; a run restarts at the first uncommitted step.
 Every random choice derives from the seed and the round, and the scheduler's state after each round
@@ -36,7 +49,13 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from lerobot_mtdagger.collect import COLLECT_STREAM, Episode, run_episodes, success_by_task
+from lerobot_mtdagger.collect import (
+    COLLECT_STREAM,
+    Episode,
+    learner_success_by_task,
+    run_episodes,
+    success_by_task,
+)
 from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.envs import IMAGE_KEY, suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
@@ -47,12 +66,14 @@ from lerobot_mtdagger.records import PhaseRecord, RoundRecord, round_features
 from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
 from lerobot_mtdagger.train import (
+    EPISODE_ID_STRIDE,
     NormalisedData,
     TrainingData,
     build_processors,
     compute_stats,
     load_round,
     loss_split,
+    per_task_loss_of,
     policy_config,
     save_policy,
     train_phase,
@@ -120,14 +141,18 @@ def schedule_round(ctx: RunContext, round_index: int) -> tuple[Scheduler, Alloca
     if previous.scheduler_state is not None:
         scheduler.load_state_dict(previous.scheduler_state)
     phase = experiment.read_phase_record(round_index - 1)
-    measurements: dict[str, Any] = {"gain": phase.gain}
-    if previous.rollout_success is not None and round_index - 1 > 0:
-        rates = [np.nan if r is None else r for r in previous.rollout_success]
-        measurements |= {"success_rate": rates, "episodes": previous.rollout_episodes}
+    measurements: dict[str, Any] = {}
+    if phase.gain is not None:
+        measurements["gain"] = phase.gain
+    if previous.learner_success is not None and round_index - 1 > 0:
+        rates = [np.nan if r is None else r for r in previous.learner_success]
+        measurements |= {"success_rate": rates, "episodes": previous.learner_episodes}
     scheduler.update(**measurements)
     allocation = scheduler.allocate(ctx.config.budget_for(len(ctx.task_names)))
     if round_index == 1:
-        allocation.notes.append("round 1: no policy rollouts measured yet, the prior decides")
+        allocation.notes.append(
+            "round 1: no learner rollout and no warm-started phase measured yet, the prior decides"
+        )
     return scheduler, allocation
 
 
@@ -162,6 +187,7 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
             max_steps=max_steps,
             steps_after_success=config.steps_after_success,
             progress=lambda _: bar.update(1),
+            mixing=config.mixing,
         )
     collected = time.perf_counter()
     dataset = ctx.experiment.write_round(
@@ -190,6 +216,7 @@ def round_record(
     config = ctx.config
     num_tasks = len(ctx.task_names)
     rollout_success, rollout_episodes = success_by_task(episodes, num_tasks)
+    learner_success, learner_episodes = learner_success_by_task(episodes, num_tasks)
     previous_demos = (
         [0] * num_tasks
         if round_index == 0
@@ -209,6 +236,8 @@ def round_record(
         "rollout_success": rollout_success if round_index > 0 else None,
         "rollout_episodes": rollout_episodes,
         "expert_success": rollout_success if round_index == 0 else None,
+        "learner_success": learner_success if round_index > 0 else None,
+        "learner_episodes": learner_episodes if round_index > 0 else None,
         "learner_steps": int(sum(e.learner_steps for e in episodes)),
         "frames": int(sum(e.steps for e in episodes)),
         "config": config.to_dict(),
@@ -266,17 +295,24 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     image_keys = [k for k in input_keys if k.startswith(IMAGE_KEY)]
     data = rounds_in_memory(ctx, round_index, input_keys)
     phase_seed = int(np.random.SeedSequence([config.seed, 3, round_index]).generate_state(1)[0])
-    train_index, loss_index = loss_split(data, config.gain_split, config.heldout_fraction, phase_seed)
-    stats = compute_stats(data.subset(train_index), image_keys)
+    train_index, loss_index = loss_split(data, config.gain_split, config.heldout_fraction, config.seed)
+    stats = compute_stats(data.subset(normalisation_frames(config, data, train_index)), image_keys)
     torch.manual_seed(phase_seed)
     policy = MTDAggerPolicy(policy_cfg)
-    if config.warm_start and round_index > 0:
+    previous = None
+    if round_index > 0:
         with quiet_third_party():  # LeRobot prints "Loading weights from local directory"
-            previous = MTDAggerPolicy.from_pretrained(str(ctx.experiment.policy_root(round_index - 1)))
-        policy.load_state_dict(previous.state_dict())
+            previous = PolicyRunner.from_pretrained(
+                ctx.experiment.policy_root(round_index - 1), config.policy.device
+            )
+        if config.warm_start:
+            policy.load_state_dict(previous.policy.state_dict())
     preprocessor, postprocessor = build_processors(policy_cfg, stats)
     normalised = NormalisedData(data, preprocessor, image_keys, ctx.task_names)
-    steps = config.steps_per_round * ((config.rounds + 1) if config.is_bc else 1)
+    loss_previous = None
+    if previous is not None:
+        loss_previous = per_task_loss_of(previous.predict, normalised, loss_index, len(ctx.task_names))
+    steps = config.phase_steps(len(train_index))
     loaded = time.perf_counter()
     with tqdm(
         total=steps, desc=f"round {round_index} train", leave=False, disable=not ctx.show_progress
@@ -291,6 +327,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
             lr=config.policy.lr,
             seed=phase_seed,
             on_step=lambda done, loss: bar.update(done - bar.n),
+            sampling=config.sampling,
         )
     trained = time.perf_counter()
     staging = ctx.experiment.staging_policy_root(round_index)
@@ -308,7 +345,8 @@ def train_round(ctx: RunContext, round_index: int) -> None:
         gain_split=config.gain_split,
         loss_start=result.loss_start,
         loss_end=result.loss_end,
-        gain=result.gain,
+        gain=None if loss_previous is None else performance_gain(loss_previous, result.loss_end),
+        loss_previous=loss_previous,
         loss_samples=result.loss_samples,
         final_train_loss=result.train_loss,
         eval=None if eval_result is None else eval_result.to_dict(),
@@ -316,6 +354,21 @@ def train_round(ctx: RunContext, round_index: int) -> None:
         timings=ctx.timings[round_index],
     )
     ctx.experiment.commit_phase(round_index, staging, record)
+
+
+def normalisation_frames(config: RunConfig, data: TrainingData, train_index: torch.Tensor) -> torch.Tensor:
+    """The training frames the normalisation statistics come from: round 0's (``fixed``) or all."""
+    if config.normalisation == "recompute":
+        return train_index
+    return train_index[data.episode_id[train_index] < EPISODE_ID_STRIDE]
+
+
+def performance_gain(loss_previous: list[float | None], loss_end: list[float | None]) -> list[float]:
+    """``max(0, L_previous - L_end)`` per task (0 where a task has no measured loss)."""
+    return [
+        max(0.0, before - after) if before is not None and after is not None else 0.0
+        for before, after in zip(loss_previous, loss_end, strict=True)
+    ]
 
 
 def rounds_in_memory(ctx: RunContext, round_index: int, input_keys: list[str]) -> TrainingData:

@@ -7,7 +7,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -50,16 +50,32 @@ class PolicyRunner:
         Raises:
             KeyError: If an observation lacks an input the policy was trained on.
         """
+        inputs = {
+            key: torch.from_numpy(np.stack([observation[key] for observation in observations]))
+            for key in self.input_keys
+        }
+        return self.predict(inputs, tasks).numpy()
+
+    def predict(self, inputs: dict[str, torch.Tensor], tasks: Sequence[str]) -> torch.Tensor:
+        """Unnormalised actions (B, action_dim) on the CPU for batched raw inputs.
+
+        Args:
+            inputs: Raw observation tensors by key, images uint8 (B, H, W, 3) as stored.
+            tasks: Task name of each row.
+
+        Raises:
+            KeyError: If an input the policy was trained on is missing.
+        """
         batch: dict[str, Any] = {}
         for key in self.input_keys:
-            stacked = torch.from_numpy(np.stack([observation[key] for observation in observations]))
+            tensor = inputs[key]
             if key in self.image_keys:
-                stacked = stacked.permute(0, 3, 1, 2).float() / 255.0
-            batch[key] = stacked.float()
+                tensor = tensor.permute(0, 3, 1, 2).float() / 255.0
+            batch[key] = tensor.float()
         batch["task"] = list(tasks)
         with torch.inference_mode():
             action = self.postprocessor(self.policy.select_action(self.preprocessor(batch)))
-        return action.cpu().numpy()
+        return action.cpu()
 
 
 @dataclass

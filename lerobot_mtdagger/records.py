@@ -101,8 +101,8 @@ class RoundRecord:
         n_min: The scheduler's minimum episodes per task.
         episodes_per_task: Episodes collected per task.
         demos_so_far: Expert-labelled episodes per task in rounds 0..k.
-        rollout_success: Success rate per task of this round's rollouts (None in round 0 and where a
-            task had no episode); what the next round's task need is measured from.
+        rollout_success: Success rate per task of this round's rollouts, whoever acted (None in
+            round 0 and where a task had no episode).
         rollout_episodes: Episodes behind ``rollout_success``.
         expert_success: Round 0 only: the experts' success rate per task.
         learner_steps: Steps where the learner's action was executed.
@@ -122,6 +122,10 @@ class RoundRecord:
         notes: Human-readable remarks.
         format_version: ``FORMAT_VERSION``.
         committed: True once the round is committed (a record without it is never read).
+        learner_success: Success rate per task of this round's episodes where only the learner
+            acted (None in round 0 and where a task had none): the next round's task need
+            measurement.
+        learner_episodes: Episodes behind ``learner_success``.
     """
 
     task_names: list[str]
@@ -154,6 +158,8 @@ class RoundRecord:
     notes: list[str]
     format_version: int = FORMAT_VERSION
     committed: bool = False
+    learner_success: list[float | None] | None = None
+    learner_episodes: list[int] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form, as stored in ``meta/info.json``."""
@@ -179,14 +185,18 @@ class PhaseRecord:
         frames: Training frames (all of D(k)).
         steps: Optimiser steps.
         gain_split: Where the per-task loss was measured (``train`` or ``heldout``).
-        loss_start: Per-task loss before training (None where a task had no sample).
+        loss_start: Per-task loss of the initial weights (None where a task had no sample).
         loss_end: Per-task loss after training.
-        gain: ``max(0, loss_start - loss_end)`` per task (the next round's performance gain).
+        gain: ``max(0, loss_previous - loss_end)`` per task, the next round's performance gain
+            (None in phase 0: there is no previous policy, and a loss drop from random weights
+            measures the scale of each task's actions, not learning).
         loss_samples: Frames per task behind the losses.
         final_train_loss: The last training losses.
         eval: ``EvalResult.to_dict()`` of the trained policy (None when not evaluated).
         demos_per_task: Expert-labelled episodes per task in D(k).
         timings: Seconds per part of the round (collect_s, write_s, load_s, train_s, eval_s).
+        loss_previous: Per-task loss of the previous phase's policy (the one that collected round
+            k) on the same frames, in this phase's normalisation (None in phase 0).
     """
 
     round: int
@@ -196,12 +206,13 @@ class PhaseRecord:
     gain_split: str
     loss_start: list[float | None]
     loss_end: list[float | None]
-    gain: list[float]
+    gain: list[float] | None
     loss_samples: list[int]
     final_train_loss: list[float]
     eval: dict[str, Any] | None
     demos_per_task: list[int]
     timings: dict[str, float]
+    loss_previous: list[float | None] | None = None
 
     @property
     def eval_mean(self) -> float | None:

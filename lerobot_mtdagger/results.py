@@ -85,7 +85,7 @@ def _row(root: Path, records: list, k: int, phase: Any, frames: np.ndarray) -> d
         "metric": following.metric if following is not None else None,
         "kalman_p": following.kalman_posterior.get("p") if following is not None else None,
         "raw_success": following.success_rate if following is not None else None,
-        "gain": [float(g) for g in phase.gain],
+        "gain": None if phase.gain is None else [float(g) for g in phase.gain],
         **{name: float(phase.timings.get(name, 0.0)) for name in PHASE_TIMINGS},
     }
 

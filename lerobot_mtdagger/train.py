@@ -246,10 +246,16 @@ class NormalisedData:
                 f"{len(task_names)} tasks {self.task_names}."
             )
         vector = {k: v for k, v in data.inputs.items() if k not in self.image_keys} | {"action": data.action}
+        self.preprocessor = preprocessor
         normalised = preprocessor(dict(vector))
         self.vector = {k: normalised[k] for k in vector}
         self.device = self.vector["action"].device
         self.task_index = data.task_index.to(self.device, dtype=torch.long)
+
+    def normalise_actions(self, actions: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
+        """Unnormalised actions for the frames at ``index``, normalised like the labels."""
+        vector = {k: v[index] for k, v in self.data.inputs.items() if k not in self.image_keys}
+        return self.preprocessor({**vector, "action": actions.float()})["action"]
 
     def batch(self, index: torch.Tensor) -> dict[str, torch.Tensor]:
         """The normalised batch at ``index``.
@@ -284,26 +290,39 @@ def loss_split(
     """Indices of the training frames and of the frames the per-task loss is measured on.
 
     ``train``: train on everything, measure on up to LOSS_SAMPLES_PER_TASK frames per task.
-    ``heldout``: hold out ``heldout_fraction`` of each task's episodes (at least one when the task has
-    two or more) and measure on them.
+    ``heldout``: hold out ``heldout_fraction`` of each task's episodes OF EACH ROUND (at least one
+    where the round has two or more) and measure on them. The choice depends only on ``seed``, the
+    round and its episodes, so an episode held out in one phase is held out in every later phase
+    (pass the experiment's seed, not a per-phase one): a warm-started policy never trained on it.
     """
-    generator = np.random.default_rng(seed)
     all_index = torch.arange(len(data))
     if split == "heldout":
-        heldout_episodes = []
-        for task in torch.unique(data.task_index).tolist():
-            episodes = np.unique(data.episode_id[data.task_index == task].numpy())
-            count = int(round(heldout_fraction * len(episodes)))
-            count = min(max(count, 1 if len(episodes) > 1 else 0), len(episodes) - 1)
-            heldout_episodes += generator.choice(episodes, size=count, replace=False).tolist()
-        held = torch.from_numpy(np.isin(data.episode_id.numpy(), heldout_episodes))
+        held_ids = heldout_episodes(data, heldout_fraction, seed)
+        held = torch.from_numpy(np.isin(data.episode_id.numpy(), held_ids))
         return all_index[~held], all_index[held]
+    generator = np.random.default_rng(seed)
     measure = []
     for task in torch.unique(data.task_index).tolist():
         task_index = all_index[data.task_index == task].numpy()
         size = min(LOSS_SAMPLES_PER_TASK, len(task_index))
         measure.append(np.sort(generator.choice(task_index, size=size, replace=False)))
     return all_index, torch.from_numpy(np.concatenate(measure))
+
+
+def heldout_episodes(data: TrainingData, heldout_fraction: float, seed: int) -> list[int]:
+    """Episode ids held out, chosen per (round, task) from that round's episodes of the task alone."""
+    episode_ids = data.episode_id.numpy()
+    task_index = data.task_index.numpy()
+    chosen: list[int] = []
+    for round_position in np.unique(episode_ids // EPISODE_ID_STRIDE).tolist():
+        in_round = episode_ids // EPISODE_ID_STRIDE == round_position
+        for task in np.unique(task_index[in_round]).tolist():
+            episodes = np.unique(episode_ids[in_round & (task_index == task)])
+            count = int(round(heldout_fraction * len(episodes)))
+            count = min(max(count, 1 if len(episodes) > 1 else 0), len(episodes) - 1)
+            generator = np.random.default_rng(np.random.SeedSequence([seed, round_position, task]))
+            chosen += generator.choice(episodes, size=count, replace=False).tolist()
+    return chosen
 
 
 @torch.no_grad()
@@ -324,6 +343,42 @@ def per_task_loss(
     sums, counts = sums.cpu(), counts.cpu()
     losses = [float(sums[i] / counts[i]) if counts[i] > 0 else None for i in range(num_tasks)]
     return losses, [int(c) for c in counts.tolist()]
+
+
+@torch.no_grad()
+def per_task_loss_of(
+    predict: Callable[[dict[str, torch.Tensor], list[str]], torch.Tensor],
+    data: NormalisedData,
+    index: torch.Tensor,
+    num_tasks: int,
+) -> list[float | None]:
+    """Mean MSE per task of another policy's actions, in ``data``'s normalisation.
+
+    The other policy (e.g. the previous phase's, with its own normalisation statistics) acts on the
+    raw frames; its unnormalised actions are normalised like ``data``'s labels, so its loss is
+    comparable with ``per_task_loss`` of the policy trained on ``data``.
+
+    Args:
+        predict: Raw inputs by key and task names -> unnormalised actions (``PolicyRunner.predict``).
+        data: The normalised frames (its pre-processor normalises the predictions).
+        index: Frames to measure on.
+        num_tasks: Number of tasks.
+
+    Returns:
+        The loss per task (None where a task has no frame at ``index``).
+    """
+    sums = torch.zeros(num_tasks, dtype=torch.float64)
+    counts = torch.zeros(num_tasks, dtype=torch.float64)
+    for chunk in torch.split(index, 4096):
+        inputs = {key: tensor[chunk] for key, tensor in data.data.inputs.items()}
+        task_index = data.data.task_index[chunk]
+        raw = predict(inputs, [data.task_names[i] for i in task_index.tolist()])
+        prediction = data.normalise_actions(raw, chunk).cpu()
+        errors = ((prediction - data.vector["action"][chunk.to(data.device)].cpu()) ** 2).mean(dim=1).double()
+        means, chunk_counts = per_task_means(errors, task_index, num_tasks)
+        sums += means * chunk_counts
+        counts += chunk_counts
+    return [float(sums[i] / counts[i]) if counts[i] > 0 else None for i in range(num_tasks)]
 
 
 def make_optimizer(policy: MTDAggerPolicy, lr: float) -> torch.optim.AdamW:
@@ -352,10 +407,12 @@ def train_phase(
     seed: int,
     on_step: Callable[[int, float], None] | None = None,
     log_interval: int = LOG_INTERVAL,
+    sampling: str = "uniform",
 ) -> PhaseResult:
     """Trains ``policy`` for ``steps`` AdamW steps and measures the per-task loss drop.
 
-    Each step samples ``batch_size`` frames of ``train_index`` uniformly with replacement and takes
+    Each step samples ``batch_size`` frames of ``train_index`` with replacement (uniformly, or with
+    ``sampling="balanced"`` a task uniformly and then one of its frames uniformly) and takes
     one AdamW step on ``policy.imitation_loss`` with the gradient norm clipped to
     ``config.optimizer_grad_clip_norm``. The losses stay on the device: they are read back only every
     ``log_interval`` steps and after the last one, where they are checked for NaN/inf and reported.
@@ -376,13 +433,15 @@ def train_phase(
             ``on_step(steps_done, mean_loss)``: the number of steps completed so far (1..steps) and the
             mean training loss over the steps since the previous call.
         log_interval: Steps between two reads of the loss.
+        sampling: ``uniform`` over frames or ``balanced`` over tasks.
 
     Returns:
         The per-task losses at the start and at the end, the gain and the last FINAL_LOSSES step
         losses.
 
     Raises:
-        ValueError: If the policy's task vocabulary differs from the data's, or log_interval < 1.
+        ValueError: If the policy's task vocabulary differs from the data's, log_interval < 1 or
+            ``sampling`` is unknown.
         FloatingPointError: If the loss becomes NaN or infinite (nothing is committed then).
     """
     if list(policy.config.task_names) != data.task_names:
@@ -394,6 +453,7 @@ def train_phase(
     num_tasks = len(data.task_names)
     loss_start, _ = per_task_loss(policy, data, loss_index, num_tasks)
     generator = torch.Generator().manual_seed(seed)
+    draw = batch_sampler(train_index, data.data.task_index, sampling, generator)
     optimizer = make_optimizer(policy, lr)
     parameters = [p for p in policy.parameters() if p.requires_grad]
     clip_norm = policy.config.optimizer_grad_clip_norm
@@ -407,8 +467,7 @@ def train_phase(
         if offset == 0:
             # One interval's batch indices at once, drawn on the CPU (device independent).
             block = min(log_interval, steps - step)
-            picks = train_index[torch.randint(len(train_index), (block, size), generator=generator)]
-            picks = picks.to(data.device)
+            picks = draw((block, size)).to(data.device)
         batch = data.batch(picks[offset])
         if offset == 0:
             loss, info = policy.forward(batch)
@@ -441,6 +500,36 @@ def train_phase(
         train_loss=tail.tolist(),
         loss_samples=counts,
     )
+
+
+def batch_sampler(
+    train_index: torch.Tensor, task_index: torch.Tensor, sampling: str, generator: torch.Generator
+) -> Callable[[tuple[int, int]], torch.Tensor]:
+    """A function drawing frame indices of ``train_index`` in a given shape, with replacement.
+
+    ``uniform``: every frame equally likely. ``balanced``: a task uniformly among those with
+    training frames, then one of its frames uniformly (each task gets the same share of every batch
+    in expectation, however many frames it has).
+
+    Raises:
+        ValueError: If ``sampling`` is unknown.
+    """
+    if sampling == "uniform":
+        return lambda shape: train_index[torch.randint(len(train_index), shape, generator=generator)]
+    if sampling != "balanced":
+        raise ValueError(f"sampling must be 'uniform' or 'balanced', got {sampling!r}.")
+    tasks_of_frames = task_index[train_index]
+    order = torch.argsort(tasks_of_frames, stable=True)
+    grouped = train_index[order]
+    _, counts = torch.unique_consecutive(tasks_of_frames[order], return_counts=True)
+    starts = torch.cumsum(counts, 0) - counts
+
+    def draw(shape: tuple[int, int]) -> torch.Tensor:
+        task = torch.randint(len(counts), shape, generator=generator)
+        within = (torch.rand(shape, generator=generator) * counts[task]).long()
+        return grouped[starts[task] + torch.minimum(within, counts[task] - 1)]
+
+    return draw
 
 
 def _check_finite(losses: torch.Tensor, first_step: int) -> None:

@@ -77,9 +77,10 @@ def _chain_mismatches(
         if record.gain != gain:
             problems.append(f"gain {record.gain} != phase {k - 1} gain {gain}")
     if k >= 2 and previous is not None:
-        if record.success_rate != previous.rollout_success:
+        if record.success_rate != previous.learner_success:
             problems.append(
-                f"success_rate {record.success_rate} != previous rollouts {previous.rollout_success}"
+                f"success_rate {record.success_rate} != previous learner-only rollouts "
+                f"{previous.learner_success}"
             )
         if previous.allocation is None or record.kalman_prior != previous.allocation["kalman_posterior"]:
             problems.append(f"Kalman prior is not round {k - 1}'s posterior")

@@ -22,6 +22,7 @@ from __future__ import annotations
 import contextlib
 import copy
 import logging
+import math
 import multiprocessing
 import pickle
 import signal
@@ -101,6 +102,11 @@ class Episode:
     learner_steps: int = 0
     steps: int = 0
 
+    @property
+    def learner_only(self) -> bool:
+        """Whether the learner executed every action (its success is then the learner's)."""
+        return self.steps > 0 and self.learner_steps == self.steps
+
 
 @dataclass(frozen=True)
 class EpisodeSpec:
@@ -126,12 +132,14 @@ class RolloutRules:
     """How the episodes of one ``run_episodes`` call behave (the same for every episode).
 
     Attributes:
-        beta: Probability of executing the expert's action at a step.
+        beta: Probability of executing the expert's action (at a step, or for a whole episode).
         learner: Whether a learner acts at all (False: the expert always acts).
         record: Keep the frames (observation, expert label, executed action, learner flag).
         round_index: DAgger round written into the recorded frames.
         max_steps: Longest episode (None: the env's own truncation).
         steps_after_success: Steps kept after the first success.
+        mixing: ``step`` (a beta coin at every step) or ``episode`` (one coin when the episode
+            starts: the expert or the learner acts throughout).
     """
 
     beta: float
@@ -140,11 +148,26 @@ class RolloutRules:
     round_index: int
     max_steps: int | None
     steps_after_success: int
+    mixing: str = "step"
 
     @property
     def need_expert(self) -> bool:
         """The expert is queried when its labels are stored or it may act."""
         return self.record or self.beta > 0.0 or not self.learner
+
+
+def expert_episode_coin(beta_seed: tuple[int, ...], beta: float) -> bool:
+    """Whether the expert acts throughout an episode under episode mixing (systematic sampling).
+
+    ``beta_seed`` is ``(seed, BETA_STREAM, round, task, episode)``. One uniform offset ``u`` per
+    (seed, round, task) is drawn, and episode ``e`` goes to the expert when ``floor(beta * e + u)``
+    steps up at ``e + 1``: any ``n`` consecutive episodes of a task hold ``floor(beta * n)`` or
+    ``ceil(beta * n)`` expert episodes, so even a task given 3 episodes gets both kinds at beta 0.5
+    (independent coins would give it none of the learner's one time in eight).
+    """
+    *task_entropy, episode = beta_seed
+    offset = float(np.random.default_rng(np.random.SeedSequence(list(task_entropy))).random())
+    return math.floor(beta * (episode + 1) + offset) > math.floor(beta * episode + offset)
 
 
 @dataclass
@@ -159,6 +182,7 @@ class _Running:
     observation: dict[str, np.ndarray]
     privileged: np.ndarray
     steps_since_success: int = -1
+    expert_episode: bool = False
 
 
 class RolloutWorker:
@@ -237,14 +261,19 @@ class RolloutWorker:
         env = pool.pop() if pool else self.suite.make_env(task_name)
         expert = self._expert(spec.task_index) if self.rules.need_expert else None
         observation, info = env.reset(seed=spec.reset_seed)
+        rng = np.random.default_rng(np.random.SeedSequence(list(spec.beta_seed)))
+        expert_episode = self.rules.mixing == "episode" and expert_episode_coin(
+            spec.beta_seed, self.rules.beta
+        )
         return _Running(
             spec=spec,
             env=env,
             expert=expert,
             episode=Episode(task_index=spec.task_index, episode=spec.episode, seed=spec.reset_seed),
-            rng=np.random.default_rng(np.random.SeedSequence(list(spec.beta_seed))),
+            rng=rng,
             observation=observation,
             privileged=info["privileged_state"],
+            expert_episode=expert_episode,
         )
 
     def _expert(self, task_index: int) -> Any:
@@ -276,7 +305,10 @@ class RolloutWorker:
         rules = self.rules
         episode = running.episode
         expert_action = running.expert.act(running.privileged) if running.expert is not None else None
-        expert_acts = learner_action is None or (rules.beta > 0.0 and running.rng.random() < rules.beta)
+        if learner_action is None or rules.mixing == "episode":
+            expert_acts = learner_action is None or running.expert_episode
+        else:
+            expert_acts = rules.beta > 0.0 and running.rng.random() < rules.beta
         executed = expert_action if expert_acts else learner_action
         if rules.record:
             columns = dagger_columns(executed, learner_acted=not expert_acts, round_index=rules.round_index)

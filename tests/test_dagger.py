@@ -65,8 +65,10 @@ def test_every_round_is_committed_with_its_record(experiment):
     assert round1.success_rate is None and any("prior decides" in n for n in round1.notes)
     assert round1.episodes_per_task == [3, 3, 3], "the prior decides: uniform"
     assert round1.beta == 0.5 and round2.beta == 0.0
-    assert round2.success_rate == round1.rollout_success
-    assert round2.gain == experiment.read_phase_record(1).gain
+    assert round2.success_rate == round1.learner_success, "task need: learner-only episodes"
+    assert 0 < sum(round1.learner_episodes) < sum(round1.episodes_per_task), "episode mixing at 0.5"
+    assert round1.gain is None and experiment.read_phase_record(0).gain is None, "no gain from scratch"
+    assert round2.gain == experiment.read_phase_record(1).gain is not None
     assert round2.eval_success == experiment.read_phase_record(1).eval["success"]
     assert round2.demos_so_far == [
         a + b for a, b in zip(round1.demos_so_far, round2.episodes_per_task, strict=True)

@@ -1,0 +1,212 @@
+"""The DAgger protocol: what task need and performance gain measure, and how phases train.
+
+Each test pins down one defect of the earlier protocol (a biased measurement or an unfair
+comparison) and fails on it:
+
+1. task need credited the learner with successes the expert made (per-step mixing at beta 0.5);
+2. the first performance-gain allocation ranked tasks by the scale of their actions;
+3. held-out episodes were redrawn every phase, so a warm-started policy had trained on them;
+4. DAgger rollouts were cut at 200 steps while evaluation runs to the env's 500;
+5. normalisation statistics changed under a warm-started policy;
+6. BC and DAgger phases were trained by different rules.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import draccus
+import numpy as np
+import pytest
+import torch
+
+from lerobot_mtdagger.collect import COLLECT_STREAM, learner_success_by_task, run_episodes, success_by_task
+from lerobot_mtdagger.configs import RunConfig
+from lerobot_mtdagger.dagger import performance_gain, run
+from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.evaluate import PolicyRunner
+from lerobot_mtdagger.rounds import ExperimentDir
+from lerobot_mtdagger.train import (
+    EPISODE_ID_STRIDE,
+    TrainingData,
+    batch_sampler,
+    build_processors,
+    compute_stats,
+    loss_split,
+    per_task_loss,
+    per_task_loss_of,
+)
+from lerobot_mtdagger.workers import BETA_STREAM, EnvWorkers, expert_episode_coin
+from tests.test_toy import TOY_RUN
+from tests.test_train import normalised, small_policy, synthetic_data
+
+REACH_PUSH_PICK = ["reach-v3", "push-v3", "pick-place-v3"]
+
+
+def zero_actions(observations, tasks):
+    return np.zeros((len(observations), 4), dtype=np.float32)
+
+
+@pytest.fixture(scope="module")
+def metaworld_rollouts():
+    """A zero-action learner on reach, push and pick-place at beta 0.5, both mixings (4 episodes each)."""
+    suite = make_suite("metaworld-mt10", tasks=REACH_PUSH_PICK)
+    rollouts = {}
+    with EnvWorkers(suite, 0) as workers:
+        for mixing in ("step", "episode"):
+            rollouts[mixing] = run_episodes(
+                workers,
+                [4, 4, 4],
+                policy=zero_actions,
+                beta=0.5,
+                seed=100,
+                round_index=1,
+                stream=COLLECT_STREAM,
+                record=False,
+                max_steps=None,
+                steps_after_success=0,
+                mixing=mixing,
+            )
+    return rollouts
+
+
+def test_a_zero_action_learner_measures_zero_task_success(metaworld_rollouts):
+    """Defect 1: the measurement that feeds task need counts the learner's episodes only."""
+    mixed, _ = success_by_task(metaworld_rollouts["step"], 3)
+    assert mixed[0] == 1.0, "under step mixing the expert reaches for the learner"
+    assert learner_success_by_task(metaworld_rollouts["step"], 3) == ([None] * 3, [0, 0, 0]), (
+        "step mixing at beta 0.5 leaves no learner-only episode: nothing is credited"
+    )
+    rates, counts = learner_success_by_task(metaworld_rollouts["episode"], 3)
+    assert rates == [0.0, 0.0, 0.0] and counts == [2, 2, 2]
+    experts = [e for e in metaworld_rollouts["episode"] if e.learner_steps == 0]
+    assert len(experts) == 6 and all(e.success for e in experts if e.task_index == 0)
+
+
+def test_default_rollouts_run_to_the_evaluation_horizon(metaworld_rollouts):
+    """Defect 4: a learner rollout is not cut before evaluation's horizon (the env's own, 500)."""
+    assert RunConfig().max_rollout_steps is None
+    learner = [e for e in metaworld_rollouts["episode"] if e.learner_only]
+    assert {e.steps for e in learner} == {500}
+
+
+def test_episode_mixing_gives_each_task_its_share_of_expert_episodes():
+    for beta in (0.25, 0.5, 0.75):
+        for task in range(5):
+            coins = [expert_episode_coin((7, BETA_STREAM, 1, task, e), beta) for e in range(12)]
+            for n in range(1, 13):
+                assert np.floor(beta * n) <= sum(coins[:n]) <= np.ceil(beta * n)
+    assert not any(expert_episode_coin((0, BETA_STREAM, 1, 0, e), 0.0) for e in range(10))
+    assert all(expert_episode_coin((0, BETA_STREAM, 1, 0, e), 1.0) for e in range(10))
+
+
+def test_episode_mixing_does_not_depend_on_the_worker_count():
+    suite = make_suite("toy")
+
+    def collect(workers: int):
+        with EnvWorkers(suite, workers) as env_workers:
+            episodes = run_episodes(
+                env_workers,
+                [3, 2, 4],
+                policy=lambda obs, tasks: np.full((len(obs), 2), 0.1, dtype=np.float32),
+                beta=0.5,
+                seed=3,
+                round_index=1,
+                stream=COLLECT_STREAM,
+                record=True,
+                max_steps=40,
+                steps_after_success=0,
+                mixing="episode",
+            )
+        return [(e.task_index, e.episode, e.steps, e.learner_steps, e.success) for e in episodes]
+
+    assert collect(0) == collect(2)
+
+
+def test_heldout_episodes_stay_held_out_when_rounds_are_added():
+    """Defect 3: an episode held out in one phase is held out in every later phase."""
+
+    def round_data(position: int, episodes_per_task: int) -> TrainingData:
+        episode = torch.arange(3 * episodes_per_task).repeat_interleave(20)
+        return TrainingData(
+            inputs={"observation.state": torch.zeros(len(episode), 2)},
+            action=torch.zeros(len(episode), 2),
+            task_index=episode % 3,
+            episode_id=episode + position * EPISODE_ID_STRIDE,
+        )
+
+    round0, round1 = round_data(0, 3), round_data(1, 4)
+    _, held0 = loss_split(round0, "heldout", 0.2, seed=5)
+    both = TrainingData.concat([round0, round1])
+    train_both, held_both = loss_split(both, "heldout", 0.2, seed=5)
+    before = set(round0.episode_id[held0].tolist())
+    after = set(both.episode_id[held_both].tolist())
+    assert before and before == {e for e in after if e < EPISODE_ID_STRIDE}
+    assert not before & set(both.episode_id[train_both].tolist())
+    assert {e for e in after if e >= EPISODE_ID_STRIDE}, "the new round holds out episodes too"
+
+
+def test_the_previous_policy_is_measured_in_the_current_normalisation():
+    """Defects 2 and 5: the gain compares two policies on the same frames, in one normalisation."""
+    data = synthetic_data()
+    policy = small_policy()
+    stats = compute_stats(data, [])
+    runner = PolicyRunner(policy, *build_processors(policy.config, stats))
+    same = normalised(data, policy)
+    index = torch.arange(0, len(data), 2)
+    own, _ = per_task_loss(policy, same, index, 3)
+    assert per_task_loss_of(runner.predict, same, index, 3) == pytest.approx(own, rel=1e-5)
+    wider = {k: dict(v) for k, v in stats.items()}
+    wider["action"]["std"] = stats["action"]["std"] * 2
+    from lerobot_mtdagger.train import NormalisedData
+
+    other = NormalisedData(data, build_processors(policy.config, wider)[0], [], policy.config.task_names)
+    scaled = per_task_loss_of(runner.predict, other, index, 3)
+    assert scaled == pytest.approx([value / 4 for value in own], rel=1e-4)
+    assert performance_gain([1.0, 0.5, None], [0.25, 0.75, 0.1]) == [0.75, 0.0, 0.0]
+
+
+def test_balanced_sampling_gives_every_task_the_same_share():
+    task_index = torch.cat([torch.zeros(900, dtype=torch.long), torch.ones(100, dtype=torch.long)])
+    train_index = torch.arange(1000)
+    generator = torch.Generator().manual_seed(0)
+    balanced = batch_sampler(train_index, task_index, "balanced", generator)((50, 200))
+    uniform = batch_sampler(train_index, task_index, "uniform", generator)((50, 200))
+    assert task_index[balanced].float().mean() == pytest.approx(0.5, abs=0.02)
+    assert task_index[uniform].float().mean() == pytest.approx(0.1, abs=0.02)
+    with pytest.raises(ValueError, match="sampling"):
+        batch_sampler(train_index, task_index, "by-length", generator)
+
+
+def phase_steps(*args: str) -> int:
+    return draccus.parse(RunConfig, args=list(args)).phase_steps(12_000)
+
+
+def test_bc_and_dagger_phases_train_by_one_rule():
+    """Defect 6: at every budget BC trains like a DAgger phase."""
+    assert phase_steps("--mode=bc", "--warm_start=false") == phase_steps("--warm_start=false") == 1500
+    assert phase_steps("--mode=bc") == 4 * 1500, "warm start: BC gets the final DAgger policy's steps in all"
+    epochs = ["--steps_rule=epochs", "--epochs=10"]
+    assert phase_steps("--mode=bc", *epochs) == phase_steps(*epochs) == int(np.ceil(10 * 12_000 / 256))
+    with pytest.raises(ValueError, match="steps_rule"):
+        RunConfig(steps_rule="until-bored")
+
+
+def normaliser_stats(policy_root: Path) -> bytes:
+    (path,) = policy_root.glob("policy_preprocessor_step_*_normalizer_processor.safetensors")
+    return path.read_bytes()
+
+
+@pytest.mark.parametrize("normalisation", ["fixed", "recompute"])
+def test_normalisation_is_fixed_after_round_0_unless_asked(tmp_path, normalisation):
+    root = tmp_path / normalisation
+    config = draccus.parse(
+        RunConfig, args=[*TOY_RUN, "--rounds=1", f"--normalisation={normalisation}", f"--output_dir={root}"]
+    )
+    run(config)
+    experiment = ExperimentDir(root)
+    same = normaliser_stats(experiment.policy_root(0)) == normaliser_stats(experiment.policy_root(1))
+    assert same == (normalisation == "fixed")
+    phase1 = json.loads((experiment.policy_root(1) / "training.json").read_text())
+    assert phase1["loss_previous"] is not None and phase1["gain"] is not None
