@@ -8,6 +8,7 @@ deviation over seeds at the same round (the same number of demos for every seed 
 
 from __future__ import annotations
 
+import json
 import math
 from collections import defaultdict
 from collections.abc import Sequence
@@ -16,7 +17,14 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.rounds import ExperimentDir
+from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir
+
+PER_RUN_FIELDS = ("seed", "output_dir", "resume", "progress", "workers")
+"""Config fields that may differ between the runs of one method (they never change a result, or are
+what the runs are repeated over)."""
+
+BC_BUDGET_FIELDS = ("rounds", "scheduler")
+"""Fields that may also differ between BC runs: the budget (``rounds``) and the unused scheduler."""
 
 
 @dataclass
@@ -50,8 +58,11 @@ def learning_curves(roots: Sequence[Path]) -> list[CurvePoint]:
     """Groups experiments by method and averages their curves over seeds, round by round.
 
     Raises:
-        ValueError: If two runs of one method used the same seed (a duplicate would bias the mean).
+        ValueError: If two runs of one method used the same seed (a duplicate would bias the mean),
+            their configs differ in more than the seed (``check_comparable``), or no run has an
+            evaluated phase.
     """
+    check_comparable(roots)
     grouped: dict[str, dict[int, list[tuple[int, float, float]]]] = defaultdict(dict)
     for root in roots:
         method, seed, points = experiment_curve(Path(root))
@@ -71,7 +82,44 @@ def learning_curves(roots: Sequence[Path]) -> list[CurvePoint]:
             curves.append(
                 CurvePoint(method, round_index, demos, float(np.mean(successes)), std, len(successes))
             )
+    if not curves:
+        raise ValueError(
+            f"None of the {len(roots)} experiment(s) has an evaluated phase (they ran with "
+            "--eval_episodes=0?): evaluate their policies with `lerobot-mtdagger eval` or rerun them "
+            "with --eval_episodes > 0."
+        )
     return curves
+
+
+def check_comparable(roots: Sequence[Path]) -> None:
+    """Refuses to group runs of one method whose configs differ in more than ``PER_RUN_FIELDS``.
+
+    BC runs may also differ in ``BC_BUDGET_FIELDS`` (one BC run per budget).
+
+    Raises:
+        ValueError: Naming the method, the differing fields with their values and two such runs.
+    """
+    first_of_method: dict[str, tuple[Path, dict]] = {}
+    for root in roots:
+        root = Path(root)
+        path = root / CONFIG_FILE
+        if not path.is_file():
+            raise ValueError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
+        config = json.loads(path.read_text())
+        method = "bc" if config.get("mode") == "bc" else config.get("scheduler", {}).get("type")
+        ignored = PER_RUN_FIELDS + (BC_BUDGET_FIELDS if method == "bc" else ())
+        shared = {key: value for key, value in config.items() if key not in ignored}
+        if method not in first_of_method:
+            first_of_method[method] = (root, shared)
+            continue
+        other_root, other = first_of_method[method]
+        differing = sorted(key for key in set(shared) | set(other) if shared.get(key) != other.get(key))
+        if differing:
+            details = ", ".join(f"{key}: {other.get(key)!r} vs {shared.get(key)!r}" for key in differing)
+            raise ValueError(
+                f"Refusing to average {method} runs with different configs ({details}) in {other_root} "
+                f"and {root}: report them separately, or rerun them with the same options."
+            )
 
 
 def markdown_table(curves: Sequence[CurvePoint]) -> str:

@@ -137,6 +137,27 @@ def test_report_gives_success_against_demos(experiment, tmp_path, capsys):
     assert "| need | 2 |" in (tmp_path / "r.md").read_text()
 
 
+def test_report_refuses_to_average_runs_of_different_configs(experiment, tmp_path):
+    from lerobot_mtdagger.report import learning_curves
+
+    other = tmp_path / "need-longer"
+    shutil.copytree(experiment.root, other)
+    config = json.loads((other / "config.json").read_text())
+    config |= {"seed": 1, "steps_per_round": 999, "workers": 0}
+    (other / "config.json").write_text(json.dumps(config))
+    with pytest.raises(ValueError, match=r"different configs \(steps_per_round: 60 vs 999\)"):
+        learning_curves([experiment.root, other])
+
+
+def test_report_refuses_runs_without_evaluation(tmp_path):
+    from lerobot_mtdagger.report import learning_curves
+    from tests.test_toy import toy_config
+
+    run(toy_config(tmp_path / "blind", "--rounds=0", "--eval_episodes=0"))
+    with pytest.raises(ValueError, match="no evaluated phase|has an evaluated phase"):
+        learning_curves([tmp_path / "blind"])
+
+
 def test_round_policies_are_lerobot_pretrained_models(experiment):
     policy = MTDAggerPolicy.from_pretrained(str(experiment.policy_root(2)))
     assert policy.config.task_names == TASKS

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Protocol ablation on the development seeds (100-102), MT10 state, `small` preset, 10 evaluation
+# episodes per task. One `compare` per protocol variant, each changing ONE option from the default
+# protocol; every variant resumes where it stopped. Run from the repository root:
+#   nohup bash docs/results/protocol-ablation-dev/run.sh > outputs/ablation-dev.log 2>&1 &
+set -euo pipefail
+CLI=.venv/bin/lerobot-mtdagger
+OUT=outputs/ablation-dev
+COMMON=(--seeds='[100,101,102]' --jobs=2 --eval_episodes=10 --progress=false)
+
+variant() {  # name, methods, extra run options...
+  local name=$1 methods=$2
+  shift 2
+  "$CLI" compare --methods="$methods" --bc_budgets='[12]' "${COMMON[@]}" --output_dir="$OUT/$name" "$@"
+  "$CLI" report --compare_dir="$OUT/$name"
+}
+
+variant default '[bc,uniform,need,gain]'
+variant mixing-step '[uniform,need]' --mixing=step
+variant rollout-cap-200 '[uniform,need]' --max_rollout_steps=200
+variant normalisation-recompute '[uniform,need]' --normalisation=recompute
+variant retrain-epochs '[bc,uniform,need]' --warm_start=false --steps_rule=epochs --epochs=100
+variant sampling-balanced '[bc,uniform,need]' --sampling=balanced
