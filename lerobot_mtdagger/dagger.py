@@ -439,6 +439,7 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         ValueError: On a bad config or a foreign/corrupt output directory (left untouched).
         FloatingPointError: If training diverges.
         WorkerDiedError: If an env worker process dies.
+        ExperimentLockedError: If another run is writing into the output directory.
     """
     with quiet_third_party():  # importing MetaWorld's renderer logs an OpenGL INFO line
         suite = suite_from_config(config)
@@ -446,10 +447,19 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
     experiment = ExperimentDir(config.output_dir)
     if config.resume:
         experiment.check_resumable(config.to_dict())
-        experiment.committed_rounds()  # refuses foreign or corrupt round folders before touching anything
-        experiment.clear_staging()
     else:
         experiment.initialise(config.to_dict())
+    with experiment.writer_lock():
+        if config.resume:
+            experiment.committed_rounds()  # refuses foreign or corrupt round folders before touching anything
+            experiment.clear_staging()
+        return _run_locked(config, suite, experiment, on_summary)
+
+
+def _run_locked(
+    config: RunConfig, suite: TaskSuite, experiment: ExperimentDir, on_summary: Callable[[str], None] | None
+) -> list[str]:
+    """The rounds and phases of ``run``, with the experiment's writer lock held."""
     handler = logging.FileHandler(experiment.root / "run.log")
     handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     logging.getLogger("lerobot_mtdagger").addHandler(handler)

@@ -30,12 +30,14 @@ or video features take LeRobot's own per-frame path.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import fcntl
 import json
 import logging
 import os
 import shutil
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -59,6 +61,14 @@ POLICIES_DIR = "policies"
 STAGING_DIR = ".staging"
 TRAINING_FILE = "training.json"
 CONFIG_FILE = "config.json"
+LOCK_FILE = ".lock"
+"""The writer lock of an experiment folder (an OS lock held while a run writes; it holds the pid)."""
+
+
+class ExperimentLockedError(RuntimeError):
+    """Another process holds the writer lock of an experiment folder."""
+
+
 DATASET_FPS = 80
 
 EpisodeFrames = tuple[str, Sequence[Mapping[str, Any]]]
@@ -108,6 +118,34 @@ class ExperimentDir:
         self.rounds.mkdir(parents=True, exist_ok=True)
         self.policies.mkdir(parents=True, exist_ok=True)
         write_json_atomic(self.root / CONFIG_FILE, config)
+
+    @contextlib.contextmanager
+    def writer_lock(self) -> Iterator[None]:
+        """Holds the folder's writer lock: one run writes into an experiment at a time.
+
+        The lock is an OS lock (``flock``) on ``<root>/.lock``, released when the process exits,
+        however it exits (a run killed with SIGKILL leaves no stale lock). The file holds the pid
+        of the writer, for the message a second writer gets.
+
+        Raises:
+            ExperimentLockedError: At once, if another process holds the lock, naming it.
+        """
+        self.root.mkdir(parents=True, exist_ok=True)
+        descriptor = os.open(self.root / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            try:
+                fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.pread(descriptor, 64, 0).decode(errors="replace").strip() or "unknown"
+                raise ExperimentLockedError(
+                    f"{self.root} is being written by another run (pid {holder}); wait for it to finish "
+                    f"or stop it, then pass --resume=true."
+                ) from None
+            os.ftruncate(descriptor, 0)
+            os.pwrite(descriptor, str(os.getpid()).encode(), 0)
+            yield
+        finally:
+            os.close(descriptor)  # closing releases the lock
 
     def check_resumable(
         self, config: dict[str, Any], ignore: Sequence[str] = ("resume", "progress", "output_dir", "workers")

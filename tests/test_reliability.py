@@ -1,0 +1,52 @@
+"""Reliability of experiment folders: one writer at a time."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+
+import pytest
+
+from lerobot_mtdagger.dagger import run
+from lerobot_mtdagger.rounds import LOCK_FILE, ExperimentDir, ExperimentLockedError
+from tests.test_toy import toy_config
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    root = tmp_path_factory.mktemp("lock") / "toy"
+    run(toy_config(root, "--rounds=1"))
+    return root
+
+
+def test_a_second_writer_is_refused_at_once_naming_the_folder_and_the_process(finished):
+    before = sorted(p.relative_to(finished) for p in finished.rglob("*"))
+    expected = rf"{finished} is being written by .*pid {os.getpid()}"
+    with ExperimentDir(finished).writer_lock(), pytest.raises(ExperimentLockedError, match=expected):
+        run(toy_config(finished, "--rounds=1", "--resume=true"))
+    assert sorted(p.relative_to(finished) for p in finished.rglob("*")) == before
+    assert run(toy_config(finished, "--rounds=1", "--resume=true")), "the lock is released on exit"
+
+
+def test_a_killed_writer_leaves_no_stale_lock(finished):
+    code = (
+        "import sys, time\n"
+        "from lerobot_mtdagger.rounds import ExperimentDir\n"
+        f"with ExperimentDir({str(finished)!r}).writer_lock():\n"
+        "    print('locked', flush=True)\n"
+        "    time.sleep(60)\n"
+    )
+    holder = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        assert (finished / LOCK_FILE).read_text() == str(holder.pid)
+        second_writer = ExperimentDir(finished).writer_lock()
+        with pytest.raises(ExperimentLockedError, match=f"pid {holder.pid}"), second_writer:
+            pass
+    finally:
+        holder.send_signal(signal.SIGKILL)
+        holder.wait()
+    with ExperimentDir(finished).writer_lock():
+        assert (finished / LOCK_FILE).read_text() == str(os.getpid())
