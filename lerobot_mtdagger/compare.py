@@ -12,7 +12,7 @@ options, in its own folder under the compare folder::
 BC budgets are expert demos per task. The default is the cumulative demos per task of DAgger after
 each round (``initial_demos + k * budget_per_task``, k = 0..rounds), so BC has a point at every x
 where DAgger has one; BC at the budget of round k is ``run --mode=bc --rounds=k``, which also
-trains it for the same number of steps as DAgger up to round k.
+trains it by the same rule as DAgger's phase k (``RunConfig.phase_steps``).
 
 Runs are independent processes (``--jobs`` at once, default one per core); each gets
 ``cores / jobs`` torch threads and env workers so the jobs do not oversubscribe the cores. A
