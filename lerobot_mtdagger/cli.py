@@ -191,6 +191,8 @@ class EvalConfig:
         image_size: Image side.
         output: Optional JSON file for the results.
         workers: Env worker processes (None: one per core; 0: in this process).
+        trust_checkpoint: Let the policy's processor configs name Python classes, which LeRobot's
+            loader imports and calls (default: only LeRobot registry names are accepted).
     """
 
     policy_path: str | None = None
@@ -203,6 +205,7 @@ class EvalConfig:
     image_size: int = 84
     output: Path | None = None
     workers: int | None = None
+    trust_checkpoint: bool = False
 
     @property
     def worker_count(self) -> int:
@@ -224,7 +227,7 @@ def eval_command(config: EvalConfig) -> dict:
     from lerobot_mtdagger.workers import EnvWorkers
 
     suite = suite_from_config(config)
-    runner = PolicyRunner.from_pretrained(config.policy_path)
+    runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
     with EnvWorkers(suite, config.worker_count) as workers:
         result, _ = evaluate(workers, runner, config.episodes, config.seed)
     for task, success in zip(result.task_names, result.success, strict=True):

@@ -16,6 +16,7 @@ import numpy as np
 import torch
 from lerobot.policies.factory import make_pre_post_processors
 
+from lerobot_mtdagger.checkpoints import check_hub_policy, check_policy_folder
 from lerobot_mtdagger.collect import EVAL_STREAM, PolicyFn, run_episodes, success_by_task
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.workers import EnvWorkers, Episode
@@ -33,8 +34,25 @@ class PolicyRunner:
         self.image_keys = set(policy.config.image_features)
 
     @classmethod
-    def from_pretrained(cls, path: str | Path, device: str = "cpu") -> PolicyRunner:
-        """Loads a pretrained model folder or Hub id with its saved processors."""
+    def from_pretrained(
+        cls, path: str | Path, device: str = "cpu", trust_checkpoint: bool = False
+    ) -> PolicyRunner:
+        """Loads a pretrained model folder or Hub id with its saved processors.
+
+        Args:
+            path: A local policy folder or a Hub repo id.
+            device: Torch device.
+            trust_checkpoint: Let the processor configs name Python classes to import (LeRobot's
+                loader imports and calls them); otherwise every step must be a LeRobot registry name.
+
+        Raises:
+            UntrustedCheckpointError: If a processor config names code and the checkpoint is not trusted.
+        """
+        if not trust_checkpoint:
+            if Path(path).is_dir():
+                check_policy_folder(Path(path))
+            else:
+                check_hub_policy(str(path))
         policy = MTDAggerPolicy.from_pretrained(str(path))
         policy.config.device = device
         policy.to(device)
