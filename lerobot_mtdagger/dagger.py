@@ -74,6 +74,7 @@ from lerobot_mtdagger.train import (
     load_round,
     loss_split,
     per_task_loss_of,
+    performance_gain,
     policy_config,
     save_policy,
     train_phase,
@@ -361,14 +362,6 @@ def normalisation_frames(config: RunConfig, data: TrainingData, train_index: tor
     if config.normalisation == "recompute":
         return train_index
     return train_index[data.episode_id[train_index] < EPISODE_ID_STRIDE]
-
-
-def performance_gain(loss_previous: list[float | None], loss_end: list[float | None]) -> list[float]:
-    """``max(0, L_previous - L_end)`` per task (0 where a task has no measured loss)."""
-    return [
-        max(0.0, before - after) if before is not None and after is not None else 0.0
-        for before, after in zip(loss_previous, loss_end, strict=True)
-    ]
 
 
 def rounds_in_memory(ctx: RunContext, round_index: int, input_keys: list[str]) -> TrainingData:

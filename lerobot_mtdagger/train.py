@@ -489,14 +489,10 @@ def train_phase(
             if on_step is not None:
                 on_step(step + 1, float(losses.double().mean()))
     loss_end, counts = per_task_loss(policy, data, loss_index, num_tasks)
-    gain = [
-        max(0.0, start - end) if start is not None and end is not None else 0.0
-        for start, end in zip(loss_start, loss_end, strict=True)
-    ]
     return PhaseResult(
         loss_start=loss_start,
         loss_end=loss_end,
-        gain=gain,
+        gain=performance_gain(loss_start, loss_end),
         train_loss=tail.tolist(),
         loss_samples=counts,
     )
@@ -530,6 +526,14 @@ def batch_sampler(
         return grouped[starts[task] + torch.minimum(within, counts[task] - 1)]
 
     return draw
+
+
+def performance_gain(loss_before: list[float | None], loss_after: list[float | None]) -> list[float]:
+    """``max(0, L_before - L_after)`` per task (0 where a task has no measured loss)."""
+    return [
+        max(0.0, before - after) if before is not None and after is not None else 0.0
+        for before, after in zip(loss_before, loss_after, strict=True)
+    ]
 
 
 def _check_finite(losses: torch.Tensor, first_step: int) -> None:

@@ -23,12 +23,13 @@ import torch
 
 from lerobot_mtdagger.collect import COLLECT_STREAM, learner_success_by_task, run_episodes, success_by_task
 from lerobot_mtdagger.configs import RunConfig
-from lerobot_mtdagger.dagger import performance_gain, run
+from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.evaluate import PolicyRunner
 from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.train import (
     EPISODE_ID_STRIDE,
+    NormalisedData,
     TrainingData,
     batch_sampler,
     build_processors,
@@ -36,6 +37,7 @@ from lerobot_mtdagger.train import (
     loss_split,
     per_task_loss,
     per_task_loss_of,
+    performance_gain,
 )
 from lerobot_mtdagger.workers import BETA_STREAM, EnvWorkers, expert_episode_coin
 from tests.test_toy import TOY_RUN
@@ -159,8 +161,6 @@ def test_the_previous_policy_is_measured_in_the_current_normalisation():
     assert per_task_loss_of(runner.predict, same, index, 3) == pytest.approx(own, rel=1e-5)
     wider = {k: dict(v) for k, v in stats.items()}
     wider["action"]["std"] = stats["action"]["std"] * 2
-    from lerobot_mtdagger.train import NormalisedData
-
     other = NormalisedData(data, build_processors(policy.config, wider)[0], [], policy.config.task_names)
     scaled = per_task_loss_of(runner.predict, other, index, 3)
     assert scaled == pytest.approx([value / 4 for value in own], rel=1e-4)
