@@ -12,16 +12,22 @@ policy config resolves its ``type`` through LeRobot's config registry, so neithe
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 from lerobot.processor.pipeline import ProcessorStepRegistry
 
+from lerobot_mtdagger.errors import UserError
+
 PROCESSOR_FILES = ("policy_preprocessor.json", "policy_postprocessor.json")
+POLICY_TYPE = "mtdagger"
+HUB_ID_PATTERN = re.compile(r"[A-Za-z0-9][\w.-]*/[A-Za-z0-9][\w.-]*")
+"""``owner/name``: a ``--policy_path`` of this form that is not a local folder is read from the Hub."""
 
 TRUST_HINT = "load only checkpoints you trust, with --trust_checkpoint=true"
 
 
-class UntrustedCheckpointError(ValueError):
+class UntrustedCheckpointError(UserError):
     """A policy folder asks to import code, or is not a processor config this toolkit can read."""
 
 
@@ -79,3 +85,75 @@ def check_hub_policy(repo_id: str) -> None:
 
     for name in PROCESSOR_FILES:
         check_processor_config(Path(hf_hub_download(repo_id, name)))
+
+
+def is_hub_id(path: str) -> bool:
+    """Whether a policy path that is not on disk names a Hub repo (``owner/name``)."""
+    return HUB_ID_PATTERN.fullmatch(str(path)) is not None
+
+
+def check_policy_path(path: str | Path) -> None:
+    """Refuses a policy path that is neither a loadable local policy folder nor a Hub id.
+
+    Raises:
+        UserError: Naming the path (or the file in it) at fault and what to pass instead.
+    """
+    folder = Path(path)
+    if folder.exists():
+        check_local_policy(folder)
+    elif not is_hub_id(str(path)):
+        raise UserError(
+            f"{path} does not exist: --policy_path takes a policy folder (config.json, model.safetensors, "
+            "processors; e.g. <experiment>/policies/round-003) or a Hub id owner/name."
+        )
+
+
+def check_local_policy(folder: Path) -> None:
+    """Checks that a local folder is a complete ``mtdagger`` policy with readable safetensors files.
+
+    Raises:
+        UserError: If it is a file, a dataset, an experiment, another policy type, or a file of it is
+            missing or unreadable, naming it.
+    """
+    if not folder.is_dir():
+        raise UserError(f"{folder} is a file: --policy_path takes a policy folder or a Hub id owner/name.")
+    if (folder / "policies").is_dir():
+        phases = sorted(p.name for p in (folder / "policies").glob("round-*"))
+        example = folder / "policies" / (phases[-1] if phases else "round-000")
+        raise UserError(f"{folder} is an experiment folder: pass one of its policies, e.g. {example}.")
+    config = folder / "config.json"
+    if not config.is_file():
+        kind = "a LeRobot dataset" if (folder / "meta" / "info.json").is_file() else "not a policy folder"
+        raise UserError(
+            f"{folder} is {kind} (no config.json): pass a policy folder, "
+            "e.g. <experiment>/policies/round-003."
+        )
+    try:
+        policy_type = json.loads(config.read_text()).get("type")
+    except (json.JSONDecodeError, AttributeError):
+        raise UserError(
+            f"{config} is not a policy config (unreadable JSON); the checkpoint is corrupt."
+        ) from None
+    if policy_type != POLICY_TYPE:
+        raise UserError(
+            f"{config} describes a {policy_type!r} policy; this command evaluates {POLICY_TYPE!r} policies "
+            "(stock lerobot-eval evaluates the others)."
+        )
+    if not (folder / "model.safetensors").is_file():
+        raise UserError(f"{folder / 'model.safetensors'} is missing: the checkpoint is incomplete.")
+    for weights in sorted(folder.glob("*.safetensors")):
+        _check_safetensors(weights)
+
+
+def _check_safetensors(path: Path) -> None:
+    """Refuses a truncated or garbled safetensors file, naming it."""
+    from safetensors import SafetensorError, safe_open
+
+    try:
+        with safe_open(str(path), "pt") as handle:
+            handle.keys()
+    except (SafetensorError, OSError) as error:
+        raise UserError(
+            f"{path} is not a readable safetensors file ({error}): the checkpoint is incomplete or "
+            "corrupt; copy it again or retrain it."
+        ) from None

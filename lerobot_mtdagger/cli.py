@@ -24,6 +24,8 @@ Commands:
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import logging
 import sys
@@ -33,9 +35,11 @@ from pathlib import Path
 
 import draccus
 import numpy as np
+import yaml
 
 from lerobot_mtdagger.compare import CompareConfig, split_arguments
 from lerobot_mtdagger.configs import RunConfig, renamed_option_error, resolve_workers
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.hub import PushConfig, push_command
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
 from lerobot_mtdagger.simulate import SyntheticTasks, simulate
@@ -128,14 +132,17 @@ class VerifyConfig:
 
 
 def verify_command(config: VerifyConfig) -> list[str]:
-    """Recomputes every round's allocation from its record and checks it against the data."""
+    """Checks every committed round and policy against its files and record; exits 1 on a problem."""
     from lerobot_mtdagger.rounds import ExperimentDir
     from lerobot_mtdagger.verify import verify_experiment
 
-    num_rounds, problems = verify_experiment(ExperimentDir(config.experiment_dir))
+    num_rounds, num_policies, problems = verify_experiment(ExperimentDir(config.experiment_dir))
     for problem in problems:
-        print(f"MISMATCH {problem}")
-    print(f"verified {num_rounds} round(s) in {config.experiment_dir}: {len(problems)} problem(s)")
+        print(f"PROBLEM {problem}")
+    print(
+        f"verified {num_rounds} round(s) and {num_policies} policy folder(s) in {config.experiment_dir}: "
+        f"{len(problems)} problem(s)"
+    )
     if problems:
         raise SystemExit(1)
     return problems
@@ -167,10 +174,13 @@ def merge_command(config: MergeConfig) -> Path:
     from lerobot_mtdagger.rounds import ExperimentDir, merge_rounds
 
     experiment = ExperimentDir(config.experiment_dir)
+    experiment.read_config()  # refuses a folder that is not an experiment
     rounds = experiment.committed_rounds()
+    if not rounds:
+        raise UserError(f"{config.experiment_dir} has no committed round to merge yet.")
     last = rounds[-1] if config.up_to_round is None else config.up_to_round
     if last not in rounds:
-        raise ValueError(f"Round {last} is not committed in {config.experiment_dir}; committed: {rounds}.")
+        raise UserError(f"Round {last} is not committed in {config.experiment_dir}; committed: {rounds}.")
     output = merge_rounds(experiment, list(range(last + 1)), config.output, config.repo_id)
     print(f"merged rounds 0..{last} into {output}")
     return output
@@ -228,6 +238,7 @@ def eval_command(config: EvalConfig) -> dict:
 
     suite = suite_from_config(config)
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
+    runner.check_inputs(suite.features, config.obs_mode)
     with EnvWorkers(suite, config.worker_count) as workers:
         result, _ = evaluate(workers, runner, config.episodes, config.seed)
     for task, success in zip(result.task_names, result.success, strict=True):
@@ -337,8 +348,63 @@ def configure_console_logging() -> None:
     logging.basicConfig(level=logging.INFO, handlers=[console])
 
 
+DEBUG_FLAG = "--debug"
+"""Shows the traceback of a user error (for reporting a problem)."""
+
+
+def error_line(command: str, message: object) -> str:
+    """The one line printed for a user error: ``lerobot-mtdagger <command>: error: <message>``."""
+    return f"lerobot-mtdagger {command}: error: {' '.join(str(message).split())}"
+
+
+def unparsable_option(options: Sequence[str]) -> str | None:
+    """A message naming the first option whose value is not valid YAML (draccus reads values as YAML)."""
+    for option in options:
+        name, separator, value = option.partition("=")
+        if not separator:
+            continue
+        try:
+            yaml.safe_load(value)
+        except yaml.YAMLError as error:
+            problem = getattr(error, "problem", None) or type(error).__name__
+            return (
+                f"{name}={value!r} is not a valid value ({problem}); lists are written "
+                f"{name}='[a,b]', strings with special characters are quoted."
+            )
+    return None
+
+
+def parse_config(command: str, config_class: type, options: list[str]) -> object:
+    """Parses the options of a command into its config.
+
+    Raises:
+        UserError: Naming the option at fault (draccus' own message, or the config's check).
+        SystemExit: With status 0 after ``--help``.
+    """
+    argparse_output = io.StringIO()
+    try:
+        with contextlib.redirect_stderr(argparse_output):
+            return draccus.parse(config_class=config_class, args=options, prog=f"lerobot-mtdagger {command}")
+    except draccus.utils.ParsingError as error:
+        # draccus hides the config's own ValueError (which names the field and the fix) as the cause.
+        cause = error.__cause__ if error.__cause__ is not None else error
+        raise UserError(str(cause)) from error
+    except SystemExit as exit_:
+        if exit_.code in (0, None):
+            raise
+        # argparse printed its usage and "<prog>: error: <message>"; keep the message only.
+        message = argparse_output.getvalue().strip().splitlines()[-1].partition("error: ")[2]
+        raise UserError(
+            f"{message}; the options are listed by `lerobot-mtdagger {command} --help`."
+        ) from None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the console script.
+
+    A user error (``errors.UserError``: a bad option, path or file) prints one line
+    ``lerobot-mtdagger <command>: error: <what and how to fix>`` and returns 2; with ``--debug`` it
+    raises, with its traceback. Any other exception is a bug and raises.
 
     Args:
         argv: Arguments after the program name; ``sys.argv[1:]`` when None.
@@ -347,6 +413,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         The process exit status.
     """
     args = list(sys.argv[1:] if argv is None else argv)
+    debug = DEBUG_FLAG in args
+    args = [arg for arg in args if arg != DEBUG_FLAG]
     if not args or args[0] in ("-h", "--help", "help"):
         print(_usage())
         return 0
@@ -356,22 +424,34 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     renamed = renamed_option_error(options)
     if renamed is not None:
-        print(f"lerobot-mtdagger {command}: error: {renamed}", file=sys.stderr)
+        print(error_line(command, renamed), file=sys.stderr)
         return 2
     configure_console_logging()
+    try:
+        run_command(command, options)
+    except UserError as error:
+        if debug:
+            raise
+        print(error_line(command, error), file=sys.stderr)
+        return 2
+    return 0
+
+
+def run_command(command: str, options: list[str]) -> None:
+    """Parses a command's options and runs it.
+
+    Raises:
+        UserError: On a bad option, path or file.
+    """
+    unparsable = unparsable_option(options)
+    if unparsable is not None:
+        raise UserError(unparsable)
     config_class, function = COMMANDS[command]
     passed: list[str] = []
     if command == "compare":  # compare's own options; every other option goes to each run
         options, passed = split_arguments(options)
-    try:
-        config = draccus.parse(config_class=config_class, args=options, prog=f"lerobot-mtdagger {command}")
-    except draccus.utils.ParsingError as error:
-        # draccus hides the config's own ValueError (which names the field and the fix) as the cause.
-        cause = error.__cause__ if error.__cause__ is not None else error
-        print(f"lerobot-mtdagger {command}: error: {cause}", file=sys.stderr)
-        return 2
+    config = parse_config(command, config_class, options)
     function(config, passed) if command == "compare" else function(config)
-    return 0
 
 
 if __name__ == "__main__":

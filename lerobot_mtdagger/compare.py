@@ -34,6 +34,7 @@ from pathlib import Path
 import draccus
 
 from lerobot_mtdagger.configs import RunConfig, default_worker_count
+from lerobot_mtdagger.errors import UserError
 
 logger = logging.getLogger(__name__)
 
@@ -84,7 +85,7 @@ def base_run_config(run_args: Sequence[str]) -> RunConfig:
     """
     for arg in run_args:
         if arg.split("=", 1)[0] in ("--seed", "--mode", "--scheduler.type", "--output_dir", "--resume"):
-            raise ValueError(f"{arg} is set per run by compare: use --methods/--seeds/--output_dir.")
+            raise UserError(f"{arg} is set per run by compare: use --methods/--seeds/--output_dir.")
     return draccus.parse(RunConfig, args=list(run_args))
 
 
@@ -102,7 +103,7 @@ def bc_rounds_for(config: RunConfig, budgets: Sequence[int], num_tasks: int) -> 
         k = (budget - config.initial_demos) / per_round
         if k < 0 or k != int(k):
             valid = [int(config.initial_demos + j * per_round) for j in range(config.rounds + 4)]
-            raise ValueError(
+            raise UserError(
                 f"BC budget {budget} demos per task is not initial_demos + k * budget per task "
                 f"({config.initial_demos} + k * {per_round:g}); choose among {valid}..."
             )
@@ -167,7 +168,7 @@ def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
     with log_path.open("a") as log:
         status = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT, env=env, check=False)
     if status.returncode != 0:
-        raise RuntimeError(f"Run {job.name} failed (exit {status.returncode}); see {log_path}.")
+        raise UserError(f"Run {job.name} failed (exit {status.returncode}); see {log_path}.")
     return folder
 
 
@@ -179,9 +180,9 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
         RuntimeError: If a run fails (the others still finish; rerun to resume).
     """
     if compare_config.jobs is not None and compare_config.jobs < 1:
-        raise ValueError(f"--jobs must be >= 1, got {compare_config.jobs}.")
+        raise UserError(f"--jobs must be >= 1, got {compare_config.jobs}.")
     if not compare_config.methods or not compare_config.seeds:
-        raise ValueError("--methods and --seeds must not be empty.")
+        raise UserError("--methods and --seeds must not be empty.")
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.results import results_rows, write_results
 

@@ -240,7 +240,9 @@ class RunConfig:
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}.")
         resolve_workers(self.workers)  # refuses a negative count before anything runs
-        for name in ("steps_per_round", "budget_per_task", "max_rollout_steps", "epochs"):
+        if self.seed < 0:
+            raise ValueError(f"seed must be >= 0, got {self.seed}.")
+        for name in ("steps_per_round", "budget", "budget_per_task", "max_rollout_steps", "epochs"):
             if getattr(self, name) is not None and not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}.")
         for name, choices in (
@@ -262,11 +264,12 @@ class RunConfig:
             raise ValueError(f"gain_split must be 'train' or 'heldout', got {self.gain_split!r}.")
         if not 0.0 < self.heldout_fraction < 1.0:
             raise ValueError(f"heldout_fraction must be in (0, 1), got {self.heldout_fraction}.")
-        if self.policy.batch_size <= 0 or self.policy.lr <= 0:
+        if self.policy.batch_size <= 0 or not (math.isfinite(self.policy.lr) and self.policy.lr > 0):
             raise ValueError(
-                f"policy.batch_size and policy.lr must be > 0, "
+                f"policy.batch_size and policy.lr must be finite and > 0, "
                 f"got {self.policy.batch_size}, {self.policy.lr}."
             )
+        check_device(self.policy.device)
 
     @property
     def is_bc(self) -> bool:
@@ -307,6 +310,29 @@ class RunConfig:
         record["output_dir"] = str(self.output_dir)
         record["scheduler"] = {"type": self.scheduler.type, **self.scheduler.hyperparameters()}
         return record
+
+
+def check_device(device: str) -> None:
+    """Refuses a torch device this machine does not have, before anything runs.
+
+    Raises:
+        ValueError: Naming the device and the devices there are.
+    """
+    import torch
+
+    try:
+        parsed = torch.device(device)
+    except RuntimeError:
+        raise ValueError(f"policy.device={device!r} is not a torch device: use cpu or cuda:N.") from None
+    if parsed.type == "cuda":
+        count = torch.cuda.device_count() if torch.cuda.is_available() else 0
+        if count == 0 or (parsed.index is not None and parsed.index >= count):
+            raise ValueError(
+                f"policy.device={device!r} is not available here ({count} CUDA device(s)); "
+                "pass --policy.device=cpu."
+            )
+    elif parsed.type == "mps" and not torch.backends.mps.is_available():
+        raise ValueError(f"policy.device={device!r} is not available here; pass --policy.device=cpu.")
 
 
 def resolve_workers(workers: int | None) -> int:

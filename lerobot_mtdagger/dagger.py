@@ -59,6 +59,7 @@ from lerobot_mtdagger.collect import (
 from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.envs import IMAGE_KEY, suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.evaluate import EvalResult, PolicyRunner, evaluate
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.quiet import quiet_third_party
@@ -409,12 +410,12 @@ def check_budget(config: RunConfig, num_tasks: int) -> None:
     """Refuses a round budget that cannot give every task n_min episodes, before anything runs.
 
     Raises:
-        ValueError: With the numbers and the fix.
+        UserError: With the numbers and the fix.
     """
     budget = config.budget_for(num_tasks)
     n_min = config.scheduler.min_episodes
     if not config.is_bc and budget < n_min * num_tasks:
-        raise ValueError(
+        raise UserError(
             f"budget={budget} is smaller than n_min * num_tasks = {n_min} * {num_tasks} = "
             f"{n_min * num_tasks}: raise --budget to at least {n_min * num_tasks} or lower --scheduler.n_min."
         )
@@ -428,11 +429,11 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         on_summary: Called with each round's summary line as soon as the round is done.
 
     Raises:
-        FileExistsError: If the output directory exists and ``resume`` is false.
-        ValueError: On a bad config or a foreign/corrupt output directory (left untouched).
+        UserError: If the output directory exists and ``resume`` is false, on a bad config, on a
+            foreign output directory or one whose committed files changed (left untouched), and
+            (``ExperimentLockedError``) if another run is writing into it.
         FloatingPointError: If training diverges.
         WorkerDiedError: If an env worker process dies.
-        ExperimentLockedError: If another run is writing into the output directory.
     """
     with quiet_third_party():  # importing MetaWorld's renderer logs an OpenGL INFO line
         suite = suite_from_config(config)
@@ -444,7 +445,7 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         experiment.initialise(config.to_dict())
     with experiment.writer_lock():
         if config.resume:
-            experiment.committed_rounds()  # refuses foreign or corrupt round folders before touching anything
+            experiment.check_committed_files()  # refuses foreign, corrupt or changed rounds and policies
             experiment.clear_staging()
         return _run_locked(config, suite, experiment, on_summary)
 

@@ -16,9 +16,11 @@ import numpy as np
 import torch
 from lerobot.policies.factory import make_pre_post_processors
 
-from lerobot_mtdagger.checkpoints import check_hub_policy, check_policy_folder
+from lerobot_mtdagger.checkpoints import check_hub_policy, check_policy_folder, check_policy_path
 from lerobot_mtdagger.collect import EVAL_STREAM, PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.quiet import quiet_third_party
 from lerobot_mtdagger.workers import EnvWorkers, Episode
 
 
@@ -47,13 +49,32 @@ class PolicyRunner:
 
         Raises:
             UntrustedCheckpointError: If a processor config names code and the checkpoint is not trusted.
+            UserError: If the path is not a complete ``mtdagger`` policy folder or a reachable Hub
+                policy, naming the path or file and the fix.
         """
+        check_policy_path(path)
+        if Path(path).exists():
+            return cls._load(path, device, trust_checkpoint)
+        from huggingface_hub.errors import HfHubHTTPError, LocalEntryNotFoundError
+
+        try:
+            return cls._load(path, device, trust_checkpoint)
+        except (HfHubHTTPError, LocalEntryNotFoundError, OSError) as error:
+            raise UserError(
+                f"Cannot load the Hub policy {path} ({type(error).__name__}): check the repo id, the "
+                "network and HF_TOKEN, or pass a local policy folder."
+            ) from None
+
+    @classmethod
+    def _load(cls, path: str | Path, device: str, trust_checkpoint: bool) -> PolicyRunner:
+        """Loads a checked policy path (see ``from_pretrained``)."""
         if not trust_checkpoint:
             if Path(path).is_dir():
                 check_policy_folder(Path(path))
             else:
                 check_hub_policy(str(path))
-        policy = MTDAggerPolicy.from_pretrained(str(path))
+        with quiet_third_party():  # LeRobot prints "Loading weights from local directory"
+            policy = MTDAggerPolicy.from_pretrained(str(path))
         policy.config.device = device
         policy.to(device)
         overrides = {"device_processor": {"device": device}}
@@ -61,6 +82,26 @@ class PolicyRunner:
             policy.config, pretrained_path=str(path), preprocessor_overrides=overrides
         )
         return cls(policy, pre, post)
+
+    def check_inputs(self, suite_features: dict[str, dict[str, Any]], obs_mode: str) -> None:
+        """Refuses a suite whose observations do not match the policy's inputs (key and shape).
+
+        Raises:
+            UserError: Naming the input, both shapes and the option to change.
+        """
+        for key, feature in self.policy.config.input_features.items():
+            given = suite_features.get(key)
+            if given is None:
+                raise UserError(
+                    f"The policy takes {key!r}, which --obs_mode={obs_mode} does not give (it gives "
+                    f"{sorted(suite_features)}): pass the obs_mode the policy was trained on."
+                )
+            if tuple(given["shape"]) != tuple(feature.shape):
+                raise UserError(
+                    f"The policy takes {key!r} of shape {tuple(feature.shape)}, the suite gives "
+                    f"{tuple(given['shape'])}: pass the obs_mode, image_size or num_points the policy "
+                    "was trained with."
+                )
 
     def __call__(self, observations: list[dict[str, np.ndarray]], tasks: list[str]) -> np.ndarray:
         """Actions for a batch of observations of the given tasks.

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.results import PHASE_TIMINGS
 from lerobot_mtdagger.stats import Interval, correlation, demos_to_reach, mean_interval, paired_difference
 
@@ -62,9 +63,7 @@ def curve_points(seeds: dict[int, list[Row]], x_key: str, y_of=None) -> list[tup
     y_of = y_of or (lambda row: row["eval_success_mean"])
     lengths = {len(curve) for curve in seeds.values()}
     if len(lengths) != 1:
-        raise ValueError(
-            f"Seeds with different numbers of points {sorted(lengths)}: rerun compare to finish."
-        )
+        raise UserError(f"Seeds with different numbers of points {sorted(lengths)}: rerun compare to finish.")
     points = []
     for k in range(lengths.pop()):
         column = [curve[k] for curve in seeds.values()]
@@ -355,7 +354,7 @@ def write_report(rows: Sequence[Row], task_names: Sequence[str], folder: Path, l
         ValueError: If there is no row.
     """
     if not rows:
-        raise ValueError("No evaluated round in these experiments: nothing to report.")
+        raise UserError("No evaluated round in these experiments: nothing to report.")
     folder.mkdir(parents=True, exist_ok=True)
     figures = {
         "Success against expert demos": plot_success(

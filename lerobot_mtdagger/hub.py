@@ -35,6 +35,7 @@ from typing import Any
 from huggingface_hub import DatasetCardData, HfApi
 
 from lerobot_mtdagger.datasets_cards import card_template
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.records import PhaseRecord, RoundRecord
 from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir, round_name
 
@@ -156,10 +157,10 @@ def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: in
     """
     committed = experiment.committed_rounds()
     if not committed:
-        raise ValueError(f"{experiment.root} has no committed round to describe.")
+        raise UserError(f"{experiment.root} has no committed round to describe.")
     last = committed[-1] if up_to_round is None else up_to_round
     if last not in committed:
-        raise ValueError(f"Round {last} is not committed in {experiment.root}; committed: {committed}.")
+        raise UserError(f"Round {last} is not committed in {experiment.root}; committed: {committed}.")
     records = [experiment.read_round_record(k) for k in range(last + 1)]
     latest = records[-1]
     config = latest.config or {}
@@ -293,23 +294,53 @@ def _pushable(experiment: ExperimentDir, with_policies: bool) -> tuple[list[int]
     """The committed rounds (and phases, if wanted) to push, checked before anything is sent.
 
     Raises:
-        FileNotFoundError: If the directory is not an experiment.
-        ValueError: If there is no committed round, or no committed phase while policies are wanted.
+        UserError: If the directory is not an experiment, has no committed round, or no committed
+            phase while policies are wanted.
     """
     if not (experiment.root / CONFIG_FILE).exists():
-        raise FileNotFoundError(
+        raise UserError(
             f"{experiment.root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}): pass the "
             "--output_dir of a `lerobot-mtdagger run`."
         )
     rounds = experiment.committed_rounds()
     if not rounds:
-        raise ValueError(f"{experiment.root} has no committed round to push yet.")
+        raise UserError(f"{experiment.root} has no committed round to push yet.")
     phases = experiment.committed_phases() if with_policies else []
     if with_policies and not phases:
-        raise ValueError(
+        raise UserError(
             f"{experiment.root} has no committed training phase to push: drop the policy repo option."
         )
     return rounds, phases
+
+
+def check_hub_access(api: HfApi) -> str:
+    """Checks that the Hub answers and accepts the token, before anything is uploaded.
+
+    Returns:
+        The user name the token belongs to.
+
+    Raises:
+        UserError: With no token, a rejected token, or no connection, saying how to fix it.
+    """
+    from huggingface_hub.errors import HfHubHTTPError, LocalTokenNotFoundError
+
+    try:
+        return str(api.whoami().get("name", "?"))
+    except LocalTokenNotFoundError:
+        raise UserError(
+            "No Hugging Face token: log in with `hf auth login` or set HF_TOKEN; nothing was pushed."
+        ) from None
+    except HfHubHTTPError as error:
+        status = error.response.status_code if error.response is not None else "?"
+        raise UserError(
+            f"The Hub refused the token (HTTP {status}): set HF_TOKEN to a token with write access; "
+            "nothing was pushed."
+        ) from None
+    except OSError as error:  # requests' connection errors, timeouts
+        raise UserError(
+            f"Cannot reach the Hub ({type(error).__name__}): check the network (or HF_ENDPOINT) and "
+            "push again; nothing was pushed."
+        ) from None
 
 
 def push_experiment(
@@ -339,12 +370,15 @@ def push_experiment(
         ``{"dataset": {tag: commit_id}, "policy": {tag: commit_id}}`` (``policy`` empty when not pushed).
 
     Raises:
-        FileNotFoundError: If ``experiment_dir`` is not an experiment.
-        ValueError: If there is nothing to push; nothing is sent then.
+        UserError: If ``experiment_dir`` is not an experiment, there is nothing to push, a committed
+            file changed, or the Hub cannot be reached with the token; nothing is sent then.
     """
     experiment = ExperimentDir(Path(experiment_dir))
     rounds, phases = _pushable(experiment, with_policies=policy_repo_id is not None)
+    experiment.check_committed_files()  # never publish a round or policy changed after commit
     api = api or HfApi()
+    user = check_hub_access(api)
+    logger.info("Pushing to the Hub as %s", user)
     url = api.create_repo(dataset_repo_id, repo_type="dataset", private=private, exist_ok=True)
     dataset_repo_id = url.repo_id or dataset_repo_id
     logger.info("Pushing rounds %s of %s to dataset %s", rounds, experiment.root, dataset_repo_id)

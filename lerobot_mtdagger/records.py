@@ -126,6 +126,8 @@ class RoundRecord:
             acted (None in round 0 and where a task had none): the next round's task need
             measurement.
         learner_episodes: Episodes behind ``learner_success``.
+        files: sha256 of every file of the round dataset but ``meta/info.json``, by relative path,
+            written at commit (None in rounds committed before checksums were recorded).
     """
 
     task_names: list[str]
@@ -160,6 +162,7 @@ class RoundRecord:
     committed: bool = False
     learner_success: list[float | None] | None = None
     learner_episodes: list[int] | None = None
+    files: dict[str, str] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form, as stored in ``meta/info.json``."""
@@ -197,6 +200,8 @@ class PhaseRecord:
         timings: Seconds per part of the round (collect_s, write_s, load_s, train_s, eval_s).
         loss_previous: Per-task loss of the previous phase's policy (the one that collected round
             k) on the same frames, in this phase's normalisation (None in phase 0).
+        files: sha256 of every file of the policy folder but ``training.json``, by relative path,
+            written at commit (None in phases committed before checksums were recorded).
     """
 
     round: int
@@ -213,6 +218,7 @@ class PhaseRecord:
     demos_per_task: list[int]
     timings: dict[str, float]
     loss_previous: list[float | None] | None = None
+    files: dict[str, str] | None = None
 
     @property
     def eval_mean(self) -> float | None:

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir
 
 PER_RUN_FIELDS = ("seed", "output_dir", "resume", "progress", "workers")
@@ -67,7 +68,7 @@ def learning_curves(roots: Sequence[Path]) -> list[CurvePoint]:
     for root in roots:
         method, seed, points = experiment_curve(Path(root))
         if seed in grouped[method]:
-            raise ValueError(f"Two {method} experiments with seed {seed}; give each run its own seed.")
+            raise UserError(f"Two {method} experiments with seed {seed}; give each run its own seed.")
         grouped[method][seed] = points
     curves = []
     for method, runs in sorted(grouped.items()):
@@ -83,7 +84,7 @@ def learning_curves(roots: Sequence[Path]) -> list[CurvePoint]:
                 CurvePoint(method, round_index, demos, float(np.mean(successes)), std, len(successes))
             )
     if not curves:
-        raise ValueError(
+        raise UserError(
             f"None of the {len(roots)} experiment(s) has an evaluated phase (they ran with "
             "--eval_episodes=0?): evaluate their policies with `lerobot-mtdagger eval` or rerun them "
             "with --eval_episodes > 0."
@@ -104,7 +105,7 @@ def check_comparable(roots: Sequence[Path]) -> None:
         root = Path(root)
         path = root / CONFIG_FILE
         if not path.is_file():
-            raise ValueError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
+            raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
         config = json.loads(path.read_text())
         method = "bc" if config.get("mode") == "bc" else config.get("scheduler", {}).get("type")
         ignored = PER_RUN_FIELDS + (BC_BUDGET_FIELDS if method == "bc" else ())
@@ -116,7 +117,7 @@ def check_comparable(roots: Sequence[Path]) -> None:
         differing = sorted(key for key in set(shared) | set(other) if shared.get(key) != other.get(key))
         if differing:
             details = ", ".join(f"{key}: {other.get(key)!r} vs {shared.get(key)!r}" for key in differing)
-            raise ValueError(
+            raise UserError(
                 f"Refusing to average {method} runs with different configs ({details}) in {other_root} "
                 f"and {root}: report them separately, or rerun them with the same options."
             )

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import pyarrow.parquet as pq
 
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.rounds import ExperimentDir
 
 PHASE_TIMINGS = ("collect_s", "write_s", "load_s", "train_s", "eval_s")
@@ -49,7 +50,7 @@ def experiment_rows(root: Path) -> list[dict[str, Any]]:
     experiment = ExperimentDir(root)
     rounds = experiment.committed_rounds()
     if not rounds:
-        raise ValueError(f"{root} has no committed round: is it a lerobot-mtdagger experiment?")
+        raise UserError(f"{root} has no committed round: is it a lerobot-mtdagger experiment?")
     records = [experiment.read_round_record(k) for k in rounds]
     num_tasks = len(records[0].task_names)
     frames = np.zeros(num_tasks, dtype=np.int64)
@@ -103,7 +104,7 @@ def write_results(rows: Sequence[dict[str, Any]], folder: Path) -> tuple[Path, P
         ValueError: If there is no row.
     """
     if not rows:
-        raise ValueError("No evaluated training phase in these experiments: nothing to tabulate.")
+        raise UserError("No evaluated training phase in these experiments: nothing to tabulate.")
     folder.mkdir(parents=True, exist_ok=True)
     json_path, csv_path = folder / "results.json", folder / "results.csv"
     json_path.write_text(json.dumps(list(rows), indent=1))

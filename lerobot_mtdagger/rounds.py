@@ -51,6 +51,8 @@ from lerobot.datasets.compute_stats import RunningQuantileStats, compute_episode
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import DEFAULT_FEATURES, update_chunk_file_indices, validate_frame
 
+from lerobot_mtdagger.errors import CorruptExperimentError, NotAnExperimentError, UserError
+from lerobot_mtdagger.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.quiet import quiet_third_party
 from lerobot_mtdagger.records import FORMAT_VERSION, RECORD_KEY, PhaseRecord, RoundRecord
 
@@ -65,7 +67,11 @@ LOCK_FILE = ".lock"
 """The writer lock of an experiment folder (an OS lock held while a run writes; it holds the pid)."""
 
 
-class ExperimentLockedError(RuntimeError):
+INFO_FILE = "meta/info.json"
+"""The file of a round dataset holding its record (not covered by the round's checksums)."""
+
+
+class ExperimentLockedError(UserError):
     """Another process holds the writer lock of an experiment folder."""
 
 
@@ -87,6 +93,20 @@ def write_json_atomic(path: Path, payload: Any) -> None:
     os.replace(tmp, path)
 
 
+RESULT_NEUTRAL_POLICY_OPTIONS: tuple[str, ...] = ("device",)
+"""Policy options that never change a result (the torch device), free to differ on resume."""
+
+
+def result_options(config: Mapping[str, Any], ignore: Sequence[str]) -> dict[str, Any]:
+    """A run config without the options that do not change results (compared on resume)."""
+    options = {key: value for key, value in config.items() if key not in ignore}
+    if isinstance(options.get("policy"), Mapping):
+        options["policy"] = {
+            key: value for key, value in options["policy"].items() if key not in RESULT_NEUTRAL_POLICY_OPTIONS
+        }
+    return options
+
+
 class ExperimentDir:
     """The on-disk state of one experiment (see the module docstring for the layout)."""
 
@@ -105,19 +125,31 @@ class ExperimentDir:
         return self.root.exists() and any(self.root.iterdir())
 
     def initialise(self, config: dict[str, Any]) -> None:
-        """Creates the folders and writes the run config.
+        """Creates the experiment atomically: built beside ``root``, then renamed onto it.
+
+        A start that fails before the rename leaves nothing at ``root``; after it, ``root`` holds
+        the config and empty ``rounds/`` and ``policies/``, a folder ``--resume=true`` continues.
 
         Raises:
-            FileExistsError: If the directory exists and is not empty.
+            UserError: If the directory exists and is not empty.
         """
         if self.exists():
-            raise FileExistsError(
+            raise UserError(
                 f"Output directory {self.root} already exists and is not empty: pass --resume=true to "
                 "continue that experiment, or choose another --output_dir."
             )
-        self.rounds.mkdir(parents=True, exist_ok=True)
-        self.policies.mkdir(parents=True, exist_ok=True)
-        write_json_atomic(self.root / CONFIG_FILE, config)
+        self.root.parent.mkdir(parents=True, exist_ok=True)
+        building = self.root.parent / f".{self.root.name}.creating-{os.getpid()}"
+        if building.exists():
+            shutil.rmtree(building)
+        try:
+            (building / ROUNDS_DIR).mkdir(parents=True)
+            (building / POLICIES_DIR).mkdir()
+            write_json_atomic(building / CONFIG_FILE, config)
+            os.replace(building, self.root)  # replaces an empty root too
+        finally:
+            if building.exists():  # the start failed before the rename: leave nothing
+                shutil.rmtree(building)
 
     @contextlib.contextmanager
     def writer_lock(self) -> Iterator[None]:
@@ -152,28 +184,80 @@ class ExperimentDir:
     ) -> None:
         """Checks that ``root`` holds an experiment started with the same config.
 
+        Options in ``ignore`` and ``RESULT_NEUTRAL_POLICY_OPTIONS`` never change a result, so they
+        may differ from the stored config.
+
         Raises:
-            FileNotFoundError: If there is no experiment to resume.
-            ValueError: If the directory is not an experiment or its config differs.
+            NotAnExperimentError: If there is no experiment to resume.
+            UserError: If the config differs in an option that changes results.
         """
-        config_path = self.root / CONFIG_FILE
         if not self.root.exists():
-            raise FileNotFoundError(
+            raise NotAnExperimentError(
                 f"Nothing to resume: {self.root} does not exist (drop --resume to start)."
             )
-        if not config_path.exists():
-            raise ValueError(
-                f"{self.root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}); it was left untouched."
-            )
-        stored = json.loads(config_path.read_text())
-        differing = sorted(
-            key
-            for key in set(stored) | set(config)
-            if key not in ignore and stored.get(key) != config.get(key)
-        )
+        stored = result_options(self.read_config(), ignore)
+        given = result_options(config, ignore)
+        differing = sorted(key for key in set(stored) | set(given) if stored.get(key) != given.get(key))
         if differing:
-            details = ", ".join(f"{k}: {stored.get(k)!r} -> {config.get(k)!r}" for k in differing)
-            raise ValueError(f"Cannot resume {self.root} with a different config ({details}).")
+            details = ", ".join(f"{k}: {stored.get(k)!r} -> {given.get(k)!r}" for k in differing)
+            raise UserError(
+                f"Cannot resume {self.root} with a different config ({details}): resume with the "
+                "stored values, or start a new --output_dir."
+            )
+
+    def read_config(self) -> dict[str, Any]:
+        """The run config stored in the experiment.
+
+        Raises:
+            NotAnExperimentError: If ``root`` holds no readable ``config.json``.
+        """
+        config_path = self.root / CONFIG_FILE
+        if not self.root.is_dir():
+            raise NotAnExperimentError(
+                f"{self.root} does not exist or is not a folder: pass the --output_dir of a "
+                "`lerobot-mtdagger run`."
+            )
+        try:
+            return json.loads(config_path.read_text())
+        except FileNotFoundError:
+            raise NotAnExperimentError(
+                f"{self.root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}): pass the "
+                "--output_dir of a `lerobot-mtdagger run`; the folder was left untouched."
+            ) from None
+        except (OSError, json.JSONDecodeError) as error:
+            raise CorruptExperimentError(f"{config_path} is unreadable ({error}).") from None
+
+    def check_committed_files(self) -> None:
+        """Refuses to go on from an experiment whose committed files changed after commit.
+
+        Raises:
+            CorruptExperimentError: Naming every changed, missing or added file and the fix.
+        """
+        problems = []
+        for round_index in self.committed_rounds():
+            problems += self.round_file_problems(round_index)
+        for round_index in self.committed_phases():
+            problems += self.phase_file_problems(round_index)
+        if problems:
+            raise CorruptExperimentError(
+                f"{self.root} was changed after commit: {'; '.join(problems)}. Restore the files, or "
+                "delete that round's folders under rounds/ and policies/ and every later one, and "
+                "resume to redo them."
+            )
+
+    def round_file_problems(self, round_index: int) -> list[str]:
+        """Files of a committed round that differ from the checksums of its record."""
+        recorded = self.read_round_record(round_index).files
+        if recorded is None:
+            return []
+        return digest_mismatches(self.round_root(round_index), recorded, exclude=(INFO_FILE,))
+
+    def phase_file_problems(self, round_index: int) -> list[str]:
+        """Files of a committed policy folder that differ from the checksums of its record."""
+        recorded = self.read_phase_record(round_index).files
+        if recorded is None:
+            return []
+        return digest_mismatches(self.policy_root(round_index), recorded, exclude=(TRAINING_FILE,))
 
     def clear_staging(self) -> None:
         """Deletes everything that was being written when a run was cut off."""
@@ -195,7 +279,7 @@ class ExperimentDir:
         """Indices of the committed rounds, ascending.
 
         Raises:
-            ValueError: If a round folder is not a committed round of this format (a foreign or
+            UserError: If a round folder is not a committed round of this format (a foreign or
                 corrupt dataset in the output directory).
         """
         indices = []
@@ -205,7 +289,10 @@ class ExperimentDir:
             indices.append(self.read_round_record_at(path).round)
         expected = list(range(len(indices)))
         if indices != expected:
-            raise ValueError(f"Committed rounds {indices} in {self.rounds} are not consecutive from 0.")
+            raise CorruptExperimentError(
+                f"Committed rounds {indices} in {self.rounds} are not consecutive from 0: restore the "
+                "missing round, or delete every round after the gap (and its policies) and resume."
+            )
         return indices
 
     @staticmethod
@@ -213,21 +300,26 @@ class ExperimentDir:
         """The ``mtdagger`` record of the round dataset at ``path``.
 
         Raises:
-            ValueError: If ``path`` holds no readable round record.
+            CorruptExperimentError: If ``path`` holds no readable round record.
         """
-        info_path = path / "meta" / "info.json"
+        info_path = path / INFO_FILE
         try:
             info = json.loads(info_path.read_text())
         except (OSError, json.JSONDecodeError) as error:
-            raise ValueError(f"{path} is not a readable round dataset ({info_path}: {error}).") from error
-        record = info.get(RECORD_KEY)
+            raise CorruptExperimentError(
+                f"{path} is not a readable round dataset ({info_path}: {error}); restore it or move it "
+                "out of the experiment directory."
+            ) from None
+        record = info.get(RECORD_KEY) if isinstance(info, dict) else None
         if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
-            raise ValueError(
+            raise CorruptExperimentError(
                 f"{path} is not a lerobot-mtdagger round (no '{RECORD_KEY}' record of format "
                 f"{FORMAT_VERSION} in {info_path}); move it out of the experiment directory."
             )
         if not record.get("committed"):
-            raise ValueError(f"{path} holds an uncommitted round record.")
+            raise CorruptExperimentError(
+                f"{path} holds an uncommitted round record; move it out of the experiment directory."
+            )
         return RoundRecord.from_dict(record, where=f"The round record in {info_path}")
 
     def read_round_record(self, round_index: int) -> RoundRecord:
@@ -295,10 +387,11 @@ class ExperimentDir:
             raise FileExistsError(f"Round {round_index} is already committed at {final}; it is immutable.")
         dataset.finalize()
         staging = Path(dataset.root)
-        info_path = staging / "meta" / "info.json"
+        info_path = staging / INFO_FILE
         info = json.loads(info_path.read_text())
+        files = folder_digests(staging, exclude=(INFO_FILE,))
         info[RECORD_KEY] = dataclasses.replace(
-            record, format_version=FORMAT_VERSION, committed=True
+            record, format_version=FORMAT_VERSION, committed=True, files=files
         ).to_dict()
         write_json_atomic(info_path, info)
         os.replace(staging, final)
@@ -329,8 +422,9 @@ class ExperimentDir:
         return staging
 
     def commit_phase(self, round_index: int, staging: Path, record: PhaseRecord) -> Path:
-        """Writes the training record into a staged phase and commits it atomically."""
-        write_json_atomic(staging / TRAINING_FILE, record.to_dict())
+        """Writes the training record (with the folder's checksums) into a staged phase and commits it."""
+        files = folder_digests(staging, exclude=(TRAINING_FILE,))
+        write_json_atomic(staging / TRAINING_FILE, dataclasses.replace(record, files=files).to_dict())
         final = self.policy_root(round_index)
         if final.exists():
             raise FileExistsError(f"Training phase {round_index} is already committed at {final}.")
@@ -338,9 +432,20 @@ class ExperimentDir:
         return final
 
     def read_phase_record(self, round_index: int) -> PhaseRecord:
-        """The training record of a committed phase."""
+        """The training record of a committed phase.
+
+        Raises:
+            CorruptExperimentError: If the record is unreadable.
+        """
         path = self.policy_root(round_index) / TRAINING_FILE
-        return PhaseRecord.from_dict(json.loads(path.read_text()), where=f"The training record {path}")
+        try:
+            values = json.loads(path.read_text())
+        except (OSError, json.JSONDecodeError) as error:
+            raise CorruptExperimentError(
+                f"{path} is unreadable ({error}); delete policies/{round_name(round_index)} and every "
+                "later phase, and resume to retrain them."
+            ) from None
+        return PhaseRecord.from_dict(values, where=f"The training record {path}")
 
 
 def write_round_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFrames]) -> None:
@@ -595,24 +700,32 @@ def merge_rounds(
     Task indices are preserved: every round holds the full vocabulary in the same order. The merged
     dataset's meta/info.json gets a ``mtdagger`` record listing the merged rounds' records.
 
+    The merge is written beside ``output`` and renamed onto it when complete, so a merge that stops
+    half-way leaves no ``output`` (and a re-run starts clean).
+
     Raises:
-        FileExistsError: If ``output`` exists.
-        ValueError: If a round is not committed.
+        UserError: If ``output`` exists.
+        CorruptExperimentError: If a round's files changed after commit (before anything is written).
     """
     from lerobot.datasets.aggregate import aggregate_datasets
 
     if output.exists():
-        raise FileExistsError(f"Merge target {output} exists; choose another path.")
+        raise UserError(f"Merge target {output} exists; choose another --output or delete it.")
     records = [experiment.read_round_record(k) for k in rounds]
-    roots = [experiment.round_root(k) for k in rounds]
+    problems = [problem for k in rounds for problem in experiment.round_file_problems(k)]
+    if problems:
+        raise CorruptExperimentError(f"Cannot merge: {'; '.join(problems)}. Restore the files first.")
+    staging = output.parent / f".{output.name}.merging"
+    if staging.exists():
+        shutil.rmtree(staging)
     with quiet_third_party():
         aggregate_datasets(
             repo_ids=[f"local/{round_name(k)}" for k in rounds],
             aggr_repo_id=repo_id,
-            roots=roots,
-            aggr_root=output,
+            roots=[experiment.round_root(k) for k in rounds],
+            aggr_root=staging,
         )
-    info_path = output / "meta" / "info.json"
+    info_path = staging / INFO_FILE
     info = json.loads(info_path.read_text())
     info[RECORD_KEY] = {
         "format_version": FORMAT_VERSION,
@@ -620,4 +733,5 @@ def merge_rounds(
         "rounds": [record.to_dict() for record in records],
     }
     write_json_atomic(info_path, info)
+    os.replace(staging, output)
     return output

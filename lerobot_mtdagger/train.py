@@ -31,6 +31,7 @@ import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.datasets.utils import dataset_to_policy_features
 
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
 
@@ -445,7 +446,7 @@ def train_phase(
         FloatingPointError: If the loss becomes NaN or infinite (nothing is committed then).
     """
     if list(policy.config.task_names) != data.task_names:
-        raise ValueError(
+        raise UserError(
             f"The policy's tasks {policy.config.task_names} differ from the data's {data.task_names}."
         )
     if log_interval < 1:

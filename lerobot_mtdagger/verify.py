@@ -1,32 +1,62 @@
-"""Audits an experiment folder: every committed round against its data and its own record.
+"""Audits an experiment folder: every committed round and policy against its files and its record.
 
-For each committed round ``verify_round`` checks the task vocabulary and its order, the episodes per
-task actually stored, the cumulative demonstration counts, and for DAgger rounds that the allocation
+``verify_experiment`` first refuses a folder that is not an experiment. For each committed round
+``verify_round`` checks that every file matches the sha256 recorded at commit, counts the episodes
+per task and the frames in the data files themselves against the record, checks the task vocabulary
+and its order, the cumulative demonstration counts, and for DAgger rounds that the allocation
 recomputes from the record alone (``scheduler.allocation_mismatches``, through the method's
 registered config class) and chains with the previous round: its measured success, the previous
-phase's gain, the Kalman prior = the previous round's posterior.
+phase's gain, the Kalman prior = the previous round's posterior. For each committed policy
+``verify_policy`` checks its files' sha256 and that it loads.
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from lerobot_mtdagger.errors import CorruptExperimentError, UserError
 from lerobot_mtdagger.records import RoundRecord
 from lerobot_mtdagger.rounds import ExperimentDir, round_name
 from lerobot_mtdagger.scheduler import allocation_mismatches
 
 
-def stored_tasks(root: Path, num_tasks: int) -> tuple[list[str], list[int]]:
-    """The task vocabulary (in task_index order) and the episodes per task index of a round dataset."""
-    from lerobot.datasets.lerobot_dataset import LeRobotDatasetMetadata
+def stored_tasks(root: Path, num_tasks: int) -> tuple[list[str], list[int], int]:
+    """What a round dataset's files hold: task vocabulary, episodes per task index, frames.
 
-    meta = LeRobotDatasetMetadata(f"local/{root.name}", root=root)
-    order = [str(t) for t in meta.tasks.sort_values("task_index").index]
-    lookup = {task: index for index, task in enumerate(order)}
-    counts = [0] * num_tasks
-    for tasks in meta.episodes["tasks"]:
-        counts[lookup[tasks[0]]] += 1
-    return order, counts
+    The vocabulary is read from ``meta/tasks.parquet`` (in task_index order); the episodes and frames
+    are counted in the data files themselves, not in the metadata.
+
+    Raises:
+        CorruptExperimentError: Naming the file that cannot be read.
+    """
+    tasks_table = read_parquet(root / "meta" / "tasks.parquet").to_pandas()
+    order = [str(task) for task in tasks_table.sort_values("task_index").index]
+    paths = sorted((root / "data").glob("*/*.parquet"))
+    if not paths:
+        raise CorruptExperimentError(f"{root / 'data'} holds no parquet file.")
+    table = pa.concat_tables([read_parquet(path, ["episode_index", "task_index"]) for path in paths])
+    episodes = table.column("episode_index").to_numpy()
+    tasks = table.column("task_index").to_numpy()
+    _, first = np.unique(episodes, return_index=True)
+    counts = np.bincount(tasks[first], minlength=num_tasks)
+    return order, counts.tolist(), table.num_rows
+
+
+def read_parquet(path: Path, columns: list[str] | None = None) -> pa.Table:
+    """Reads a parquet file of a round.
+
+    Raises:
+        CorruptExperimentError: Naming the file.
+    """
+    try:
+        return pq.read_table(path, columns=columns)
+    except (OSError, pa.ArrowException) as error:
+        raise CorruptExperimentError(f"{path} cannot be read ({error}).") from None
 
 
 def verify_round(
@@ -44,12 +74,20 @@ def verify_round(
         One message per problem, prefixed by the round's name; empty when the round checks out.
     """
     name = round_name(record.round)
-    problems: list[str] = []
-    order, stored = stored_tasks(experiment.round_root(record.round), len(record.task_names))
-    if order != record.task_names:
-        problems.append(f"task vocabulary {order} != record {record.task_names}")
-    if stored != record.episodes_per_task:
-        problems.append(f"dataset holds {stored} episodes per task, record says {record.episodes_per_task}")
+    problems = experiment.round_file_problems(record.round)
+    if record.files is None:
+        problems.append("no checksums recorded (committed by an older version): files not checked")
+    try:
+        order, stored, frames = stored_tasks(experiment.round_root(record.round), len(record.task_names))
+    except CorruptExperimentError as error:
+        problems.append(str(error))
+    else:
+        if order != record.task_names:
+            problems.append(f"task vocabulary {order} != record {record.task_names}")
+        if stored != record.episodes_per_task:
+            problems.append(f"data holds {stored} episodes per task, record says {record.episodes_per_task}")
+        if frames != record.frames:
+            problems.append(f"data holds {frames} frames, record says {record.frames}")
     before = previous.demos_so_far if previous is not None else [0] * len(record.task_names)
     if record.demos_so_far != [a + b for a, b in zip(before, record.episodes_per_task, strict=True)]:
         problems.append("demos_so_far is not the running sum of episodes_per_task")
@@ -87,18 +125,60 @@ def _chain_mismatches(
     return problems
 
 
-def verify_experiment(experiment: ExperimentDir) -> tuple[int, list[str]]:
-    """Verifies every committed round of an experiment.
+def verify_policy(experiment: ExperimentDir, round_index: int) -> list[str]:
+    """Checks one committed policy folder: its files against its record's checksums, and that it loads.
+
+    Loading never runs code named by the checkpoint (``trust_checkpoint`` stays false).
 
     Returns:
-        The number of rounds verified and every problem found.
+        One message per problem, prefixed by the policy's folder.
     """
-    rounds = experiment.committed_rounds()
-    phases = set(experiment.committed_phases())
-    problems: list[str] = []
+    from lerobot_mtdagger.evaluate import PolicyRunner
+
+    prefix = f"policies/{round_name(round_index)}"
+    try:
+        record = experiment.read_phase_record(round_index)
+    except UserError as error:
+        return [f"{prefix}: {error}"]
+    problems = experiment.phase_file_problems(round_index)
+    if record.files is None:
+        problems.append("no checksums recorded (committed by an older version): files not checked")
+    try:
+        PolicyRunner.from_pretrained(experiment.policy_root(round_index))
+    except (UserError, OSError, RuntimeError, json.JSONDecodeError) as error:
+        problems.append(f"does not load: {type(error).__name__}: {error}")
+    return [f"{prefix}: {problem}" for problem in problems]
+
+
+def verify_experiment(experiment: ExperimentDir) -> tuple[int, int, list[str]]:
+    """Verifies every committed round and policy of an experiment.
+
+    Returns:
+        The numbers of rounds and of policies verified, and every problem found.
+
+    Raises:
+        NotAnExperimentError: If the folder is missing or holds no experiment.
+    """
+    experiment.read_config()
+    try:
+        rounds = experiment.committed_rounds()
+    except UserError as error:
+        return 0, 0, [str(error)]
+    phases = experiment.committed_phases()
+    problems = [problem for k in phases for problem in verify_policy(experiment, k)]
+    readable_phases = {k for k in phases if _readable_phase(experiment, k)}
     previous = None
     for round_index in rounds:
         record = experiment.read_round_record(round_index)
-        problems += verify_round(experiment, record, previous, phases)
+        problems += verify_round(experiment, record, previous, readable_phases)
         previous = record
-    return len(rounds), problems
+    return len(rounds), len(phases), problems
+
+
+def _readable_phase(experiment: ExperimentDir, round_index: int) -> bool:
+    """Whether a committed phase's record reads (an unreadable one is reported by ``verify_policy``)."""
+    try:
+        experiment.read_phase_record(round_index)
+    except UserError:
+        return False
+    return True

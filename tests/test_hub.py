@@ -23,10 +23,15 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
+import requests
+from huggingface_hub.errors import LocalTokenNotFoundError
 from huggingface_hub.utils import filter_repo_objects
 
 from lerobot_mtdagger import hub
+from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.errors import CorruptExperimentError, UserError
 from lerobot_mtdagger.hub import PushConfig, push_command, push_experiment, render_dataset_card
+from lerobot_mtdagger.integrity import folder_digests
 from lerobot_mtdagger.rounds import ExperimentDir
 
 TASKS = ["reach-v3", "button-press-topdown-v3"]
@@ -59,6 +64,15 @@ class FakeHfApi:
         self.repos: dict[tuple[str, str], FakeRepo] = {}
         self.calls: list[str] = []
         self.num_commits = 0
+        self.access = "ok"  # or "no token", "offline": what whoami() meets
+
+    def whoami(self) -> dict:
+        self.calls.append("whoami")
+        if self.access == "no token":
+            raise LocalTokenNotFoundError("Token is required (`token=True`), but no token found.")
+        if self.access == "offline":
+            raise requests.ConnectionError("Failed to resolve 'huggingface.co'")
+        return {"name": "tester"}
 
     def _repo(self, repo_id: str, repo_type: str | None) -> FakeRepo:
         key = (repo_type or "model", repo_id)
@@ -171,7 +185,7 @@ def test_each_round_is_a_tagged_commit_holding_exactly_that_round(experiment_dir
     assert list(pushed["dataset"]) == ["round-000", "round-001"]
     assert pushed["policy"] == {}
     assert repo.tags == pushed["dataset"]
-    assert fake_api.calls[0] == "create_repo"
+    assert fake_api.calls[:2] == ["whoami", "create_repo"]
     for k in (0, 1):
         snapshot = fake_api.snapshot(DATASET_REPO, f"round-{k:03d}")
         assert round_info(snapshot)["mtdagger"]["round"] == k
@@ -191,6 +205,10 @@ def test_stale_files_of_an_earlier_round_vanish_but_user_files_stay(experiment_d
         path = ExperimentDir(copy).round_root(0) / name
         path.parent.mkdir(parents=True)
         shutil.copy(ExperimentDir(copy).round_root(0) / "data/chunk-000/file-000.parquet", path)
+    info_path = ExperimentDir(copy).round_root(0) / "meta" / "info.json"
+    info = json.loads(info_path.read_text())  # as if round 0 had been committed with those files
+    info["mtdagger"]["files"] = folder_digests(ExperimentDir(copy).round_root(0), exclude=["meta/info.json"])
+    info_path.write_text(json.dumps(info))
     fake_api.create_repo(DATASET_REPO, repo_type="dataset")
     user_file = {".gitattributes": b"*.parquet filter=lfs\n", "images/plot.png": b"png"}
     fake_api._commit(fake_api.repos[("dataset", DATASET_REPO)], user_file, "a file the user added")
@@ -233,12 +251,41 @@ def test_repushing_keeps_existing_tags_and_adds_nothing_stale(experiment_dir, fa
 
 
 def test_nothing_is_sent_for_a_directory_that_is_not_an_experiment(tmp_path, fake_api):
-    with pytest.raises(FileNotFoundError, match="not a lerobot-mtdagger experiment"):
+    with pytest.raises(UserError, match="not a lerobot-mtdagger experiment"):
         push_experiment(tmp_path / "missing", DATASET_REPO, api=fake_api)
     (tmp_path / "empty").mkdir()
     (tmp_path / "empty" / "config.json").write_text("{}")
     with pytest.raises(ValueError, match="no committed round"):
         push_experiment(tmp_path / "empty", DATASET_REPO, api=fake_api)
+    assert fake_api.calls == []
+
+
+@pytest.mark.parametrize(
+    ("access", "message"), [("no token", "No Hugging Face token"), ("offline", "Cannot reach the Hub")]
+)
+def test_the_token_and_network_are_checked_before_anything_is_sent(experiment_dir, fake_api, access, message):
+    fake_api.access = access
+    with pytest.raises(UserError, match=message):
+        push_experiment(experiment_dir, DATASET_REPO, POLICY_REPO, api=fake_api)
+    assert fake_api.calls == ["whoami"] and not fake_api.repos
+
+
+def test_push_without_a_token_is_one_error_line(experiment_dir, fake_api, monkeypatch, capsys):
+    fake_api.access = "no token"
+    monkeypatch.setattr(hub, "HfApi", lambda: fake_api)
+    status = main(["push", f"--experiment_dir={experiment_dir}", f"--repo_id={DATASET_REPO}"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1
+    assert err[0].startswith("lerobot-mtdagger push: error: No Hugging Face token: log in with")
+
+
+def test_a_round_changed_after_commit_is_never_pushed(experiment_dir, fake_api, tmp_path):
+    copy = tmp_path / "copy"
+    shutil.copytree(experiment_dir, copy)
+    parquet = next((copy / "rounds" / "round-001" / "data").rglob("*.parquet"))
+    parquet.write_bytes(parquet.read_bytes()[:-100])
+    with pytest.raises(CorruptExperimentError, match=f"{parquet} changed after commit"):
+        push_experiment(copy, DATASET_REPO, api=fake_api)
     assert fake_api.calls == []
 
 

@@ -1,4 +1,5 @@
-"""Reliability of experiment folders: one writer at a time, policy folders that cannot run code."""
+"""Reliability of experiment folders: one writer at a time, policy folders that cannot run code,
+verify that reads the data, options checked before anything is written, one-line user errors."""
 
 from __future__ import annotations
 
@@ -8,14 +9,20 @@ import shutil
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
+from lerobot_mtdagger import dagger as dagger_module
+from lerobot_mtdagger import rounds as rounds_module
 from lerobot_mtdagger.checkpoints import UntrustedCheckpointError
+from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.dagger import run
+from lerobot_mtdagger.errors import CorruptExperimentError, UserError
 from lerobot_mtdagger.evaluate import PolicyRunner
 from lerobot_mtdagger.rounds import LOCK_FILE, ExperimentDir, ExperimentLockedError
-from tests.test_toy import toy_config
+from lerobot_mtdagger.verify import verify_experiment
+from tests.test_toy import TOY_RUN, toy_config
 
 
 @pytest.fixture(scope="module")
@@ -85,3 +92,222 @@ def test_a_policy_folder_naming_an_unregistered_step_is_refused(finished, tmp_pa
 def test_the_runs_own_policies_load_without_trust(finished):
     runner = PolicyRunner.from_pretrained(ExperimentDir(finished).policy_root(1))
     assert runner.policy.config.task_names
+
+
+# -------------------------------------------------------------------------------------------------
+# verify reads the data (item 1)
+# -------------------------------------------------------------------------------------------------
+
+
+def damaged_copy(finished, tmp_path, damage) -> Path:
+    """A copy of the finished experiment with ``damage(copy)`` applied."""
+    copy = tmp_path / "damaged"
+    shutil.copytree(finished, copy, ignore=shutil.ignore_patterns(LOCK_FILE))
+    damage(copy)
+    return copy
+
+
+def round_parquet(root: Path, round_index: int = 1) -> Path:
+    return next((ExperimentDir(root).round_root(round_index) / "data").rglob("*.parquet"))
+
+
+def truncate(path: Path) -> None:
+    path.write_bytes(path.read_bytes()[: len(path.read_bytes()) // 2])
+
+
+def garble(path: Path) -> None:
+    data = bytearray(path.read_bytes())
+    middle = len(data) // 2
+    data[middle : middle + 64] = bytes(64)
+    path.write_bytes(bytes(data))
+
+
+DAMAGES = {
+    "truncated parquet": lambda root: truncate(round_parquet(root)),
+    "garbled parquet": lambda root: garble(round_parquet(root)),
+    "deleted parquet": lambda root: round_parquet(root).unlink(),
+    "truncated weights": lambda root: truncate(ExperimentDir(root).policy_root(1) / "model.safetensors"),
+}
+
+
+def test_verify_passes_an_intact_experiment_and_counts_rounds_and_policies(finished, capsys):
+    assert verify_experiment(ExperimentDir(finished)) == (2, 2, [])
+    assert main(["verify", f"--experiment_dir={finished}"]) == 0
+    assert "verified 2 round(s) and 2 policy folder(s)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("damage", list(DAMAGES))
+def test_verify_names_every_damaged_file_and_exits_non_zero(finished, tmp_path, capsys, damage):
+    copy = damaged_copy(finished, tmp_path, DAMAGES[damage])
+    _, _, problems = verify_experiment(ExperimentDir(copy))
+    damaged = "policies/round-001" if "weights" in damage else "rounds/round-001"
+    assert problems and all(damaged in problem for problem in problems), problems
+    with pytest.raises(SystemExit) as exit_:
+        main(["verify", f"--experiment_dir={copy}"])
+    assert exit_.value.code == 1
+    out = capsys.readouterr().out
+    assert "PROBLEM" in out and ("model.safetensors" in out or ".parquet" in out)
+
+
+def test_verify_counts_frames_and_episodes_in_the_data_itself(finished, tmp_path):
+    def forge_record(root: Path) -> None:  # a record that no longer matches its (intact) data
+        info_path = ExperimentDir(root).round_root(1) / "meta" / "info.json"
+        info = json.loads(info_path.read_text())
+        info["mtdagger"]["frames"] += 1
+        info_path.write_text(json.dumps(info))
+
+    _, _, problems = verify_experiment(ExperimentDir(damaged_copy(finished, tmp_path, forge_record)))
+    assert any("data holds" in problem and "frames" in problem for problem in problems), problems
+
+
+@pytest.mark.parametrize("folder", ["missing", "empty", "not-an-experiment"])
+def test_verify_of_a_folder_that_is_not_an_experiment_is_an_error(tmp_path, capsys, folder):
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "not-an-experiment").mkdir()
+    (tmp_path / "not-an-experiment" / "notes.txt").write_text("hello")
+    assert main(["verify", f"--experiment_dir={tmp_path / folder}"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "error:" in err[0] and "--output_dir of a `lerobot-mtdagger run`" in err[0]
+
+
+# -------------------------------------------------------------------------------------------------
+# Options validated before anything is written; atomic folders; resume (item 4)
+# -------------------------------------------------------------------------------------------------
+
+
+BAD_RUN_OPTIONS = {
+    "--policy.lr=nan": "policy.lr must be finite and > 0",
+    "--seed=-1": "seed must be >= 0",
+    "--budget=-3": "budget must be > 0",
+    "--policy.device=cuda:99": "policy.device='cuda:99' is not available here",
+    "--policy.device=nonsense": "is not a torch device",
+}
+
+
+@pytest.mark.parametrize("option", list(BAD_RUN_OPTIONS))
+@pytest.mark.parametrize("mode", ["dagger", "bc"])
+def test_a_bad_option_is_refused_before_anything_is_written(tmp_path, capsys, option, mode):
+    output = tmp_path / "run"
+    status = main(["run", *TOY_RUN, f"--output_dir={output}", f"--mode={mode}", option])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and BAD_RUN_OPTIONS[option] in err[0]
+    assert not output.exists()
+
+
+def test_a_start_that_fails_before_the_config_is_written_leaves_nothing(tmp_path, monkeypatch):
+    output = tmp_path / "run"
+
+    def disk_full(path, payload):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(rounds_module, "write_json_atomic", disk_full)
+    with pytest.raises(OSError, match="No space left"):
+        run(toy_config(output))
+    assert not output.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_a_start_that_fails_after_creation_leaves_a_resumable_folder(tmp_path, monkeypatch):
+    output = tmp_path / "run"
+
+    def diverge(*args, **kwargs):
+        raise FloatingPointError("Training loss became nan at step 3; nothing was committed.")
+
+    monkeypatch.setattr(dagger_module, "train_phase", diverge)
+    with pytest.raises(FloatingPointError):
+        run(toy_config(output, "--rounds=1"))
+    assert (output / "config.json").is_file() and ExperimentDir(output).committed_phases() == []
+    monkeypatch.undo()
+    assert len(run(toy_config(output, "--rounds=1", "--resume=true"))) == 2
+
+
+def test_options_that_do_not_change_results_may_differ_on_resume(finished):
+    experiment = ExperimentDir(finished)
+    stored = json.loads((finished / "config.json").read_text())
+    neutral = {**stored, "workers": 0, "progress": True, "policy": {**stored["policy"], "device": "cuda"}}
+    experiment.check_resumable(neutral)
+    changed = {**stored, "policy": {**stored["policy"], "lr": 1.0}}
+    with pytest.raises(UserError, match=r"different config \(policy: .*start a new --output_dir"):
+        experiment.check_resumable(changed)
+
+
+def test_resume_refuses_a_round_changed_after_commit_before_running(finished, tmp_path):
+    copy = damaged_copy(finished, tmp_path, lambda root: truncate(round_parquet(root)))
+    before = sorted(p.relative_to(copy) for p in copy.rglob("*") if p.name != LOCK_FILE)
+    with pytest.raises(CorruptExperimentError, match=rf"{round_parquet(copy)} changed after commit"):
+        run(toy_config(copy, "--rounds=1", "--resume=true"))
+    assert sorted(p.relative_to(copy) for p in copy.rglob("*") if p.name != LOCK_FILE) == before
+
+
+def test_merge_is_built_beside_its_target_and_renamed(finished, tmp_path):
+    output = tmp_path / "merged"
+    (tmp_path / ".merged.merging").mkdir()  # left by a merge that was killed
+    (tmp_path / ".merged.merging" / "partial").write_text("x")
+    assert main(["merge", f"--experiment_dir={finished}", f"--output={output}"]) == 0
+    assert (output / "meta" / "info.json").is_file() and not (tmp_path / ".merged.merging").exists()
+
+
+def test_merge_of_a_damaged_round_writes_nothing(finished, tmp_path, capsys):
+    copy = damaged_copy(finished, tmp_path, lambda root: truncate(round_parquet(root)))
+    output = tmp_path / "merged"
+    assert main(["merge", f"--experiment_dir={copy}", f"--output={output}"]) == 2
+    assert "changed after commit" in capsys.readouterr().err
+    assert not output.exists() and not (tmp_path / ".merged.merging").exists()
+
+
+# -------------------------------------------------------------------------------------------------
+# One line per user error, a traceback only with --debug (item 5)
+# -------------------------------------------------------------------------------------------------
+
+
+def bad_inputs(finished: Path, tmp_path: Path) -> dict[str, tuple[list[str], str]]:
+    """Command lines a user may get wrong, with what the one error line must say."""
+    policy = ExperimentDir(finished).policy_root(1)
+    truncated = tmp_path / "truncated-policy"
+    shutil.copytree(policy, truncated)
+    truncate(truncated / "model.safetensors")
+    return {
+        "eval of a missing path": (["eval", f"--policy_path={tmp_path / 'nowhere'}"], "does not exist"),
+        "eval of a dataset": (
+            ["eval", f"--policy_path={ExperimentDir(finished).round_root(0)}"],
+            "is a LeRobot dataset (no config.json)",
+        ),
+        "eval of an experiment": (["eval", f"--policy_path={finished}"], f"e.g. {policy}"),
+        "eval of truncated weights": (
+            ["eval", f"--policy_path={truncated}"],
+            f"{truncated / 'model.safetensors'} is not a readable safetensors file",
+        ),
+        "eval on other observations": (
+            ["eval", f"--policy_path={policy}", "--tasks=[reach-v3]", "--workers=0"],
+            "The policy takes 'observation.state' of shape",
+        ),
+        "unclosed list": (
+            ["run", "--tasks=[reach-v3,push-v3"],
+            "--tasks='[reach-v3,push-v3' is not a valid value",
+        ),
+        "unknown option": (["run", "--roundz=3"], "unrecognized arguments: --roundz=3"),
+        "not an int": (["run", "--rounds=three"], "Couldn't parse 'three' into an int"),
+        "resume of nothing": (
+            ["run", f"--output_dir={tmp_path / 'none'}", "--resume=true"],
+            "Nothing to resume",
+        ),
+        "report of nothing": (["report", f"--compare_dir={tmp_path}"], "is not a compare folder"),
+        "merge of a non-experiment": (
+            ["merge", f"--experiment_dir={tmp_path}", f"--output={tmp_path / 'm'}"],
+            "is not a lerobot-mtdagger experiment",
+        ),
+    }
+
+
+def test_every_bad_input_is_one_error_line_and_exit_2(finished, tmp_path, capsys):
+    for name, (argv, expected) in bad_inputs(finished, tmp_path).items():
+        assert main(argv) == 2, name
+        captured = capsys.readouterr()
+        err = captured.err.strip().splitlines()
+        assert len(err) == 1, (name, err)
+        assert err[0].startswith(f"lerobot-mtdagger {argv[0]}: error: ") and expected in err[0], (name, err)
+        assert "Traceback" not in captured.out + captured.err
+
+
+def test_debug_shows_the_traceback_of_a_user_error(tmp_path):
+    with pytest.raises(UserError, match="does not exist"):
+        main(["eval", f"--policy_path={tmp_path / 'nowhere'}", "--debug"])

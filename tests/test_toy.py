@@ -291,7 +291,7 @@ def test_every_method_runs_end_to_end_and_verifies(tmp_path, method):
     lines = run(toy_config(tmp_path / method, f"--scheduler.type={method}"))
     experiment = ExperimentDir(tmp_path / method)
     assert len(lines) == 3 and experiment.committed_phases() == [0, 1, 2]
-    assert verify_experiment(experiment) == (3, [])
+    assert verify_experiment(experiment) == (3, 3, [])
     records = [experiment.read_round_record(k) for k in range(3)]
     assert [r.method for r in records] == [method] * 3
     assert [sum(r.episodes_per_task) for r in records] == [3, 6, 6]

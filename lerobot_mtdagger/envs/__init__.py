@@ -41,6 +41,7 @@ from lerobot_mtdagger.envs.base import (  # noqa: E402
     ObservationConfig,
     TaskSuite,
 )
+from lerobot_mtdagger.errors import UserError
 
 SUITE_NAMES: tuple[str, ...] = (
     "metaworld-mt10",
@@ -115,7 +116,7 @@ def make_suite(
         include_goal=include_goal,
     )
     if name not in SUITE_NAMES:
-        raise ValueError(f"Unknown suite {name!r}; available suites: {list(SUITE_NAMES)}.")
+        raise UserError(f"Unknown suite {name!r}; available suites: {list(SUITE_NAMES)}.")
     if name == "drawers":
         from lerobot_mtdagger.envs.drawers import DRAWER_TASKS, DrawerSuite
 
@@ -130,14 +131,14 @@ def make_suite(
     named_lists = {"metaworld-mt10": MT10_TASKS, "metaworld-mt25": MT25_TASKS, "metaworld-mt50": MT50_TASKS}
     if name == "metaworld":
         if not tasks:
-            raise ValueError("Suite 'metaworld' needs an explicit tasks=[...] list of v3 task names.")
+            raise UserError("Suite 'metaworld' needs an explicit tasks=[...] list of v3 task names.")
         task_names = list(tasks)
     else:
         available = named_lists[name]
         task_names = list(tasks) if tasks else list(available)
         outside = [t for t in task_names if t not in available]
         if outside:
-            raise ValueError(f"Task(s) {outside} are not in {name}; its tasks: {list(available)}.")
+            raise UserError(f"Task(s) {outside} are not in {name}; its tasks: {list(available)}.")
     return MetaWorldSuite(task_names, observation, max_episode_steps=max_episode_steps, name=name)
 
 

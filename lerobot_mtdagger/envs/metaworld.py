@@ -38,6 +38,7 @@ from lerobot_mtdagger.envs.base import (
     observation_features,
 )
 from lerobot_mtdagger.envs.rendering import CropBox, PointCloudCamera, SceneRenderer, camera_rays
+from lerobot_mtdagger.errors import UserError
 
 logger = logging.getLogger(__name__)
 
@@ -289,7 +290,7 @@ class MetaWorldSuite(TaskSuite):
         """
         unknown = [t for t in task_names if t not in ALL_V3_ENVIRONMENTS]
         if unknown:
-            raise ValueError(f"Unknown MetaWorld v3 task(s) {unknown}; known tasks: {list(ALL_TASKS)}.")
+            raise UserError(f"Unknown MetaWorld v3 task(s) {unknown}; known tasks: {list(ALL_TASKS)}.")
         self.name = name
         super().__init__(task_names, observation)
         self.max_episode_steps = max_episode_steps

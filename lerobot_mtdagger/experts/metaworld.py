@@ -8,6 +8,8 @@ from typing import Any
 import numpy as np
 from metaworld.policies import ENV_POLICY_MAP
 
+from lerobot_mtdagger.errors import UserError
+
 # The scripted policies warn on every step whose proportional gain saturates; the env clips the
 # action to [-1, 1] anyway (we clip too), so the warning carries no information.
 warnings.filterwarnings("ignore", message=r"Constant\(s\) may be too high", category=UserWarning)
@@ -23,7 +25,7 @@ class MetaWorldScriptedExpert:
             ValueError: If MetaWorld has no scripted policy for the task.
         """
         if task_name not in ENV_POLICY_MAP:
-            raise ValueError(
+            raise UserError(
                 f"MetaWorld has no scripted policy for {task_name!r}; known: {sorted(ENV_POLICY_MAP)}."
             )
         self.task_name = task_name

@@ -20,6 +20,7 @@ import importlib
 from collections.abc import Callable
 from typing import Any
 
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.experts.base import ActionCheckedExpert, Expert
 
 ANY_TASK = "*"
@@ -78,7 +79,7 @@ def make_expert(suite: Any, task_name: str) -> ActionCheckedExpert:
         family = suite.expert_family
         factory = _FACTORIES.get((family, task_name)) or _FACTORIES.get((family, ANY_TASK))
         if factory is None:
-            raise ValueError(
+            raise UserError(
                 f"No expert is registered for task {task_name!r} of suite family {family!r}; register one "
                 "with lerobot_mtdagger.experts.register_expert(family, factory) or give the suite one with "
                 "suite.with_experts({task: expert})."
