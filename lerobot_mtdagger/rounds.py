@@ -67,6 +67,7 @@ LOCK_FILE = ".lock"
 """The writer lock of an experiment folder (an OS lock held while a run writes; it holds the pid)."""
 
 
+STATS_FILE = "meta/stats.json"
 INFO_FILE = "meta/info.json"
 """The file of a round dataset holding its record (not covered by the round's checksums)."""
 
@@ -387,6 +388,7 @@ class ExperimentDir:
             raise FileExistsError(f"Round {round_index} is already committed at {final}; it is immutable.")
         dataset.finalize()
         staging = Path(dataset.root)
+        sort_stats_file(staging)
         info_path = staging / INFO_FILE
         info = json.loads(info_path.read_text())
         files = folder_digests(staging, exclude=(INFO_FILE,))
@@ -446,6 +448,20 @@ class ExperimentDir:
                 "later phase, and resume to retrain them."
             ) from None
         return PhaseRecord.from_dict(values, where=f"The training record {path}")
+
+
+def sort_stats_file(root: Path) -> None:
+    """Rewrites a dataset's ``meta/stats.json`` with sorted keys: a round's bytes are reproducible.
+
+    LeRobot aggregates statistics over a set of feature names, so the file's key order follows
+    Python's per-process string hashing: two identical rounds would differ byte for byte, and the
+    sha256 of a round (and a kill-and-resume run against an uninterrupted one) could not be compared.
+    The content is unchanged; readers look keys up by name.
+    """
+    path = root / STATS_FILE
+    if path.is_file():
+        stats = json.loads(path.read_text())
+        path.write_text(json.dumps(stats, indent=4, ensure_ascii=False, sort_keys=True))
 
 
 def write_round_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFrames]) -> None:
