@@ -338,6 +338,9 @@ def _assert_same_dataset_files(ours: Path, theirs: Path) -> None:
             assert pq.ParquetFile(a).metadata.num_row_groups == pq.ParquetFile(b).metadata.num_row_groups
         elif relative.name == "info.json":
             ours_info, theirs_info = json.loads(a.read_text()), json.loads(b.read_text())
+            # The records' sha256 of the files differ with the parquet fingerprints (see above).
+            for info in (ours_info, theirs_info):
+                info.get("mtdagger", {}).pop("files", None)
             assert ours_info == theirs_info, relative
         else:
             assert a.read_bytes() == b.read_bytes(), relative
