@@ -11,3 +11,8 @@ OUT=outputs/mt10-state-eval
 "$CLI" compare --methods='[bc,uniform,need,need_raw,gain]' --seeds='[0,1,2,3,4]' --jobs=2 \
   --output_dir="$OUT" --preset=small --rounds=6 --eval_episodes=20 --progress=false
 "$CLI" report --compare_dir="$OUT" --levels='[0.6,0.8,0.9]'
+# The second BC baseline: BC's best training variant on the development seeds (balanced sampling).
+"$CLI" compare --methods='[bc]' --seeds='[0,1,2,3,4]' --jobs=2 --bc_budgets='[3,6,9,12,15,18,21]' \
+  --output_dir="$OUT-bc-balanced" --preset=small --rounds=6 --eval_episodes=20 --progress=false \
+  --sampling=balanced
+"$CLI" report --compare_dir="$OUT-bc-balanced" --levels='[0.6,0.8,0.9]'
