@@ -24,8 +24,6 @@ Commands:
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import logging
 import sys
@@ -33,14 +31,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import draccus
 import numpy as np
-import yaml
 
 from lerobot_mtdagger.compare import CompareConfig, split_arguments
 from lerobot_mtdagger.configs import RunConfig, renamed_option_error, resolve_workers
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.hub import PushConfig, push_command
+from lerobot_mtdagger.parsing import parse_options
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
 from lerobot_mtdagger.simulate import SyntheticTasks, simulate
 
@@ -357,48 +354,6 @@ def error_line(command: str, message: object) -> str:
     return f"lerobot-mtdagger {command}: error: {' '.join(str(message).split())}"
 
 
-def unparsable_option(options: Sequence[str]) -> str | None:
-    """A message naming the first option whose value is not valid YAML (draccus reads values as YAML)."""
-    for option in options:
-        name, separator, value = option.partition("=")
-        if not separator:
-            continue
-        try:
-            yaml.safe_load(value)
-        except yaml.YAMLError as error:
-            problem = getattr(error, "problem", None) or type(error).__name__
-            return (
-                f"{name}={value!r} is not a valid value ({problem}); lists are written "
-                f"{name}='[a,b]', strings with special characters are quoted."
-            )
-    return None
-
-
-def parse_config(command: str, config_class: type, options: list[str]) -> object:
-    """Parses the options of a command into its config.
-
-    Raises:
-        UserError: Naming the option at fault (draccus' own message, or the config's check).
-        SystemExit: With status 0 after ``--help``.
-    """
-    argparse_output = io.StringIO()
-    try:
-        with contextlib.redirect_stderr(argparse_output):
-            return draccus.parse(config_class=config_class, args=options, prog=f"lerobot-mtdagger {command}")
-    except draccus.utils.ParsingError as error:
-        # draccus hides the config's own ValueError (which names the field and the fix) as the cause.
-        cause = error.__cause__ if error.__cause__ is not None else error
-        raise UserError(str(cause)) from error
-    except SystemExit as exit_:
-        if exit_.code in (0, None):
-            raise
-        # argparse printed its usage and "<prog>: error: <message>"; keep the message only.
-        message = argparse_output.getvalue().strip().splitlines()[-1].partition("error: ")[2]
-        raise UserError(
-            f"{message}; the options are listed by `lerobot-mtdagger {command} --help`."
-        ) from None
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the console script.
 
@@ -443,14 +398,11 @@ def run_command(command: str, options: list[str]) -> None:
     Raises:
         UserError: On a bad option, path or file.
     """
-    unparsable = unparsable_option(options)
-    if unparsable is not None:
-        raise UserError(unparsable)
     config_class, function = COMMANDS[command]
     passed: list[str] = []
     if command == "compare":  # compare's own options; every other option goes to each run
         options, passed = split_arguments(options)
-    config = parse_config(command, config_class, options)
+    config = parse_options(config_class, options, f"lerobot-mtdagger {command}")
     function(config, passed) if command == "compare" else function(config)
 
 

@@ -31,10 +31,10 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import draccus
-
 from lerobot_mtdagger.configs import RunConfig, default_worker_count
 from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.parsing import parse_options
+from lerobot_mtdagger.scheduler import scheduling_methods
 
 logger = logging.getLogger(__name__)
 
@@ -86,7 +86,7 @@ def base_run_config(run_args: Sequence[str]) -> RunConfig:
     for arg in run_args:
         if arg.split("=", 1)[0] in ("--seed", "--mode", "--scheduler.type", "--output_dir", "--resume"):
             raise UserError(f"{arg} is set per run by compare: use --methods/--seeds/--output_dir.")
-    return draccus.parse(RunConfig, args=list(run_args))
+    return parse_options(RunConfig, run_args, "lerobot-mtdagger run")
 
 
 def bc_rounds_for(config: RunConfig, budgets: Sequence[int], num_tasks: int) -> dict[int, int]:
@@ -183,6 +183,10 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
         raise UserError(f"--jobs must be >= 1, got {compare_config.jobs}.")
     if not compare_config.methods or not compare_config.seeds:
         raise UserError("--methods and --seeds must not be empty.")
+    known = ("bc", *scheduling_methods())
+    unknown = [method for method in compare_config.methods if method not in known]
+    if unknown:
+        raise UserError(f"Unknown method(s) {unknown} in --methods; choose among {list(known)}.")
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.results import results_rows, write_results
 

@@ -291,6 +291,14 @@ def bad_inputs(finished: Path, tmp_path: Path) -> dict[str, tuple[list[str], str
             "Nothing to resume",
         ),
         "report of nothing": (["report", f"--compare_dir={tmp_path}"], "is not a compare folder"),
+        "compare of an unknown method": (
+            ["compare", "--methods=[foo]", f"--output_dir={tmp_path / 'cmp'}"],
+            "Unknown method(s) ['foo'] in --methods",
+        ),
+        "compare with a bad run option": (
+            ["compare", "--rounds=-1", f"--output_dir={tmp_path / 'cmp'}"],
+            "rounds must be >= 0",
+        ),
         "merge of a non-experiment": (
             ["merge", f"--experiment_dir={tmp_path}", f"--output={tmp_path / 'm'}"],
             "is not a lerobot-mtdagger experiment",
@@ -306,6 +314,7 @@ def test_every_bad_input_is_one_error_line_and_exit_2(finished, tmp_path, capsys
         assert len(err) == 1, (name, err)
         assert err[0].startswith(f"lerobot-mtdagger {argv[0]}: error: ") and expected in err[0], (name, err)
         assert "Traceback" not in captured.out + captured.err
+    assert not (tmp_path / "cmp").exists(), "compare wrote before checking its options"
 
 
 def test_debug_shows_the_traceback_of_a_user_error(tmp_path):
