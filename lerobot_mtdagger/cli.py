@@ -333,16 +333,22 @@ def _usage() -> str:
     return f"usage: lerobot-mtdagger <command> [--option=value ...]\ncommands: {names}\n" + (__doc__ or "")
 
 
+HUB_LOGGER = "huggingface_hub"
+"""huggingface_hub's logger (its own console handler): errors only, not a warning per HTTP retry."""
+
+
 def configure_console_logging() -> None:
     """Warnings and errors on the console; INFO records still reach file handlers (``run.log``).
 
     The console shows what the commands print (one summary line per round for ``run``), never the
-    INFO chatter of the libraries underneath.
+    INFO chatter of the libraries underneath, nor huggingface_hub's warning at each HTTP retry (a
+    Hub that cannot be reached is one error line of ours).
     """
     console = logging.StreamHandler()
     console.setLevel(logging.WARNING)
     console.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     logging.basicConfig(level=logging.INFO, handlers=[console])
+    logging.getLogger(HUB_LOGGER).setLevel(logging.ERROR)
 
 
 DEBUG_FLAG = "--debug"

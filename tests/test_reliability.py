@@ -320,3 +320,12 @@ def test_every_bad_input_is_one_error_line_and_exit_2(finished, tmp_path, capsys
 def test_debug_shows_the_traceback_of_a_user_error(tmp_path):
     with pytest.raises(UserError, match="does not exist"):
         main(["eval", f"--policy_path={tmp_path / 'nowhere'}", "--debug"])
+
+
+def test_eval_of_a_hub_id_that_cannot_be_fetched_is_one_error_line(monkeypatch, capsys):
+    import huggingface_hub.constants
+
+    monkeypatch.setattr(huggingface_hub.constants, "HF_HUB_OFFLINE", True)  # no network in the test
+    assert main(["eval", "--policy_path=nobody/no-such-policy"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "Cannot load the Hub policy nobody/no-such-policy" in err[0], err
