@@ -94,6 +94,18 @@ def write_json_atomic(path: Path, payload: Any) -> None:
     os.replace(tmp, path)
 
 
+def read_committed_json(path: Path, fix: str) -> Any:
+    """Reads a JSON file of a committed round or phase.
+
+    Raises:
+        CorruptExperimentError: Naming the file, what is wrong and ``fix``.
+    """
+    try:
+        return json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as error:
+        raise CorruptExperimentError(f"{path} is unreadable ({error}); {fix}.") from None
+
+
 RESULT_NEUTRAL_POLICY_OPTIONS: tuple[str, ...] = ("device",)
 """Policy options that never change a result (the torch device), free to differ on resume."""
 
@@ -236,9 +248,9 @@ class ExperimentDir:
         """
         problems = []
         for round_index in self.committed_rounds():
-            problems += self.round_file_problems(round_index)
+            problems += self.round_file_problems(self.read_round_record(round_index))
         for round_index in self.committed_phases():
-            problems += self.phase_file_problems(round_index)
+            problems += self.phase_file_problems(self.read_phase_record(round_index))
         if problems:
             raise CorruptExperimentError(
                 f"{self.root} was changed after commit: {'; '.join(problems)}. Restore the files, or "
@@ -246,19 +258,17 @@ class ExperimentDir:
                 "resume to redo them."
             )
 
-    def round_file_problems(self, round_index: int) -> list[str]:
-        """Files of a committed round that differ from the checksums of its record."""
-        recorded = self.read_round_record(round_index).files
-        if recorded is None:
+    def round_file_problems(self, record: RoundRecord) -> list[str]:
+        """Files of a committed round that differ from its record's checksums (none recorded: [])."""
+        if record.files is None:
             return []
-        return digest_mismatches(self.round_root(round_index), recorded, exclude=(INFO_FILE,))
+        return digest_mismatches(self.round_root(record.round), record.files, exclude=(INFO_FILE,))
 
-    def phase_file_problems(self, round_index: int) -> list[str]:
-        """Files of a committed policy folder that differ from the checksums of its record."""
-        recorded = self.read_phase_record(round_index).files
-        if recorded is None:
+    def phase_file_problems(self, record: PhaseRecord) -> list[str]:
+        """Files of a committed policy folder that differ from its record's checksums."""
+        if record.files is None:
             return []
-        return digest_mismatches(self.policy_root(round_index), recorded, exclude=(TRAINING_FILE,))
+        return digest_mismatches(self.policy_root(record.round), record.files, exclude=(TRAINING_FILE,))
 
     def clear_staging(self) -> None:
         """Deletes everything that was being written when a run was cut off."""
@@ -304,13 +314,7 @@ class ExperimentDir:
             CorruptExperimentError: If ``path`` holds no readable round record.
         """
         info_path = path / INFO_FILE
-        try:
-            info = json.loads(info_path.read_text())
-        except (OSError, json.JSONDecodeError) as error:
-            raise CorruptExperimentError(
-                f"{path} is not a readable round dataset ({info_path}: {error}); restore it or move it "
-                "out of the experiment directory."
-            ) from None
+        info = read_committed_json(info_path, "restore it, or move the round out of the experiment directory")
         record = info.get(RECORD_KEY) if isinstance(info, dict) else None
         if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
             raise CorruptExperimentError(
@@ -440,13 +444,8 @@ class ExperimentDir:
             CorruptExperimentError: If the record is unreadable.
         """
         path = self.policy_root(round_index) / TRAINING_FILE
-        try:
-            values = json.loads(path.read_text())
-        except (OSError, json.JSONDecodeError) as error:
-            raise CorruptExperimentError(
-                f"{path} is unreadable ({error}); delete policies/{round_name(round_index)} and every "
-                "later phase, and resume to retrain them."
-            ) from None
+        fix = f"delete policies/{round_name(round_index)} and every later phase, and resume to retrain them"
+        values = read_committed_json(path, fix)
         return PhaseRecord.from_dict(values, where=f"The training record {path}")
 
 
@@ -728,7 +727,7 @@ def merge_rounds(
     if output.exists():
         raise UserError(f"Merge target {output} exists; choose another --output or delete it.")
     records = [experiment.read_round_record(k) for k in rounds]
-    problems = [problem for k in rounds for problem in experiment.round_file_problems(k)]
+    problems = [problem for record in records for problem in experiment.round_file_problems(record)]
     if problems:
         raise CorruptExperimentError(f"Cannot merge: {'; '.join(problems)}. Restore the files first.")
     staging = output.parent / f".{output.name}.merging"

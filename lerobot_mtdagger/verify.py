@@ -74,7 +74,7 @@ def verify_round(
         One message per problem, prefixed by the round's name; empty when the round checks out.
     """
     name = round_name(record.round)
-    problems = experiment.round_file_problems(record.round)
+    problems = experiment.round_file_problems(record)
     if record.files is None:
         problems.append("no checksums recorded (committed by an older version): files not checked")
     try:
@@ -140,7 +140,7 @@ def verify_policy(experiment: ExperimentDir, round_index: int) -> list[str]:
         record = experiment.read_phase_record(round_index)
     except UserError as error:
         return [f"{prefix}: {error}"]
-    problems = experiment.phase_file_problems(round_index)
+    problems = experiment.phase_file_problems(record)
     if record.files is None:
         problems.append("no checksums recorded (committed by an older version): files not checked")
     try:
