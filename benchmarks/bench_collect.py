@@ -7,11 +7,15 @@ Run: ``.venv/bin/python benchmarks/bench_collect.py`` (options: ``--workers 1 2`
   one process), the per-core reference;
 - ``collect``: a DAgger round as the runner collects it: the learner acting at every step
   (``beta = 0``; an untrained ``mtdagger`` policy with its LeRobot processors, batched in the main
-  process), the expert labelling every step, frames recorded, rollouts cut at 200 steps, with each
+  process), the expert labelling every step, frames recorded, rollouts to the env's 500-step horizon (the
+runner's default), with each
   worker count; recorded steps per second of wall time;
 - ``eval``: evaluation episodes per second (the pure policy, to the env's 500-step truncation);
 - ``raw, N processes at once``: N processes stepping raw MetaWorld at the same time, the machine's
-  own ceiling for N workers (two cores that slow each other down cap it below N x raw).
+  own ceiling for N workers (two cores that slow each other down cap it below N x raw);
+- ``raw along the trajectories``: MetaWorld's own step replaying, from the same reset seeds, the
+  actions executed in the collection (the same for every worker count; one process), to check
+  that the learner's trajectories do not cost more than random actions (measured: they do not).
 
 The workers (and their envs) are started and warmed up before the clock starts: in a run they live
 for the whole experiment. Raw and collection measurements are interleaved over ``--repeats`` and
@@ -33,6 +37,7 @@ from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.metaworld import _make_raw_env
 from lerobot_mtdagger.evaluate import PolicyRunner, evaluate
 from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.records import EXECUTED_ACTION
 from lerobot_mtdagger.train import build_processors, policy_config
 from lerobot_mtdagger.workers import EnvWorkers
 
@@ -56,6 +61,27 @@ def raw_rate(tasks: list[str], steps: int) -> float:
             env.step(action)
             total_time += time.perf_counter() - start
         total_steps += len(actions)
+        env.close()
+    return total_steps / total_time
+
+
+def replay_rate(suite, episodes: list) -> float:
+    """Single-process raw MetaWorld steps/s replaying the executed actions of recorded episodes."""
+    envs: dict[int, object] = {}
+    total_time, total_steps = 0.0, 0
+    for episode in episodes:
+        env = envs.get(episode.task_index) or envs.setdefault(
+            episode.task_index, suite.make_env(suite.task_names[episode.task_index])
+        )
+        env.reset(seed=episode.seed)
+        raw_env = env._env  # MetaWorld's SawyerXYZEnv under the state wrapper
+        actions = [np.clip(frame[EXECUTED_ACTION], -1.0, 1.0) for frame in episode.frames]
+        start = time.perf_counter()
+        for action in actions:
+            raw_env.step(action)
+        total_time += time.perf_counter() - start
+        total_steps += len(actions)
+    for env in envs.values():
         env.close()
     return total_steps / total_time
 
@@ -98,8 +124,8 @@ def untrained_runner(suite) -> PolicyRunner:
     return PolicyRunner(MTDAggerPolicy(config), preprocessor, postprocessor)
 
 
-def collect_rate(workers: EnvWorkers, runner: PolicyRunner, episodes: int, seed: int) -> float:
-    """Recorded steps per second of a DAgger round with the learner acting."""
+def collect_rate(workers: EnvWorkers, runner: PolicyRunner, episodes: int, seed: int) -> tuple[float, list]:
+    """Recorded steps per second of a DAgger round with the learner acting, and its episodes."""
     start = time.perf_counter()
     result = run_episodes(
         workers,
@@ -110,10 +136,10 @@ def collect_rate(workers: EnvWorkers, runner: PolicyRunner, episodes: int, seed:
         round_index=1,
         stream=COLLECT_STREAM,
         record=True,
-        max_steps=200,
+        max_steps=None,  # the runner's default: the env's own 500-step horizon
         steps_after_success=10,
     )
-    return sum(e.steps for e in result) / (time.perf_counter() - start)
+    return sum(e.steps for e in result) / (time.perf_counter() - start), result
 
 
 def eval_rate(workers: EnvWorkers, runner: PolicyRunner, episodes: int) -> float:
@@ -136,6 +162,7 @@ def main() -> None:
     suite = make_suite("metaworld-mt10")
     runner = untrained_runner(suite)
     raw: list[float] = []
+    replay: list[float] = []
     parallel_raw: dict[int, list[float]] = {n: [] for n in args.workers}
     collect: dict[int, list[float]] = {n: [] for n in args.workers}
     evals: dict[int, list[float]] = {n: [] for n in args.workers}
@@ -149,19 +176,26 @@ def main() -> None:
             for n in args.workers:
                 parallel_raw[n].append(parallel_raw_rate(list(suite.task_names), RAW_STEPS, n))
             for n, pool in pools.items():
-                collect[n].append(collect_rate(pool, runner, args.episodes, seed=repeat))
+                rate, episodes = collect_rate(pool, runner, args.episodes, seed=repeat)
+                collect[n].append(rate)
                 evals[n].append(eval_rate(pool, runner, args.eval_episodes))
+            replay.append(replay_rate(suite, episodes))  # the same trajectories for every worker count
     finally:
         for pool in pools.values():
             pool.close()
     raw_median = statistics.median(raw)
+    replay_median = statistics.median(replay)
     print(f"MetaWorld MT10, state; repeats: {args.repeats}; wall time {time.perf_counter() - started:.0f} s")
-    print(f"raw single-env MetaWorld step rate (one process): {raw_median:.0f} steps/s")
+    print(f"raw single-env MetaWorld step rate (one process, random actions): {raw_median:.0f} steps/s")
+    print(
+        f"raw MetaWorld step rate along the collected trajectories (one process): {replay_median:.0f} steps/s"
+    )
     print(
         "| workers | raw steps/s, N processes at once | collect steps/s | ratio to N x raw | "
-        "ratio to N processes' raw | eval episodes/s | eval speed-up |"
+        "ratio to N processes' raw | ratio to N x raw along the trajectories | eval episodes/s | "
+        "eval speed-up |"
     )
-    print("|--------:|------:|------:|------:|------:|------:|------:|")
+    print("|--------:|------:|------:|------:|------:|------:|------:|------:|")
     base_eval = statistics.median(evals[args.workers[0]])
     ratios = {}
     for n in args.workers:
@@ -171,7 +205,7 @@ def main() -> None:
         ceiling = statistics.median(parallel_raw[n])
         print(
             f"| {n} | {ceiling:.0f} | {rate:.0f} | {ratios[n]:.3f} | {rate / ceiling:.3f} | "
-            f"{eval_median:.2f} | {eval_median / base_eval:.2f} |"
+            f"{rate / (n * replay_median):.3f} | {eval_median:.2f} | {eval_median / base_eval:.2f} |"
         )
     for n, ratio in ratios.items():
         verdict = "PASS" if ratio >= TARGET else "FAIL"

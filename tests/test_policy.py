@@ -81,7 +81,9 @@ def test_forward_backward_for_each_modality(modality):
     # Only the embeddings of the tasks in the batch move (door-open-v3 is absent).
     embedding_grad_norms = policy.task_embedding.weight.grad.norm(dim=1)
     assert embedding_grad_norms[0] > 0 and embedding_grad_norms[1] > 0 and embedding_grad_norms[2] == 0
+    assert policy.training
     assert policy.select_action(batch).shape == (6, 4)
+    assert not any(module.training for module in policy.modules()), "select_action leaves eval mode on"
 
 
 def test_per_task_loss_equals_hand_computed_means():

@@ -166,3 +166,27 @@ def test_negative_worker_counts_are_refused(suite):
         EnvWorkers(suite, -1)
     with pytest.raises(ValueError, match="workers must be >= 0"):
         RunConfig(suite="toy", workers=-2)
+
+
+@pytest.mark.parametrize(("tasks", "workers"), [(10, 2), (50, 2), (10, 3), (7, 2)])
+def test_lanes_are_spread_evenly_over_the_workers(tasks, workers):
+    """Every worker steps as many lanes as the others (within one), and so does each group's share.
+
+    With 2 workers and MT10's 10 lanes in two groups of 5, spreading by group alone gave one
+    worker 6 lanes and the other 4, and each cycle waited for the busier one.
+    """
+    from collections import deque
+
+    from lerobot_mtdagger.collect import LANE_GROUPS, _assign, _Lane, _Schedule
+
+    lanes = [_Lane(home_task=task, group=task % LANE_GROUPS) for task in range(tasks)]
+    schedule = _Schedule(
+        [deque(range(3)) for _ in range(tasks)], seed=0, round_index=1, stream=COLLECT_STREAM
+    )
+    for handle in range(tasks):
+        _assign(lanes, handle, schedule, workers)
+    per_worker = [sum(lane.worker == w for lane in lanes) for w in range(workers)]
+    assert max(per_worker) - min(per_worker) <= 1, per_worker
+    for group in range(LANE_GROUPS):
+        shares = [sum(lane.worker == w and lane.group == group for lane in lanes) for w in range(workers)]
+        assert max(shares) - min(shares) <= 1, (group, shares)

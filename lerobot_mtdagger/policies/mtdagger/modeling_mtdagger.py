@@ -238,8 +238,13 @@ class MTDAggerPolicy(PreTrainedPolicy):
 
     @torch.no_grad()
     def select_action(self, batch: dict[str, Any], **kwargs: Any) -> Tensor:
-        """The action for each observation of the batch, (B, action_dim)."""
-        self.eval()
+        """The action for each observation of the batch, (B, action_dim).
+
+        Switches the policy to eval mode first if it is training (``eval()`` walks every module,
+        which costs more than a batched forward of the state network: skipped when already so).
+        """
+        if self.training:
+            self.eval()
         return self.predict(batch)
 
     def reset(self) -> None:
