@@ -257,6 +257,10 @@ class ReportConfig:
             ``experiments`` only, no figures unless given).
         output: Optional markdown file for the table.
         levels: Success levels of the "demos to reach" and "time to reach" figures.
+        variants: More runs reported under a method name of their own, by name: a ``compare`` folder
+            or one experiment each, e.g. ``--variants='{bc-balanced: outputs/bc-balanced}'`` for BC
+            trained with balanced sampling beside the ``bc`` of ``compare_dir``. A BC variant is a
+            baseline like ``bc``.
     """
 
     experiments: list[Path] = field(default_factory=list)
@@ -264,6 +268,7 @@ class ReportConfig:
     output_dir: Path | None = None
     output: Path | None = None
     levels: list[float] = field(default_factory=lambda: [0.5, 0.6, 0.7, 0.8])
+    variants: dict[str, Path] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not self.experiments and self.compare_dir is None:
@@ -275,21 +280,43 @@ class ReportConfig:
             raise ValueError(f"{self.compare_dir} is not a compare folder (no runs/ in it).")
         if self.compare_dir is not None and self.output_dir is None:
             self.output_dir = self.compare_dir / "report"
+        from lerobot_mtdagger.rounds import CONFIG_FILE
+
+        for name, folder in self.variants.items():
+            if not (Path(folder) / "runs").is_dir() and not (Path(folder) / CONFIG_FILE).is_file():
+                raise ValueError(
+                    f"--variants: {folder} (for {name!r}) is neither a compare folder (runs/) nor an "
+                    "experiment: give the folder compare or run wrote."
+                )
 
     @property
     def experiment_dirs(self) -> list[Path]:
-        """The experiments to report on."""
-        if self.compare_dir is None:
-            return list(self.experiments)
-        runs = sorted(p for p in (self.compare_dir / "runs").iterdir() if p.is_dir())
-        return [*self.experiments, *runs]
+        """The experiments to report on (the variants' last)."""
+        mine = list(self.experiments)
+        if self.compare_dir is not None:
+            mine += _compare_runs(self.compare_dir)
+        return mine + list(self.labels)
+
+    @property
+    def labels(self) -> dict[Path, str]:
+        """The method name of each variant's experiments."""
+        return {
+            run: name
+            for name, folder in self.variants.items()
+            for run in (_compare_runs(Path(folder)) if (Path(folder) / "runs").is_dir() else [Path(folder)])
+        }
+
+
+def _compare_runs(compare_dir: Path) -> list[Path]:
+    """The run folders of a ``compare`` folder."""
+    return sorted(p for p in (compare_dir / "runs").iterdir() if p.is_dir())
 
 
 def report_command(config: ReportConfig) -> str:
     """Prints the learning curves (mean and std over seeds); writes the figures and summary."""
     from lerobot_mtdagger.report import learning_curves, markdown_table
 
-    table = markdown_table(learning_curves(config.experiment_dirs))
+    table = markdown_table(learning_curves(config.experiment_dirs, config.labels))
     print(table)
     if config.output is not None:
         config.output.write_text(table + "\n")
@@ -298,7 +325,7 @@ def report_command(config: ReportConfig) -> str:
         from lerobot_mtdagger.results import results_rows, write_results
         from lerobot_mtdagger.rounds import ExperimentDir
 
-        rows = results_rows(config.experiment_dirs)
+        rows = results_rows(config.experiment_dirs, config.labels)
         task_names = ExperimentDir(config.experiment_dirs[0]).read_round_record(0).task_names
         write_results(rows, config.output_dir)
         path = write_report(rows, task_names, config.output_dir, levels=config.levels)

@@ -30,13 +30,28 @@ from lerobot_mtdagger.results import PHASE_TIMINGS
 from lerobot_mtdagger.stats import Interval, correlation, demos_to_reach, mean_interval, paired_difference
 
 LEVELS = (0.5, 0.6, 0.7, 0.8)
-BASELINES = ("uniform", "bc")
 Row = dict[str, Any]
 
 
 # -------------------------------------------------------------------------------------------------
 # Curves from rows
 # -------------------------------------------------------------------------------------------------
+
+
+def is_bc(row: Row) -> bool:
+    """Whether a row comes from a one-round BC run (under any label)."""
+    return bool(row.get("bc", row["method"] == "bc"))
+
+
+def bc_methods(rows: Sequence[Row]) -> list[str]:
+    """The methods (labels) of BC runs: ``bc`` first, then its labelled variants."""
+    names = {row["method"] for row in rows if is_bc(row)}
+    return sorted(names, key=lambda name: (name != "bc", name))
+
+
+def baselines(rows: Sequence[Row]) -> list[str]:
+    """What every other method is compared with: Uniform DAgger and every BC variant."""
+    return ["uniform", *bc_methods(rows)]
 
 
 def runs_by_method(rows: Sequence[Row]) -> dict[str, dict[int, list[Row]]]:
@@ -92,7 +107,7 @@ def demos_of(curve: Sequence[Row]) -> list[float]:
 
 def cumulative_seconds(curve: Sequence[Row]) -> list[float]:
     """Wall time spent up to each point of a DAgger curve (BC: each point's own run)."""
-    if curve and curve[0]["method"] == "bc":
+    if curve and is_bc(curve[0]):
         return [sum(row[name] for name in PHASE_TIMINGS) for row in curve]
     return list(np.cumsum([sum(row[name] for name in PHASE_TIMINGS) for row in curve]))
 
@@ -121,6 +136,7 @@ def plot_success(rows: Sequence[Row], x_key: str, x_label: str, path: Path, meth
     """Figure 1 (and 5 with ``methods``): success against demos or frames, one curve per method."""
     plt = _pyplot()
     figure, axis = plt.subplots(figsize=(7, 4.5))
+    bc_names = bc_methods(rows)
     for method, seeds in runs_by_method(rows).items():
         if methods is not None and method not in methods:
             continue
@@ -130,9 +146,11 @@ def plot_success(rows: Sequence[Row], x_key: str, x_label: str, path: Path, meth
         # Success is a fraction: the band is drawn within [0, 1] (a t interval over few seeds is wide).
         low = np.clip([i.low for _, i in points], 0.0, 1.0)
         high = np.clip([i.high for _, i in points], 0.0, 1.0)
-        if method == "bc":
+        if method in bc_names:
             error = np.nan_to_num(np.vstack([mean - low, high - mean]))
-            axis.errorbar(x, mean, yerr=error, fmt="s", capsize=3, label="BC (one round)", color="black")
+            label = "BC (one round)" if method == "bc" else f"{method} (BC, one round)"
+            marker, color = ("s", "black") if method == "bc" else ("D", "dimgray")
+            axis.errorbar(x, mean, yerr=error, fmt=marker, capsize=3, label=label, color=color)
         else:
             (line,) = axis.plot(x, mean, marker="o", label=method)
             axis.fill_between(x, low, high, alpha=0.2, color=line.get_color())
@@ -217,8 +235,12 @@ def plot_metrics(rows: Sequence[Row], path: Path) -> tuple[Path, dict[str, float
 
 
 def hardest_tasks(rows: Sequence[Row], count: int = 2) -> list[int]:
-    """Task indices with the lowest BC success at the largest budget (else lowest final success)."""
-    bc = [row for row in rows if row["method"] == "bc"]
+    """Task indices with the lowest BC success at the largest budget (else lowest final success).
+
+    BC is the run labelled ``bc`` where there is one, else any BC variant.
+    """
+    names = bc_methods(rows)
+    bc = [row for row in rows if names and row["method"] == names[0]]
     if bc:
         largest = max(row["demos_per_task_mean"] for row in bc)
         pool = [row for row in bc if row["demos_per_task_mean"] == largest]
@@ -233,6 +255,7 @@ def plot_hardest(rows: Sequence[Row], task_names: Sequence[str], path: Path) -> 
     """Figure 4: success curves of every method on the two hardest tasks."""
     plt = _pyplot()
     tasks = hardest_tasks(rows)
+    bc_names = bc_methods(rows)
     figure, axes = plt.subplots(1, len(tasks), figsize=(5 * len(tasks), 4.5), squeeze=False)
     for axis, task in zip(axes[0], tasks, strict=True):
         for method, seeds in runs_by_method(rows).items():
@@ -241,10 +264,10 @@ def plot_hardest(rows: Sequence[Row], task_names: Sequence[str], path: Path) -> 
             )
             x = [np.mean([c[k]["demos_per_task"][task] for c in seeds.values()]) for k in range(len(points))]
             mean = [i.mean for _, i in points]
-            style = "s" if method == "bc" else "o-"
+            style = "s" if method in bc_names else "o-"
             axis.plot(x, mean, style, label=method)
             low, high = [i.low for _, i in points], [i.high for _, i in points]
-            if method != "bc":
+            if method not in bc_names:
                 axis.fill_between(x, low, high, alpha=0.15)
         axis.set_title(f"{task_names[task]}")
         axis.set_xlabel("expert demos of this task")
@@ -319,6 +342,19 @@ def _format(interval: Interval) -> str:
     return f"{interval.mean:+.3f} [{interval.low:+.3f}, {interval.high:+.3f}]{mark}"
 
 
+def comparison_pairs(rows: Sequence[Row]) -> list[tuple[str, str]]:
+    """The (method, baseline) pairs of the summary.
+
+    Every method against every baseline (Uniform DAgger and each BC variant), Uniform DAgger against
+    each BC variant, and each labelled BC variant against ``bc``.
+    """
+    bases = baselines(rows)
+    bc_names = bc_methods(rows)
+    methods = [m for m in runs_by_method(rows) if m not in bases]
+    pairs = [(m, b) for m in methods for b in bases] + [("uniform", b) for b in bc_names]
+    return pairs + [(variant, "bc") for variant in bc_names if variant != "bc" and "bc" in bc_names]
+
+
 def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[str, Any], levels) -> str:
     """The report: figures embedded, paired differences and demo ratios per pair of methods."""
     lines = ["# Method comparison", "", _caption(rows) + ".", ""]
@@ -329,8 +365,7 @@ def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[
     lines += ["## Paired differences of average success (method - baseline), 95% t interval over seeds", ""]
     lines += ["`*`: the interval excludes 0.", "", "| method | baseline | demos per task | difference |"]
     lines += ["|---|---|---:|---|"]
-    methods = [m for m in runs_by_method(rows) if m not in BASELINES]
-    pairs = [(m, b) for m in methods for b in BASELINES] + [("uniform", "bc")]
+    pairs = comparison_pairs(rows)
     for method, baseline in pairs:
         for budget, interval in paired_rows(rows, method, baseline):
             lines.append(f"| {method} | {baseline} | {budget:.1f} | {_format(interval)} |")

@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import math
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,8 +40,13 @@ class CurvePoint:
     seeds: int
 
 
-def experiment_curve(root: Path) -> tuple[str, int, list[tuple[int, float, float]]]:
-    """``(method, seed, [(round, mean demos per task, mean eval success), ...])`` of one experiment."""
+def experiment_curve(root: Path, label: str | None = None) -> tuple[str, int, list[tuple[int, float, float]]]:
+    """``(method, seed, [(round, mean demos per task, mean eval success), ...])`` of one experiment.
+
+    Args:
+        root: The experiment folder.
+        label: The method name to report it under (default: its method, ``bc`` for BC).
+    """
     experiment = ExperimentDir(root)
     record = experiment.read_round_record(0)
     points = []
@@ -49,24 +54,30 @@ def experiment_curve(root: Path) -> tuple[str, int, list[tuple[int, float, float
         phase = experiment.read_phase_record(round_index)
         if phase.eval_mean is not None:
             points.append((round_index, float(np.mean(phase.demos_per_task)), phase.eval_mean))
-    method = record.method
-    if method == "bc":  # BC at several budgets: one group per budget (a point each)
-        method = f"bc ({np.mean(record.demos_so_far):g} demos/task)"
+    method = label or record.method
+    if record.method == "bc":  # BC at several budgets: one group per budget (a point each)
+        method = f"{method} ({np.mean(record.demos_so_far):g} demos/task)"
     return method, record.seed, points
 
 
-def learning_curves(roots: Sequence[Path]) -> list[CurvePoint]:
+def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> list[CurvePoint]:
     """Groups experiments by method and averages their curves over seeds, round by round.
+
+    Args:
+        roots: Experiment folders.
+        labels: Method name per folder where it is not the run's own (a variant of a method, e.g.
+            BC with balanced sampling reported as ``bc-balanced`` beside ``bc``).
 
     Raises:
         ValueError: If two runs of one method used the same seed (a duplicate would bias the mean),
             their configs differ in more than the seed (``check_comparable``), or no run has an
             evaluated phase.
     """
-    check_comparable(roots)
+    labels = labels or {}
+    check_comparable(roots, labels)
     grouped: dict[str, dict[int, list[tuple[int, float, float]]]] = defaultdict(dict)
     for root in roots:
-        method, seed, points = experiment_curve(Path(root))
+        method, seed, points = experiment_curve(Path(root), labels.get(Path(root)))
         if seed in grouped[method]:
             raise UserError(f"Two {method} experiments with seed {seed}; give each run its own seed.")
         grouped[method][seed] = points
@@ -92,10 +103,11 @@ def learning_curves(roots: Sequence[Path]) -> list[CurvePoint]:
     return curves
 
 
-def check_comparable(roots: Sequence[Path]) -> None:
+def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> None:
     """Refuses to group runs of one method whose configs differ in more than ``PER_RUN_FIELDS``.
 
-    BC runs may also differ in ``BC_BUDGET_FIELDS`` (one BC run per budget).
+    BC runs may also differ in ``BC_BUDGET_FIELDS`` (one BC run per budget). A run given a label in
+    ``labels`` is grouped under that label, not under its method.
 
     Raises:
         ValueError: Naming the method, the differing fields with their values and two such runs.
@@ -107,8 +119,9 @@ def check_comparable(roots: Sequence[Path]) -> None:
         if not path.is_file():
             raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
         config = json.loads(path.read_text())
-        method = "bc" if config.get("mode") == "bc" else config.get("scheduler", {}).get("type")
-        ignored = PER_RUN_FIELDS + (BC_BUDGET_FIELDS if method == "bc" else ())
+        is_bc = config.get("mode") == "bc"
+        method = (labels or {}).get(root) or ("bc" if is_bc else config.get("scheduler", {}).get("type"))
+        ignored = PER_RUN_FIELDS + (BC_BUDGET_FIELDS if is_bc else ())
         shared = {key: value for key, value in config.items() if key not in ignored}
         if method not in first_of_method:
             first_of_method[method] = (root, shared)
@@ -119,7 +132,8 @@ def check_comparable(roots: Sequence[Path]) -> None:
             details = ", ".join(f"{key}: {other.get(key)!r} vs {shared.get(key)!r}" for key in differing)
             raise UserError(
                 f"Refusing to average {method} runs with different configs ({details}) in {other_root} "
-                f"and {root}: report them separately, or rerun them with the same options."
+                f"and {root}: report them separately, give one set a label of its own (report "
+                "--variants), or rerun them with the same options."
             )
 
 

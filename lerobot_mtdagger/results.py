@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import csv
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -41,8 +41,12 @@ def round_frames_per_task(root: Path, num_tasks: int) -> list[int]:
     return counts.tolist()
 
 
-def experiment_rows(root: Path) -> list[dict[str, Any]]:
+def experiment_rows(root: Path, label: str | None = None) -> list[dict[str, Any]]:
     """The rows of one experiment, one per committed training phase with an evaluation.
+
+    Args:
+        root: The experiment folder.
+        label: Method name of its rows (default: the run's method); ``bc`` says whether it is BC.
 
     Raises:
         ValueError: If ``root`` is not an experiment with committed rounds.
@@ -60,18 +64,21 @@ def experiment_rows(root: Path) -> list[dict[str, Any]]:
         phase = experiment.read_phase_record(k)
         if phase.eval is None:
             continue
-        rows.append(_row(root, records, k, phase, frames))
+        rows.append(_row(root, records, k, phase, frames, label))
     return rows
 
 
-def _row(root: Path, records: list, k: int, phase: Any, frames: np.ndarray) -> dict[str, Any]:
+def _row(
+    root: Path, records: list, k: int, phase: Any, frames: np.ndarray, label: str | None
+) -> dict[str, Any]:
     record = records[k]
     following = records[k + 1] if k + 1 < len(records) else None
     config = record.config
     demos = [int(d) for d in phase.demos_per_task]
     return {
         "experiment": str(root),
-        "method": record.method,
+        "method": label or record.method,
+        "bc": record.method == "bc",
         "seed": int(record.seed),
         "round": int(k),
         "preset": config.get("preset"),
@@ -91,9 +98,15 @@ def _row(root: Path, records: list, k: int, phase: Any, frames: np.ndarray) -> d
     }
 
 
-def results_rows(roots: Sequence[Path]) -> list[dict[str, Any]]:
-    """The rows of every experiment, sorted by (method, seed, demos, round)."""
-    rows = [row for root in roots for row in experiment_rows(Path(root))]
+def results_rows(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> list[dict[str, Any]]:
+    """The rows of every experiment, sorted by (method, seed, demos, round).
+
+    Args:
+        roots: Experiment folders.
+        labels: Method name per folder where it is not the run's own (``report --variants``).
+    """
+    labels = labels or {}
+    rows = [row for root in roots for row in experiment_rows(Path(root), labels.get(Path(root)))]
     return sorted(rows, key=lambda r: (r["method"], r["seed"], r["demos_per_task_mean"], r["round"]))
 
 

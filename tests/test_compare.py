@@ -116,3 +116,39 @@ def test_hardest_tasks_are_those_bc_fails_most_at_its_largest_budget():
         {"method": "need", "demos_per_task_mean": 5.0, "round": 2, "eval_success": [0.0, 1.0, 1.0]},
     ]
     assert hardest_tasks(rows) == [1, 2]
+
+
+def test_report_shows_a_labelled_bc_variant_as_a_second_baseline(compared, tmp_path, capsys):
+    """BC trained differently (balanced sampling) is reported beside ``bc`` under its own name."""
+    folder, _ = compared
+    balanced = tmp_path / "bc-balanced"
+    args = ["compare", "--methods=[bc]", "--seeds=[0,1]", "--bc_budgets=[1,3]", f"--output_dir={balanced}"]
+    assert main([*args, "--jobs=2", *TINY, "--sampling=balanced"]) == 0
+    capsys.readouterr()
+    runs = sorted((balanced / "runs").glob("bc-*"))
+    runs = [run for run in runs if run.is_dir()]
+    # Grouped with the other BC runs without a label, they are refused (their configs differ).
+    experiments = ",".join(str(p) for p in [*runs, *(folder / "runs").glob("bc-1demos-seed*")] if p.is_dir())
+    assert main(["report", f"--experiments=[{experiments}]"]) == 2
+    assert "--variants" in capsys.readouterr().err
+    out = tmp_path / "report"
+    command = ["report", f"--compare_dir={folder}", f"--variants={{bc-balanced: {balanced}}}"]
+    assert main([*command, f"--output_dir={out}"]) == 0
+    assert "bc-balanced (3 demos/task)" in capsys.readouterr().out
+    summary = (out / "report.md").read_text()
+    for pair in (
+        "| need | bc-balanced | 3.0 |",
+        "| uniform | bc-balanced | 1.0 |",
+        "| bc-balanced | bc | 3.0 |",
+    ):
+        assert pair in summary, pair
+    assert "| need | bc | 3.0 |" in summary  # the plain BC stays a baseline
+    rows = json.loads((out / "results.json").read_text())
+    assert {(r["method"], r["bc"]) for r in rows if r["bc"]} == {("bc", True), ("bc-balanced", True)}
+
+
+def test_report_refuses_a_variant_folder_that_holds_no_runs(compared, tmp_path, capsys):
+    folder, _ = compared
+    (tmp_path / "empty").mkdir()
+    assert main(["report", f"--compare_dir={folder}", f"--variants={{x: {tmp_path / 'empty'}}}"]) == 2
+    assert "neither a compare folder" in capsys.readouterr().err
