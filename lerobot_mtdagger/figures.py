@@ -105,6 +105,11 @@ def demos_of(curve: Sequence[Row]) -> list[float]:
     return [row["demos_per_task_mean"] for row in curve]
 
 
+def frames_of(curve: Sequence[Row]) -> list[float]:
+    """Mean expert-labelled frames per task at each point of a curve (the expert's queries)."""
+    return [row["expert_frames_per_task_mean"] for row in curve]
+
+
 def cumulative_seconds(curve: Sequence[Row]) -> list[float]:
     """Wall time spent up to each point of a DAgger curve (BC: each point's own run)."""
     if curve and is_bc(curve[0]):
@@ -355,6 +360,58 @@ def comparison_pairs(rows: Sequence[Row]) -> list[tuple[str, str]]:
     return pairs + [(variant, "bc") for variant in bc_names if variant != "bc" and "bc" in bc_names]
 
 
+def reach_lines(rows: Sequence[Row], levels: Sequence[float]) -> list[str]:
+    """Markdown: expert demos and expert-labelled frames per task each method needed to reach each level."""
+    lines = ["## Expert data needed to reach a level", ""]
+    lines += [
+        "Per task, at the first crossing of each seed's curve (interpolated; BC: along its budgets), mean "
+        "over the seeds that reached the level with its 95% t interval; k/n: seeds that reached it.",
+        "",
+        "| method | level | expert demos per task | expert-labelled frames per task | seeds |",
+        "|---|---:|---:|---:|---:|",
+    ]
+    for method, seeds in runs_by_method(rows).items():
+        for level in levels:
+            demos = [seed_reach(curve, level, demos_of) for curve in seeds.values()]
+            frames = [seed_reach(curve, level, frames_of) for curve in seeds.values()]
+            reached = [(d, f) for d, f in zip(demos, frames, strict=True) if d is not None and f is not None]
+            cells = ["never", "never"]
+            if reached:
+                demo_interval = mean_interval([d for d, _ in reached])
+                frame_interval = mean_interval([f for _, f in reached])
+                cells = [_format_amount(demo_interval, "{:.1f}"), _format_amount(frame_interval, "{:.0f}")]
+            lines.append(
+                f"| {method} | {level:.0%} | {cells[0]} | {cells[1]} | {len(reached)}/{len(demos)} |"
+            )
+    return lines + [""]
+
+
+def _format_amount(interval: Interval, pattern: str) -> str:
+    if math.isnan(interval.low):
+        return pattern.format(interval.mean)
+    return (
+        f"{pattern.format(interval.mean)} [{pattern.format(interval.low)}, {pattern.format(interval.high)}]"
+    )
+
+
+def cost_lines(rows: Sequence[Row]) -> list[str]:
+    """Markdown: the wall time each method's runs took (collect + write + load + train + eval)."""
+    lines = ["## What the runs cost", ""]
+    lines += [
+        "Wall time of the committed phases (collect + write + load + train + eval; start-up not "
+        "counted), from each phase's record. A BC run is one budget of one seed.",
+        "",
+        "| method | runs | phase time per run, mean (s) | all runs (min) |",
+        "|---|---:|---:|---:|",
+    ]
+    for method in runs_by_method(rows):
+        method_rows = [row for row in rows if row["method"] == method]
+        seconds = sum(sum(row[name] for name in PHASE_TIMINGS) for row in method_rows)
+        runs = len({row.get("experiment", (row["seed"], row["demos_per_task_mean"])) for row in method_rows})
+        lines.append(f"| {method} | {runs} | {seconds / runs:.0f} | {seconds / 60:.1f} |")
+    return lines + [""]
+
+
 def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[str, Any], levels) -> str:
     """The report: figures embedded, paired differences and demo ratios per pair of methods."""
     lines = ["# Method comparison", "", _caption(rows) + ".", ""]
@@ -379,6 +436,7 @@ def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[
             ratio, paired, seeds = demos_ratio(rows, method, baseline, level)
             shown = "n/a" if ratio is None else f"{ratio:.2f}"
             lines.append(f"| {method} | {baseline} | {level:.0%} | {shown} | {paired}/{seeds} |")
+    lines += ["", *reach_lines(rows, levels), *cost_lines(rows)]
     return "\n".join(lines) + "\n"
 
 

@@ -80,6 +80,8 @@ def test_report_writes_every_figure_and_the_paired_differences(compared, capsys)
         assert f"]({name})" in summary
     assert "| need | uniform | 3.0 |" in summary and "| gain | bc | 5.0 |" in summary
     assert "mean over 2 seeds, 95% t interval; 2 eval episodes per task" in summary
+    assert "## Expert data needed to reach a level" in summary and "## What the runs cost" in summary
+    assert "| need | 2 |" in summary and "| bc | 6 |" in summary  # 2 seeds; BC: 3 budgets x 2 seeds
     assert "bc (1 demos/task)" in capsys.readouterr().out  # the table keeps BC budgets apart
 
 
@@ -152,3 +154,26 @@ def test_report_refuses_a_variant_folder_that_holds_no_runs(compared, tmp_path, 
     (tmp_path / "empty").mkdir()
     assert main(["report", f"--compare_dir={folder}", f"--variants={{x: {tmp_path / 'empty'}}}"]) == 2
     assert "neither a compare folder" in capsys.readouterr().err
+
+
+def test_reach_table_gives_demos_and_frames_at_the_first_crossing():
+    from lerobot_mtdagger.figures import reach_lines
+
+    def curve(seed, successes):
+        return [
+            {
+                "method": "need",
+                "seed": seed,
+                "round": k,
+                "demos_per_task_mean": demos,
+                "expert_frames_per_task_mean": 100.0 * demos,
+                "eval_success_mean": success,
+            }
+            for k, (demos, success) in enumerate(zip((1.0, 3.0, 5.0), successes, strict=True))
+        ]
+
+    rows = curve(0, (0.2, 0.6, 0.9)) + curve(1, (0.2, 0.4, 0.6))
+    table = "\n".join(reach_lines(rows, [0.5, 0.95]))
+    # seed 0 crosses 0.5 at 2.5 demos (250 frames), seed 1 at 4.0 (400): mean 3.25 and 325.
+    assert "| need | 50% | 3.2" in table and "| 325 [" in table and "| 2/2 |" in table
+    assert "| need | 95% | never | never | 0/2 |" in table
