@@ -351,13 +351,17 @@ def comparison_pairs(rows: Sequence[Row]) -> list[tuple[str, str]]:
     """The (method, baseline) pairs of the summary.
 
     Every method against every baseline (Uniform DAgger and each BC variant), Uniform DAgger against
-    each BC variant, and each labelled BC variant against ``bc``.
+    each BC variant, each labelled BC variant against ``bc``, and task need with the Kalman filter
+    against task need without it.
     """
     bases = baselines(rows)
     bc_names = bc_methods(rows)
     methods = [m for m in runs_by_method(rows) if m not in bases]
     pairs = [(m, b) for m in methods for b in bases] + [("uniform", b) for b in bc_names]
-    return pairs + [(variant, "bc") for variant in bc_names if variant != "bc" and "bc" in bc_names]
+    pairs += [(variant, "bc") for variant in bc_names if variant != "bc" and "bc" in bc_names]
+    if "need" in methods and "need_raw" in methods:  # the Kalman filter's own effect
+        pairs.append(("need", "need_raw"))
+    return pairs
 
 
 def reach_lines(rows: Sequence[Row], levels: Sequence[float]) -> list[str]:
@@ -392,6 +396,69 @@ def _format_amount(interval: Interval, pattern: str) -> str:
     return (
         f"{pattern.format(interval.mean)} [{pattern.format(interval.low)}, {pattern.format(interval.high)}]"
     )
+
+
+def task_gap_lines(rows: Sequence[Row], hardest: Sequence[int]) -> list[str]:
+    """Markdown: paired differences of final per-task success on the hardest tasks and on the rest."""
+    lines = ["## The hardest tasks against the others", ""]
+    lines += [
+        "Paired over seeds at the largest budget both methods ran: success minus the baseline's, "
+        "averaged over the hardest tasks and over the other tasks, 95% t interval. The hardest "
+        "tasks are chosen by BC's own success at its largest budget, so a difference against that "
+        "BC on them is biased in the method's favour (regression to the mean); against Uniform "
+        "DAgger it is not.",
+        "",
+        "| method | baseline | demos per task | hardest tasks | other tasks |",
+        "|---|---|---:|---|---|",
+    ]
+    grouped = runs_by_method(rows)
+    for method, baseline in comparison_pairs(rows):
+        if method not in grouped or baseline not in grouped:
+            continue
+        common = _budgets(grouped[method]) & _budgets(grouped[baseline])
+        if not common:
+            continue
+        budget = max(common)
+        hard, other = [], []
+        for seed in sorted(set(grouped[method]) & set(grouped[baseline])):
+            first = [r for r in grouped[method][seed] if r["demos_per_task_mean"] == budget]
+            second = [r for r in grouped[baseline][seed] if r["demos_per_task_mean"] == budget]
+            if first and second:
+                difference = np.subtract(first[-1]["eval_success"], second[-1]["eval_success"])
+                hard.append(float(difference[list(hardest)].mean()))
+                other.append(float(np.delete(difference, list(hardest)).mean()))
+        if hard:
+            cells = f"{_format(mean_interval(hard))} | {_format(mean_interval(other))}"
+            lines.append(f"| {method} | {baseline} | {budget:.1f} | {cells} |")
+    return lines + [""]
+
+
+def _budgets(seeds: dict[int, list[Row]]) -> set[float]:
+    return {row["demos_per_task_mean"] for curve in seeds.values() for row in curve}
+
+
+def stability_lines(rows: Sequence[Row]) -> list[str]:
+    """Markdown: how much each DAgger method's success varies over seeds and from round to round."""
+    lines = ["## Stability", ""]
+    lines += [
+        "Per DAgger method: the standard deviation of average success over seeds, averaged over its "
+        "rounds; the mean absolute change of a seed's success from one round to the next; the "
+        "share of those changes that are drops.",
+        "",
+        "| method | std over seeds (mean over rounds) | round-to-round change | drops |",
+        "|---|---:|---:|---:|",
+    ]
+    for method, seeds in runs_by_method(rows).items():
+        curves = [[row["eval_success_mean"] for row in curve] for curve in seeds.values()]
+        if any(is_bc(curve[0]) for curve in seeds.values()) or len(curves) < 2:
+            continue
+        length = min(len(curve) for curve in curves)
+        spread = float(np.mean([np.std([c[k] for c in curves], ddof=1) for k in range(length)]))
+        changes = np.concatenate([np.diff(curve) for curve in curves])
+        drops = float(np.mean(changes < 0)) if changes.size else math.nan
+        mean_change = float(np.mean(np.abs(changes))) if changes.size else math.nan
+        lines.append(f"| {method} | {spread:.3f} | {mean_change:.3f} | {drops:.0%} |")
+    return lines + [""]
 
 
 def cost_lines(rows: Sequence[Row]) -> list[str]:
@@ -436,7 +503,8 @@ def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[
             ratio, paired, seeds = demos_ratio(rows, method, baseline, level)
             shown = "n/a" if ratio is None else f"{ratio:.2f}"
             lines.append(f"| {method} | {baseline} | {level:.0%} | {shown} | {paired}/{seeds} |")
-    lines += ["", *reach_lines(rows, levels), *cost_lines(rows)]
+    lines += ["", *reach_lines(rows, levels), *task_gap_lines(rows, notes["hardest_indices"])]
+    lines += [*stability_lines(rows), *cost_lines(rows)]
     return "\n".join(lines) + "\n"
 
 
@@ -490,6 +558,7 @@ def write_report(rows: Sequence[Row], task_names: Sequence[str], folder: Path, l
     notes = {
         "correlations": {k: round(v, 3) for k, v in correlations.items()},
         "hardest": [task_names[t] for t in hardest],
+        "hardest_indices": list(hardest),
     }
     path = folder / "report.md"
     path.write_text(summary_markdown(rows, figures, notes, levels))

@@ -82,6 +82,9 @@ def test_report_writes_every_figure_and_the_paired_differences(compared, capsys)
     assert "mean over 2 seeds, 95% t interval; 2 eval episodes per task" in summary
     assert "## Expert data needed to reach a level" in summary and "## What the runs cost" in summary
     assert "| need | 2 |" in summary and "| bc | 6 |" in summary  # 2 seeds; BC: 3 budgets x 2 seeds
+    assert "## The hardest tasks against the others" in summary and "## Stability" in summary
+    assert "| need | need_raw | 3.0 |" in summary  # the Kalman filter's own effect, paired
+    assert "| need | uniform | 5.0 | " in summary.split("## The hardest tasks")[1]
     assert "bc (1 demos/task)" in capsys.readouterr().out  # the table keeps BC budgets apart
 
 
