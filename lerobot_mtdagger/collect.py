@@ -117,6 +117,7 @@ def run_episodes(
     steps_after_success: int,
     progress: Callable[[Episode], None] | None = None,
     mixing: str = "step",
+    expert_multiple: float | None = None,
 ) -> list[Episode]:
     """Runs ``episodes_per_task[i]`` episodes of task i on the env workers, in lock-step.
 
@@ -139,6 +140,8 @@ def run_episodes(
         steps_after_success: Steps kept after the first success.
         progress: Called with each finished episode.
         mixing: ``step`` (a beta coin per step) or ``episode`` (one per episode).
+        expert_multiple: Cut a learner's episode at this multiple of the expert's own steps to
+            success from the same reset seed (``RolloutRules.expert_multiple``; None: no such cut).
 
     Returns:
         The episodes, ordered by (task, episode).
@@ -161,6 +164,7 @@ def run_episodes(
             max_steps=max_steps,
             steps_after_success=steps_after_success,
             mixing=mixing,
+            expert_multiple=expert_multiple,
         )
     )
     schedule = _Schedule([deque(range(int(n))) for n in episodes_per_task], seed, round_index, stream)

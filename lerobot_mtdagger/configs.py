@@ -165,6 +165,9 @@ class RunConfig:
             ``gain_split=heldout`` (decided once per round, so an episode never changes side).
         max_rollout_steps: Steps after which a DAgger rollout is cut (None: the env's own horizon,
             the one evaluation runs to).
+        rollout_expert_multiple: Cut a DAgger rollout at this multiple of the steps the expert alone
+            takes to succeed from the same reset seed (the expert runs that episode first,
+            unrecorded; no cut where it fails). None: no such cut. ``max_rollout_steps`` still applies.
         steps_after_success: Steps recorded after the first success before an episode ends.
         num_points: Points per cloud (pointcloud mode).
         image_size: Image side (rgb mode).
@@ -204,6 +207,7 @@ class RunConfig:
     gain_split: str = "train"
     heldout_fraction: float = 0.2
     max_rollout_steps: int | None = None
+    rollout_expert_multiple: float | None = None
     steps_after_success: int = 10
     num_points: int = 1024
     image_size: int = 84
@@ -242,8 +246,10 @@ class RunConfig:
         resolve_workers(self.workers)  # refuses a negative count before anything runs
         if self.seed < 0:
             raise ValueError(f"seed must be >= 0, got {self.seed}.")
-        for name in ("steps_per_round", "budget", "budget_per_task", "max_rollout_steps", "epochs"):
-            if getattr(self, name) is not None and not getattr(self, name) > 0:
+        positive = ("steps_per_round", "budget", "budget_per_task", "max_rollout_steps", "epochs")
+        for name in (*positive, "rollout_expert_multiple"):
+            value = getattr(self, name)
+            if value is not None and not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}.")
         for name, choices in (
             ("mixing", MIXING_MODES),

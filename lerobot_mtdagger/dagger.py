@@ -190,6 +190,7 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
             steps_after_success=config.steps_after_success,
             progress=lambda _: bar.update(1),
             mixing=config.mixing,
+            expert_multiple=config.rollout_expert_multiple,
         )
     collected = time.perf_counter()
     dataset = ctx.experiment.write_round(

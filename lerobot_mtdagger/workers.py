@@ -140,6 +140,10 @@ class RolloutRules:
         steps_after_success: Steps kept after the first success.
         mixing: ``step`` (a beta coin at every step) or ``episode`` (one coin when the episode
             starts: the expert or the learner acts throughout).
+        expert_multiple: Cut an episode where the learner acts at ``ceil(expert_multiple * L)``
+            steps, ``L`` being the steps the expert alone takes to its first success from the same
+            reset seed (run first, unrecorded; no cut where the expert does not succeed). None: no
+            such cut. ``max_steps`` still applies.
     """
 
     beta: float
@@ -149,11 +153,12 @@ class RolloutRules:
     max_steps: int | None
     steps_after_success: int
     mixing: str = "step"
+    expert_multiple: float | None = None
 
     @property
     def need_expert(self) -> bool:
         """The expert is queried when its labels are stored or it may act."""
-        return self.record or self.beta > 0.0 or not self.learner
+        return self.record or self.beta > 0.0 or not self.learner or self.expert_multiple is not None
 
 
 def expert_episode_coin(beta_seed: tuple[int, ...], beta: float) -> bool:
@@ -183,6 +188,7 @@ class _Running:
     privileged: np.ndarray
     steps_since_success: int = -1
     expert_episode: bool = False
+    max_steps: int | None = None
 
 
 class RolloutWorker:
@@ -260,11 +266,18 @@ class RolloutWorker:
         pool = self.free_envs[spec.task_index]
         env = pool.pop() if pool else self.suite.make_env(task_name)
         expert = self._expert(spec.task_index) if self.rules.need_expert else None
-        observation, info = env.reset(seed=spec.reset_seed)
-        rng = np.random.default_rng(np.random.SeedSequence(list(spec.beta_seed)))
         expert_episode = self.rules.mixing == "episode" and expert_episode_coin(
             spec.beta_seed, self.rules.beta
         )
+        max_steps = self.rules.max_steps
+        if self.rules.expert_multiple is not None and self.rules.learner and not expert_episode:
+            expert_steps = _expert_steps_to_success(env, expert, spec.reset_seed)
+            if expert_steps is not None:
+                limit = math.ceil(self.rules.expert_multiple * expert_steps)
+                max_steps = limit if max_steps is None else min(max_steps, limit)
+            expert.reset()
+        observation, info = env.reset(seed=spec.reset_seed)
+        rng = np.random.default_rng(np.random.SeedSequence(list(spec.beta_seed)))
         return _Running(
             spec=spec,
             env=env,
@@ -274,6 +287,7 @@ class RolloutWorker:
             observation=observation,
             privileged=info["privileged_state"],
             expert_episode=expert_episode,
+            max_steps=max_steps,
         )
 
     def _expert(self, task_index: int) -> Any:
@@ -325,9 +339,25 @@ class RolloutWorker:
         return bool(
             terminated
             or truncated
-            or (rules.max_steps is not None and episode.steps >= rules.max_steps)
+            or (running.max_steps is not None and episode.steps >= running.max_steps)
             or (episode.success and running.steps_since_success >= rules.steps_after_success)
         )
+
+
+def _expert_steps_to_success(env: Any, expert: Any, reset_seed: int) -> int | None:
+    """Steps the expert alone takes from ``reset_seed`` to its first success (None: it never succeeds).
+
+    Runs one unrecorded expert episode on ``env`` (the caller resets ``env`` and ``expert`` after it).
+    """
+    _, info = env.reset(seed=reset_seed)
+    steps = 0
+    while True:
+        _, _, terminated, truncated, info = env.step(expert.act(info["privileged_state"]))
+        steps += 1
+        if info["success"]:
+            return steps
+        if terminated or truncated:
+            return None
 
 
 def _worker_loop(connection: Connection, suite: TaskSuite, inherited: list[Connection]) -> None:

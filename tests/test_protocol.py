@@ -93,6 +93,48 @@ def test_default_rollouts_run_to_the_evaluation_horizon(metaworld_rollouts):
     assert {e.steps for e in learner} == {500}
 
 
+def expert_steps_to_success(suite, task: str, reset_seed: int) -> int | None:
+    """The expert's own steps to its first success from ``reset_seed`` (fresh env and expert)."""
+    from lerobot_mtdagger.experts import make_expert
+
+    env, expert = suite.make_env(task), make_expert(suite, task)
+    expert.reset()
+    _, info = env.reset(seed=reset_seed)
+    for step in range(1, 501):
+        _, _, terminated, truncated, info = env.step(expert.act(info["privileged_state"]))
+        if info["success"]:
+            return step
+        if terminated or truncated:
+            break
+    return None
+
+
+def test_rollouts_can_end_at_a_multiple_of_the_experts_length_on_the_same_seed():
+    """``rollout_expert_multiple``: a failing learner is cut at ceil(m * the expert's steps to success)."""
+    suite = make_suite("metaworld-mt10", tasks=REACH_PUSH_PICK)
+    with EnvWorkers(suite, 0) as workers:
+        options = dict(policy=zero_actions, beta=0.5, seed=100, round_index=1, stream=COLLECT_STREAM)
+        options |= dict(record=True, max_steps=None, steps_after_success=10, mixing="episode")
+        episodes = run_episodes(workers, [2, 2, 2], **options, expert_multiple=1.5)
+        uncut = run_episodes(workers, [2, 2, 2], **options)
+    for cut, whole in zip(episodes, uncut, strict=True):  # the expert's trial run leaves no trace
+        states = [frame["observation.state"] for frame in cut.frames]
+        assert np.array_equal(states, [frame["observation.state"] for frame in whole.frames[: len(states)]])
+    learner = [e for e in episodes if e.learner_only]
+    assert len(learner) == 3  # one learner episode per task at beta 0.5
+    for episode in learner:
+        expert_steps = expert_steps_to_success(suite, REACH_PUSH_PICK[episode.task_index], episode.seed)
+        assert expert_steps is not None and expert_steps < 200
+        assert episode.steps == len(episode.frames) == int(np.ceil(1.5 * expert_steps)), episode
+    # The expert's own episodes are not cut: they end 10 steps after success as before.
+    experts = [e for e in episodes if e.learner_steps == 0]
+    for episode in experts:
+        expert_steps = expert_steps_to_success(suite, REACH_PUSH_PICK[episode.task_index], episode.seed)
+        assert episode.success and episode.steps == expert_steps + 10
+    with pytest.raises(ValueError, match="rollout_expert_multiple must be > 0"):
+        RunConfig(rollout_expert_multiple=0.0)
+
+
 def test_episode_mixing_gives_each_task_its_share_of_expert_episodes():
     for beta in (0.25, 0.5, 0.75):
         for task in range(5):
@@ -103,7 +145,8 @@ def test_episode_mixing_gives_each_task_its_share_of_expert_episodes():
     assert all(expert_episode_coin((0, BETA_STREAM, 1, 0, e), 1.0) for e in range(10))
 
 
-def test_episode_mixing_does_not_depend_on_the_worker_count():
+@pytest.mark.parametrize("expert_multiple", [None, 2.0])
+def test_episode_mixing_does_not_depend_on_the_worker_count(expert_multiple):
     suite = make_suite("toy")
 
     def collect(workers: int):
@@ -120,6 +163,7 @@ def test_episode_mixing_does_not_depend_on_the_worker_count():
                 max_steps=40,
                 steps_after_success=0,
                 mixing="episode",
+                expert_multiple=expert_multiple,
             )
         return [(e.task_index, e.episode, e.steps, e.learner_steps, e.success) for e in episodes]
 
