@@ -1,4 +1,4 @@
-"""Frozen-code shim for the MT10 evaluation study: drop the editable finder of /work/main."""
+"""Import shim of the frozen-code study runs: drops the editable install's import hook (see README)."""
 
 import sys
 
