@@ -21,5 +21,5 @@ variant rollout-cap-200 '[uniform,need]' --max_rollout_steps=200
 variant normalisation-recompute '[uniform,need]' --normalisation=recompute
 variant retrain-epochs '[bc,uniform,need]' --warm_start=false --steps_rule=epochs --epochs=100
 variant sampling-balanced '[bc,uniform,need]' --sampling=balanced
-# Queued 2026-11-22 (not in the results table yet): rollouts cut at twice the expert's length.
+# Added 2026-11-22: rollouts cut at twice the expert's length on the same seed.
 variant rollout-expert-2x '[uniform,need]' --rollout_expert_multiple=2
