@@ -7,9 +7,8 @@ Run: ``.venv/bin/python benchmarks/bench_collect.py`` (options: ``--workers 1 2`
   one process), the per-core reference;
 - ``collect``: a DAgger round as the runner collects it: the learner acting at every step
   (``beta = 0``; an untrained ``mtdagger`` policy with its LeRobot processors, batched in the main
-  process), the expert labelling every step, frames recorded, rollouts to the env's 500-step horizon (the
-runner's default), with each
-  worker count; recorded steps per second of wall time;
+  process), the expert labelling every step, frames recorded, rollouts to the env's 500-step
+  horizon (the runner's default), with each worker count; recorded steps per second of wall time;
 - ``eval``: evaluation episodes per second (the pure policy, to the env's 500-step truncation);
 - ``raw, N processes at once``: N processes stepping raw MetaWorld at the same time, the machine's
   own ceiling for N workers (two cores that slow each other down cap it below N x raw);

@@ -316,7 +316,8 @@ def report_command(config: ReportConfig) -> str:
     """Prints the learning curves (mean and std over seeds); writes the figures and summary."""
     from lerobot_mtdagger.report import learning_curves, markdown_table
 
-    table = markdown_table(learning_curves(config.experiment_dirs, config.labels))
+    roots, labels = config.experiment_dirs, config.labels  # each lists the run folders once
+    table = markdown_table(learning_curves(roots, labels))
     print(table)
     if config.output is not None:
         config.output.write_text(table + "\n")
@@ -325,8 +326,8 @@ def report_command(config: ReportConfig) -> str:
         from lerobot_mtdagger.results import results_rows, write_results
         from lerobot_mtdagger.rounds import ExperimentDir
 
-        rows = results_rows(config.experiment_dirs, config.labels)
-        task_names = ExperimentDir(config.experiment_dirs[0]).read_round_record(0).task_names
+        rows = results_rows(roots, labels)
+        task_names = ExperimentDir(roots[0]).read_round_record(0).task_names
         write_results(rows, config.output_dir)
         path = write_report(rows, task_names, config.output_dir, levels=config.levels)
         print(f"figures and summary: {path}")

@@ -250,7 +250,7 @@ class RunConfig:
         for name in (*positive, "rollout_expert_multiple"):
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}.")
+                raise ValueError(f"{name} must be > 0, got {value}.")
         for name, choices in (
             ("mixing", MIXING_MODES),
             ("steps_rule", STEPS_RULES),

@@ -305,23 +305,31 @@ def _save(figure, path: Path) -> Path:
 # -------------------------------------------------------------------------------------------------
 
 
+def seed_pairs(
+    grouped: dict[str, dict[int, list[Row]]], method: str, baseline: str, budget: float
+) -> list[tuple[Row, Row]]:
+    """The (method, baseline) rows at ``budget`` demos per task, one pair per seed both ran it."""
+    pairs = []
+    for seed in sorted(set(grouped[method]) & set(grouped[baseline])):
+        a = [r for r in grouped[method][seed] if r["demos_per_task_mean"] == budget]
+        b = [r for r in grouped[baseline][seed] if r["demos_per_task_mean"] == budget]
+        if a and b:
+            pairs.append((a[0], b[0]))
+    return pairs
+
+
 def paired_rows(rows: Sequence[Row], method: str, baseline: str) -> list[tuple[float, Interval]]:
     """Paired differences (method - baseline) of success over the seeds both ran, at every common budget."""
     grouped = runs_by_method(rows)
     if method not in grouped or baseline not in grouped:
         return []
-    seeds = sorted(set(grouped[method]) & set(grouped[baseline]))
     comparisons = []
-    budgets = sorted({r["demos_per_task_mean"] for r in rows if r["method"] == method})
-    for budget in budgets:
-        pairs = []
-        for seed in seeds:
-            a = [r for r in grouped[method][seed] if r["demos_per_task_mean"] == budget]
-            b = [r for r in grouped[baseline][seed] if r["demos_per_task_mean"] == budget]
-            if a and b:
-                pairs.append((a[0]["eval_success_mean"], b[0]["eval_success_mean"]))
+    for budget in sorted(_budgets(grouped[method])):
+        pairs = seed_pairs(grouped, method, baseline, budget)
         if pairs:
-            comparisons.append((budget, paired_difference([p[0] for p in pairs], [p[1] for p in pairs])))
+            first = [a["eval_success_mean"] for a, _ in pairs]
+            second = [b["eval_success_mean"] for _, b in pairs]
+            comparisons.append((budget, paired_difference(first, second)))
     return comparisons
 
 
@@ -420,13 +428,10 @@ def task_gap_lines(rows: Sequence[Row], hardest: Sequence[int]) -> list[str]:
             continue
         budget = max(common)
         hard, other = [], []
-        for seed in sorted(set(grouped[method]) & set(grouped[baseline])):
-            first = [r for r in grouped[method][seed] if r["demos_per_task_mean"] == budget]
-            second = [r for r in grouped[baseline][seed] if r["demos_per_task_mean"] == budget]
-            if first and second:
-                difference = np.subtract(first[-1]["eval_success"], second[-1]["eval_success"])
-                hard.append(float(difference[list(hardest)].mean()))
-                other.append(float(np.delete(difference, list(hardest)).mean()))
+        for first, second in seed_pairs(grouped, method, baseline, budget):
+            difference = np.subtract(first["eval_success"], second["eval_success"])
+            hard.append(float(difference[list(hardest)].mean()))
+            other.append(float(np.delete(difference, list(hardest)).mean()))
         if hard:
             cells = f"{_format(mean_interval(hard))} | {_format(mean_interval(other))}"
             lines.append(f"| {method} | {baseline} | {budget:.1f} | {cells} |")
@@ -474,7 +479,7 @@ def cost_lines(rows: Sequence[Row]) -> list[str]:
     for method in runs_by_method(rows):
         method_rows = [row for row in rows if row["method"] == method]
         seconds = sum(sum(row[name] for name in PHASE_TIMINGS) for row in method_rows)
-        runs = len({row.get("experiment", (row["seed"], row["demos_per_task_mean"])) for row in method_rows})
+        runs = len({row["experiment"] for row in method_rows})
         lines.append(f"| {method} | {runs} | {seconds / runs:.0f} | {seconds / 60:.1f} |")
     return lines + [""]
 

@@ -271,11 +271,7 @@ class RolloutWorker:
         )
         max_steps = self.rules.max_steps
         if self.rules.expert_multiple is not None and self.rules.learner and not expert_episode:
-            expert_steps = _expert_steps_to_success(env, expert, spec.reset_seed)
-            if expert_steps is not None:
-                limit = math.ceil(self.rules.expert_multiple * expert_steps)
-                max_steps = limit if max_steps is None else min(max_steps, limit)
-            expert.reset()
+            max_steps = self._expert_step_limit(env, expert, spec.reset_seed)
         observation, info = env.reset(seed=spec.reset_seed)
         rng = np.random.default_rng(np.random.SeedSequence(list(spec.beta_seed)))
         return _Running(
@@ -289,6 +285,18 @@ class RolloutWorker:
             expert_episode=expert_episode,
             max_steps=max_steps,
         )
+
+    def _expert_step_limit(self, env: Any, expert: Any, reset_seed: int) -> int | None:
+        """``max_steps`` capped at ``expert_multiple`` times the expert's own steps to success.
+
+        Runs the expert's trial episode on ``env`` and resets ``expert`` after it.
+        """
+        expert_steps = _expert_steps_to_success(env, expert, reset_seed)
+        expert.reset()
+        limits = [self.rules.max_steps]
+        if expert_steps is not None:
+            limits.append(math.ceil(self.rules.expert_multiple * expert_steps))
+        return min((limit for limit in limits if limit is not None), default=None)
 
     def _expert(self, task_index: int) -> Any:
         """A reset expert of the task that no running episode uses.
