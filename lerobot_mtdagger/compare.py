@@ -17,6 +17,8 @@ trains it by the same rule as DAgger's phase k (``RunConfig.phase_steps``).
 Runs are independent processes (``--jobs`` at once, default one per core); each gets
 ``cores / jobs`` torch threads and env workers so the jobs do not oversubscribe the cores. A
 finished run is skipped, a cut-off run is resumed (``--resume=true``), so ``compare`` itself resumes.
+Asked again with more ``--rounds``, it extends the finished DAgger runs by the new rounds and adds BC
+at the new budgets; the rounds already made are kept as they are.
 """
 
 from __future__ import annotations
@@ -66,6 +68,7 @@ class Job:
 
     name: str
     args: tuple[str, ...]
+    last_phase: int
 
 
 def split_arguments(argv: Sequence[str]) -> tuple[list[str], list[str]]:
@@ -119,24 +122,27 @@ def jobs_for(compare: CompareConfig, run_args: Sequence[str], num_tasks: int) ->
         for method in compare.methods:
             if method != "bc":
                 name = f"{method}-seed{seed}"
-                jobs.append(Job(name, (*run_args, f"--scheduler.type={method}", f"--seed={seed}")))
+                args = (*run_args, f"--scheduler.type={method}", f"--seed={seed}")
+                jobs.append(Job(name, args, last_phase=config.rounds))
                 continue
             for budget, rounds in sorted(bc_rounds_for(config, compare.bc_budgets, num_tasks).items()):
                 name = f"bc-{budget}demos-seed{seed}"
-                jobs.append(Job(name, (*run_args, "--mode=bc", f"--rounds={rounds}", f"--seed={seed}")))
+                args = (*run_args, "--mode=bc", f"--rounds={rounds}", f"--seed={seed}")
+                jobs.append(Job(name, args, last_phase=0))
     return jobs
 
 
-def is_finished(folder: Path) -> bool:
-    """Whether the run in ``folder`` committed all its training phases."""
+def is_finished(folder: Path, last_phase: int) -> bool:
+    """Whether the run in ``folder`` committed its training phases up to ``last_phase``.
+
+    A DAgger run finished at fewer rounds than asked is not: resuming it with more ``--rounds``
+    extends it (``ExperimentDir.check_resumable``).
+    """
     from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir  # LeRobot: loaded only when needed
 
-    config_path = folder / CONFIG_FILE
-    if not config_path.exists():
+    if not (folder / CONFIG_FILE).exists():
         return False
-    config = json.loads(config_path.read_text())
-    last = 0 if config["mode"] == "bc" else config["rounds"]
-    return last in ExperimentDir(folder).committed_phases()
+    return last_phase in ExperimentDir(folder).committed_phases()
 
 
 def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
@@ -148,7 +154,7 @@ def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
     from lerobot_mtdagger.rounds import CONFIG_FILE
 
     folder = runs_dir / job.name
-    if is_finished(folder):
+    if is_finished(folder, job.last_phase):
         logger.info("%s: finished, skipped", job.name)
         return folder
     resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []

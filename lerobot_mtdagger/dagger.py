@@ -448,6 +448,7 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         if config.resume:
             experiment.check_committed_files()  # refuses foreign, corrupt or changed rounds and policies
             experiment.clear_staging()
+            experiment.extend_rounds(config.rounds)  # a DAgger run resumed with more --rounds
         return _run_locked(config, suite, experiment, on_summary)
 
 

@@ -120,6 +120,17 @@ def result_options(config: Mapping[str, Any], ignore: Sequence[str]) -> dict[str
     return options
 
 
+def adds_dagger_rounds(stored: Mapping[str, Any], given: Mapping[str, Any]) -> bool:
+    """Whether ``given`` asks a stored DAgger run for more rounds (and maybe nothing else)."""
+    rounds = stored.get("rounds"), given.get("rounds")
+    return (
+        stored.get("mode") != "bc"
+        and given.get("mode") == stored.get("mode")
+        and all(isinstance(r, int) for r in rounds)
+        and rounds[1] > rounds[0]
+    )
+
+
 class ExperimentDir:
     """The on-disk state of one experiment (see the module docstring for the layout)."""
 
@@ -198,7 +209,9 @@ class ExperimentDir:
         """Checks that ``root`` holds an experiment started with the same config.
 
         Options in ``ignore`` and ``RESULT_NEUTRAL_POLICY_OPTIONS`` never change a result, so they
-        may differ from the stored config.
+        may differ from the stored config. So may a larger ``rounds`` of a DAgger run: no round
+        depends on how many follow it, so the run is extended (``extend_rounds``) and its rounds so
+        far are those of a run started with the larger number.
 
         Raises:
             NotAnExperimentError: If there is no experiment to resume.
@@ -210,13 +223,33 @@ class ExperimentDir:
             )
         stored = result_options(self.read_config(), ignore)
         given = result_options(config, ignore)
+        if adds_dagger_rounds(stored, given):
+            stored["rounds"] = given["rounds"]
         differing = sorted(key for key in set(stored) | set(given) if stored.get(key) != given.get(key))
         if differing:
             details = ", ".join(f"{k}: {stored.get(k)!r} -> {given.get(k)!r}" for k in differing)
-            raise UserError(
-                f"Cannot resume {self.root} with a different config ({details}): resume with the "
-                "stored values, or start a new --output_dir."
+            hint = (
+                " (--rounds may only grow, and only for a DAgger run: BC's one round holds the demos "
+                "of every round)"
+                if "rounds" in differing
+                else ""
             )
+            raise UserError(
+                f"Cannot resume {self.root} with a different config ({details}){hint}: resume with "
+                "the stored values, or start a new --output_dir."
+            )
+
+    def extend_rounds(self, rounds: int) -> bool:
+        """Raises the stored ``rounds`` of a DAgger run to ``rounds``; returns whether it grew.
+
+        Call it after ``check_resumable`` accepted the config, with the writer lock held.
+        """
+        config = self.read_config()
+        if rounds <= config["rounds"]:
+            return False
+        logger.info("Extending %s from %d to %d DAgger rounds", self.root, config["rounds"], rounds)
+        write_json_atomic(self.root / CONFIG_FILE, {**config, "rounds": rounds})
+        return True
 
     def read_config(self) -> dict[str, Any]:
         """The run config stored in the experiment.

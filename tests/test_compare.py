@@ -106,6 +106,28 @@ def test_every_method_gets_the_same_seeds_and_run_options():
         jobs_for(CompareConfig(), [*TINY, "--seed=1"], 3)
 
 
+@pytest.mark.slow
+def test_compare_with_more_rounds_extends_dagger_runs_and_adds_bc_budgets(tmp_path):
+    folder = tmp_path / "cmp"
+    args = ["compare", "--methods=[bc,uniform]", "--seeds=[0]", f"--output_dir={folder}", "--jobs=1"]
+    short = [arg for arg in TINY if not arg.startswith("--rounds")]
+    assert main([*args, *short, "--rounds=1"]) == 0
+    policies = folder / "runs" / "uniform-seed0" / "policies"
+
+    def weights_written() -> dict[str, int]:
+        return {p.parent.name: p.stat().st_mtime_ns for p in policies.glob("round-*/model.safetensors")}
+
+    before = weights_written()
+    assert sorted(before) == ["round-000", "round-001"]
+    assert main([*args, *short, "--rounds=2"]) == 0
+    after = weights_written()
+    assert sorted(after) == ["round-000", "round-001", "round-002"]
+    assert {name: after[name] for name in before} == before  # the rounds made are kept as they were
+    rows = json.loads((folder / "results.json").read_text())
+    assert sorted(r["round"] for r in rows if r["method"] == "uniform") == [0, 1, 2]
+    assert sorted(r["demos_per_task_mean"] for r in rows if r["method"] == "bc") == [1.0, 3.0, 5.0]
+
+
 def test_reach_interpolates_along_dagger_and_takes_the_cheapest_bc_run():
     curve = [{"eval_success_mean": s, "x": x} for x, s in [(1, 0.2), (3, 0.6), (5, 0.9)]]
     assert seed_reach(curve, 0.5, lambda c: [r["x"] for r in c]) == pytest.approx(2.5)

@@ -15,6 +15,7 @@ from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.toy import MAX_EPISODE_STEPS, TOY_TASKS
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.records import DAGGER_ROUND, EXECUTED_ACTION, LEARNER_ACTED, RoundRecord, round_features
 from lerobot_mtdagger.rounds import STAGING_DIR, ExperimentDir
@@ -329,6 +330,40 @@ def test_a_run_cut_after_a_phase_resumes_to_the_same_rounds_and_weights(tmp_path
     ]
     for name, tensor in weights[0].items():
         torch.testing.assert_close(tensor, weights[1][name], rtol=0, atol=0)
+
+
+def test_a_dagger_run_resumed_with_more_rounds_equals_one_started_with_them(tmp_path):
+    from lerobot_mtdagger.policies import MTDAggerPolicy
+
+    reference, extended = tmp_path / "reference", tmp_path / "extended"
+    run(toy_config(reference))  # 2 rounds from the start
+    run(toy_config(extended, "--rounds=1"))
+    assert len(run(toy_config(extended, "--rounds=2", "--resume=true"))) == 3
+    assert json.loads((extended / "config.json").read_text())["rounds"] == 2
+    experiments = [ExperimentDir(reference), ExperimentDir(extended)]
+    records = [[{**e.read_round_record(k).to_dict(), "config": None} for k in range(3)] for e in experiments]
+    assert records[0] == records[1]  # the same allocations, from the same measured success and gain
+    phases = [[e.read_phase_record(k) for k in range(3)] for e in experiments]
+    assert [(p.eval, p.gain, p.loss_end) for p in phases[0]] == [
+        (p.eval, p.gain, p.loss_end) for p in phases[1]
+    ]
+    weights = [MTDAggerPolicy.from_pretrained(str(e.policy_root(2))).state_dict() for e in experiments]
+    for name, tensor in weights[0].items():
+        torch.testing.assert_close(tensor, weights[1][name], rtol=0, atol=0)
+    assert verify_experiment(experiments[1]) == (3, 3, [])
+
+
+def test_rounds_may_only_grow_and_only_for_dagger(tmp_path):
+    dagger, bc = tmp_path / "dagger", tmp_path / "bc"
+    run(toy_config(dagger, "--rounds=1"))
+    run(toy_config(bc, "--mode=bc", "--rounds=1"))
+    hint = r"rounds: 1 -> 0\) \(--rounds may only grow, and only for a DAgger run"
+    with pytest.raises(UserError, match=hint):
+        run(toy_config(dagger, "--rounds=0", "--resume=true"))
+    with pytest.raises(UserError, match=r"rounds: 1 -> 2\) \(--rounds may only grow, and only for a DAgger"):
+        run(toy_config(bc, "--mode=bc", "--rounds=2", "--resume=true"))
+    assert json.loads((bc / "config.json").read_text())["rounds"] == 1
+    assert ExperimentDir(bc).committed_rounds() == [0] and ExperimentDir(dagger).committed_phases() == [0, 1]
 
 
 def test_nan_loss_is_an_error_and_committed_rounds_survive(tmp_path, monkeypatch):
