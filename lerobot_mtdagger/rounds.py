@@ -239,17 +239,15 @@ class ExperimentDir:
                 "the stored values, or start a new --output_dir."
             )
 
-    def extend_rounds(self, rounds: int) -> bool:
-        """Raises the stored ``rounds`` of a DAgger run to ``rounds``; returns whether it grew.
+    def extend_rounds(self, rounds: int) -> None:
+        """Raises the stored ``rounds`` of a DAgger run to ``rounds`` (nothing if not larger).
 
         Call it after ``check_resumable`` accepted the config, with the writer lock held.
         """
         config = self.read_config()
-        if rounds <= config["rounds"]:
-            return False
-        logger.info("Extending %s from %d to %d DAgger rounds", self.root, config["rounds"], rounds)
-        write_json_atomic(self.root / CONFIG_FILE, {**config, "rounds": rounds})
-        return True
+        if rounds > config["rounds"]:
+            logger.info("Extending %s from %d to %d DAgger rounds", self.root, config["rounds"], rounds)
+            write_json_atomic(self.root / CONFIG_FILE, {**config, "rounds": rounds})
 
     def read_config(self) -> dict[str, Any]:
         """The run config stored in the experiment.

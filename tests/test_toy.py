@@ -357,10 +357,10 @@ def test_rounds_may_only_grow_and_only_for_dagger(tmp_path):
     dagger, bc = tmp_path / "dagger", tmp_path / "bc"
     run(toy_config(dagger, "--rounds=1"))
     run(toy_config(bc, "--mode=bc", "--rounds=1"))
-    hint = r"rounds: 1 -> 0\) \(--rounds may only grow, and only for a DAgger run"
-    with pytest.raises(UserError, match=hint):
+    hint = r"\(--rounds may only grow, and only for a DAgger run"
+    with pytest.raises(UserError, match=r"rounds: 1 -> 0\) " + hint):
         run(toy_config(dagger, "--rounds=0", "--resume=true"))
-    with pytest.raises(UserError, match=r"rounds: 1 -> 2\) \(--rounds may only grow, and only for a DAgger"):
+    with pytest.raises(UserError, match=r"rounds: 1 -> 2\) " + hint):
         run(toy_config(bc, "--mode=bc", "--rounds=2", "--resume=true"))
     assert json.loads((bc / "config.json").read_text())["rounds"] == 1
     assert ExperimentDir(bc).committed_rounds() == [0] and ExperimentDir(dagger).committed_phases() == [0, 1]
