@@ -61,8 +61,9 @@ MIXING_MODES: tuple[str, ...] = ("episode", "step")
 at every step (classic DAgger)."""
 NORMALISATIONS: tuple[str, ...] = ("fixed", "recompute")
 """``fixed``: statistics of round 0's training frames, kept for every phase; ``recompute``: of D(k)."""
-STEPS_RULES: tuple[str, ...] = ("fixed", "epochs")
-"""``fixed``: ``steps_per_round`` per phase; ``epochs``: ``epochs`` passes over the phase's frames."""
+STEPS_RULES: tuple[str, ...] = ("fixed", "epochs", "plateau")
+"""``fixed``: ``steps_per_round`` per phase; ``epochs``: ``epochs`` passes over the phase's frames;
+``plateau``: until the loss on held-out episodes stops improving."""
 SAMPLINGS: tuple[str, ...] = ("uniform", "balanced")
 """``uniform``: frames uniformly; ``balanced``: a task uniformly, then one of its frames."""
 """``dagger``: Algorithm 1 with the chosen scheduler; ``bc``: the one-round behaviour-cloning baseline."""
@@ -153,16 +154,23 @@ class RunConfig:
             or ``step`` (a coin at every step). Task need is measured on the episodes where only the
             learner acted, so under ``step`` mixing with beta > 0 a round measures nothing.
         warm_start: Continue from the previous round's weights (else retrain from scratch).
-        steps_rule: ``fixed`` (``steps_per_round`` steps per phase) or ``epochs`` (``epochs`` passes
-            over the phase's training frames, at least one step).
+        steps_rule: ``fixed`` (``steps_per_round`` steps per phase), ``epochs`` (``epochs`` passes
+            over the phase's training frames, at least one step) or ``plateau`` (until the loss on
+            held-out episodes stops improving, at most ``plateau_max_steps``; the weights of its
+            minimum are kept). ``plateau`` holds ``heldout_fraction`` of each task's episodes out of
+            training, BC's and DAgger's alike.
         epochs: Passes over the training frames per phase when ``steps_rule=epochs``.
+        plateau_every: Steps between two held-out loss measurements when ``steps_rule=plateau``.
+        plateau_patience: Measurements without a new minimum that end a ``plateau`` phase.
+        plateau_max_steps: Most steps of a ``plateau`` phase.
         normalisation: ``fixed`` (statistics of round 0's training frames for every phase: a warm
             start sees inputs normalised as before) or ``recompute`` (statistics of D(k) each phase).
         sampling: ``uniform`` (frames uniformly) or ``balanced`` (a task uniformly, then one of its
             frames).
         gain_split: ``train`` (per-task loss on the training data) or ``heldout`` (on held-out episodes).
-        heldout_fraction: Fraction of each task's episodes of a round held out when
-            ``gain_split=heldout`` (decided once per round, so an episode never changes side).
+        heldout_fraction: Fraction of each task's episodes held out of training when
+            ``gain_split=heldout`` or ``steps_rule=plateau`` (decided once per episode, so an
+            episode never changes side; a task's first episode is always trained on).
         max_rollout_steps: Steps after which a DAgger rollout is cut (None: the env's own horizon,
             the one evaluation runs to).
         rollout_expert_multiple: Cut a DAgger rollout at this multiple of the steps the expert alone
@@ -202,6 +210,9 @@ class RunConfig:
     warm_start: bool = True
     steps_rule: str = "fixed"
     epochs: float = 100.0
+    plateau_every: int = 200
+    plateau_patience: int = 5
+    plateau_max_steps: int = 20_000
     normalisation: str = "fixed"
     sampling: str = "uniform"
     gain_split: str = "train"
@@ -246,7 +257,16 @@ class RunConfig:
         resolve_workers(self.workers)  # refuses a negative count before anything runs
         if self.seed < 0:
             raise ValueError(f"seed must be >= 0, got {self.seed}.")
-        positive = ("steps_per_round", "budget", "budget_per_task", "max_rollout_steps", "epochs")
+        positive = (
+            "steps_per_round",
+            "budget",
+            "budget_per_task",
+            "max_rollout_steps",
+            "epochs",
+            "plateau_every",
+            "plateau_patience",
+            "plateau_max_steps",
+        )
         for name in (*positive, "rollout_expert_multiple"):
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and value > 0):
@@ -296,10 +316,13 @@ class RunConfig:
         """Optimiser steps of one training phase on ``frames`` training frames.
 
         A DAgger phase takes ``steps_per_round`` steps (``steps_rule=fixed``) or ``epochs`` passes
-        over its frames (``steps_rule=epochs``). BC trains once, on its final data, by the same rule,
+        over its frames (``steps_rule=epochs``), or at most ``plateau_max_steps`` (``steps_rule=plateau``:
+        the held-out loss ends it sooner). BC trains once, on its final data, by the same rule,
         except with fixed steps and a warm start: the final DAgger policy has then taken
         ``(rounds + 1) * steps_per_round`` steps in all, and so does BC.
         """
+        if self.steps_rule == "plateau":
+            return self.plateau_max_steps
         if self.steps_rule == "epochs":
             return max(1, math.ceil(self.epochs * frames / self.policy.batch_size))
         if self.is_bc and self.warm_start:
@@ -309,6 +332,11 @@ class RunConfig:
     def budget_for(self, num_tasks: int) -> int:
         """Expert episodes per DAgger round."""
         return self.budget if self.budget is not None else self.budget_per_task * num_tasks
+
+    @classmethod
+    def option_defaults(cls) -> dict[str, Any]:
+        """The top-level options with a plain default value, by name (e.g. ``plateau_every: 200``)."""
+        return {f.name: f.default for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (stored in every round's record)."""

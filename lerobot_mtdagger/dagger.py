@@ -28,8 +28,8 @@ The scheduler is fed two measurements, both of the learner alone:
   by the scale of their actions).
 
 Normalisation statistics come from round 0's training frames and stay fixed (``normalisation``), so
-a warm-started policy sees its inputs as before; held-out episodes (``gain_split=heldout``) are
-chosen once per round and stay held out.
+a warm-started policy sees its inputs as before; held-out episodes (``gain_split=heldout`` or
+``steps_rule=plateau``) are chosen once per episode and stay held out.
 
 Resuming: committed rounds and phases are immutable; a run restarts at the first uncommitted step.
 Every random choice derives from the seed and the round, and the scheduler's state after each round
@@ -68,16 +68,19 @@ from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
 from lerobot_mtdagger.train import (
     EPISODE_ID_STRIDE,
+    FrameSplit,
     NormalisedData,
+    PlateauStop,
     TrainingData,
     build_processors,
     compute_stats,
+    heldout_mask,
     load_round,
-    loss_split,
     per_task_loss_of,
     performance_gain,
     policy_config,
     save_policy,
+    split_frames,
     train_phase,
 )
 from lerobot_mtdagger.workers import EnvWorkers
@@ -298,8 +301,10 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     image_keys = [k for k in input_keys if k.startswith(IMAGE_KEY)]
     data = rounds_in_memory(ctx, round_index, input_keys)
     phase_seed = int(np.random.SeedSequence([config.seed, 3, round_index]).generate_state(1)[0])
-    train_index, loss_index = loss_split(data, config.gain_split, config.heldout_fraction, config.seed)
-    stats = compute_stats(data.subset(normalisation_frames(config, data, train_index)), image_keys)
+    split = split_frames(
+        data, config.gain_split, config.heldout_fraction, config.seed, hold_out=config.steps_rule == "plateau"
+    )
+    stats = compute_stats(data.subset(normalisation_frames(config, data, split.train)), image_keys)
     torch.manual_seed(phase_seed)
     policy = MTDAggerPolicy(policy_cfg)
     previous = None
@@ -314,8 +319,8 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     normalised = NormalisedData(data, preprocessor, image_keys, ctx.task_names)
     loss_previous = None
     if previous is not None:
-        loss_previous = per_task_loss_of(previous.predict, normalised, loss_index, len(ctx.task_names))
-    steps = config.phase_steps(len(train_index))
+        loss_previous = per_task_loss_of(previous.predict, normalised, split.loss, len(ctx.task_names))
+    steps = config.phase_steps(len(split.train))
     loaded = time.perf_counter()
     with tqdm(
         total=steps, desc=f"round {round_index} train", leave=False, disable=not ctx.show_progress
@@ -323,14 +328,15 @@ def train_round(ctx: RunContext, round_index: int) -> None:
         result = train_phase(
             policy,
             normalised,
-            train_index,
-            loss_index,
+            split.train,
+            split.loss,
             steps=steps,
             batch_size=config.policy.batch_size,
             lr=config.policy.lr,
             seed=phase_seed,
             on_step=lambda done, loss: bar.update(done - bar.n),
             sampling=config.sampling,
+            plateau=plateau_stop(config, split),
         )
     trained = time.perf_counter()
     staging = ctx.experiment.staging_policy_root(round_index)
@@ -344,7 +350,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
         round=round_index,
         trained_on_rounds=list(range(round_index + 1)),
         frames=len(data),
-        steps=steps,
+        steps=result.steps,
         gain_split=config.gain_split,
         loss_start=result.loss_start,
         loss_end=result.loss_end,
@@ -355,8 +361,17 @@ def train_round(ctx: RunContext, round_index: int) -> None:
         eval=None if eval_result is None else eval_result.to_dict(),
         demos_per_task=demos,
         timings=ctx.timings[round_index],
+        best_step=result.best_step,
+        heldout_loss=result.heldout_loss,
     )
     ctx.experiment.commit_phase(round_index, staging, record)
+
+
+def plateau_stop(config: RunConfig, split: FrameSplit) -> PlateauStop | None:
+    """The phase's plateau stop on the held-out frames (``steps_rule=plateau``), or None."""
+    if config.steps_rule != "plateau":
+        return None
+    return PlateauStop(index=split.heldout, every=config.plateau_every, patience=config.plateau_patience)
 
 
 def normalisation_frames(config: RunConfig, data: TrainingData, train_index: torch.Tensor) -> torch.Tensor:
@@ -422,6 +437,24 @@ def check_budget(config: RunConfig, num_tasks: int) -> None:
         )
 
 
+def check_heldout(config: RunConfig, num_tasks: int) -> None:
+    """Refuses ``steps_rule=plateau`` when round 0 would hold no episode out, before anything runs.
+
+    Raises:
+        UserError: With the numbers and the fix.
+    """
+    if config.steps_rule != "plateau":
+        return
+    fraction, demos = config.heldout_fraction, config.initial_demos
+    if not any(heldout_mask(demos, fraction, config.seed, task).any() for task in range(num_tasks)):
+        raise UserError(
+            f"--steps_rule=plateau needs held-out episodes, and round 0 would hold none out: a task's "
+            f"first episode is always trained on, and --heldout_fraction={config.heldout_fraction} of the "
+            f"other {config.initial_demos - 1} per task gives none. Raise --heldout_fraction or "
+            "--initial_demos, or choose --steps_rule=fixed or epochs."
+        )
+
+
 def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> list[str]:
     """Runs (or resumes) one experiment; returns the per-round summary lines.
 
@@ -439,9 +472,10 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
     with quiet_third_party():  # importing MetaWorld's renderer logs an OpenGL INFO line
         suite = suite_from_config(config)
     check_budget(config, len(suite.task_names))
+    check_heldout(config, len(suite.task_names))
     experiment = ExperimentDir(config.output_dir)
     if config.resume:
-        experiment.check_resumable(config.to_dict())
+        experiment.check_resumable(config.to_dict(), added_defaults=RunConfig.option_defaults())
     else:
         experiment.initialise(config.to_dict())
     with experiment.writer_lock():

@@ -185,8 +185,8 @@ class PhaseRecord:
     Attributes:
         round: k: the policy was trained on rounds 0..k.
         trained_on_rounds: ``[0, ..., k]``.
-        frames: Training frames (all of D(k)).
-        steps: Optimiser steps.
+        frames: Frames of D(k) (held-out episodes included).
+        steps: Optimiser steps taken (with ``steps_rule=plateau``, up to where the phase stopped).
         gain_split: Where the per-task loss was measured (``train`` or ``heldout``).
         loss_start: Per-task loss of the initial weights (None where a task had no sample).
         loss_end: Per-task loss after training.
@@ -202,6 +202,10 @@ class PhaseRecord:
             k) on the same frames, in this phase's normalisation (None in phase 0).
         files: sha256 of every file of the policy folder but ``training.json``, by relative path,
             written at commit (None in phases committed before checksums were recorded).
+        best_step: With ``steps_rule=plateau``, the step whose weights were kept (the lowest held-out
+            loss; 0: the phase's initial weights); None otherwise.
+        heldout_loss: With ``steps_rule=plateau``, ``[step, mean held-out loss]`` at every
+            measurement; None otherwise.
     """
 
     round: int
@@ -219,6 +223,8 @@ class PhaseRecord:
     timings: dict[str, float]
     loss_previous: list[float | None] | None = None
     files: dict[str, str] | None = None
+    best_step: int | None = None
+    heldout_loss: list[list[float]] | None = None
 
     @property
     def eval_mean(self) -> float | None:

@@ -204,14 +204,19 @@ class ExperimentDir:
             os.close(descriptor)  # closing releases the lock
 
     def check_resumable(
-        self, config: dict[str, Any], ignore: Sequence[str] = ("resume", "progress", "output_dir", "workers")
+        self,
+        config: dict[str, Any],
+        ignore: Sequence[str] = ("resume", "progress", "output_dir", "workers"),
+        added_defaults: Mapping[str, Any] | None = None,
     ) -> None:
         """Checks that ``root`` holds an experiment started with the same config.
 
         Options in ``ignore`` and ``RESULT_NEUTRAL_POLICY_OPTIONS`` never change a result, so they
         may differ from the stored config. So may a larger ``rounds`` of a DAgger run: no round
         depends on how many follow it, so the run is extended (``extend_rounds``) and its rounds so
-        far are those of a run started with the larger number.
+        far are those of a run started with the larger number. An option the stored config lacks (added
+        to the toolkit after the run started) matches when ``config`` gives it its default in
+        ``added_defaults``: a new option's default keeps the behaviour the run was made with.
 
         Raises:
             NotAnExperimentError: If there is no experiment to resume.
@@ -223,6 +228,9 @@ class ExperimentDir:
             )
         stored = result_options(self.read_config(), ignore)
         given = result_options(config, ignore)
+        for key, default in (added_defaults or {}).items():
+            if key in given and key not in stored and given[key] == default:
+                stored[key] = default
         if adds_dagger_rounds(stored, given):
             stored["rounds"] = given["rounds"]
         differing = sorted(key for key in set(stored) | set(given) if stored.get(key) != given.get(key))

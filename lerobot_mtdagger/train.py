@@ -19,6 +19,7 @@ from __future__ import annotations
 import io
 import json
 import logging
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,6 +48,9 @@ FINAL_LOSSES = 10
 
 EPISODE_ID_STRIDE = 1_000_000
 """``episode_id = episode_index + round_position * EPISODE_ID_STRIDE``."""
+
+HELDOUT_STREAM = 7
+"""Seed stream of the held-out episode choice (``heldout_episodes``)."""
 
 
 @dataclass
@@ -276,54 +280,100 @@ class NormalisedData:
 
 @dataclass
 class PhaseResult:
-    """Per-task losses of one training phase (lists aligned with the task names; None: no sample)."""
+    """Per-task losses of one training phase (lists aligned with the task names; None: no sample).
+
+    Attributes:
+        loss_start: Per-task loss before training.
+        loss_end: Per-task loss of the returned weights.
+        gain: ``max(0, loss_start - loss_end)`` per task.
+        train_loss: The last FINAL_LOSSES step losses.
+        loss_samples: Frames per task behind the losses.
+        steps: Optimiser steps taken (fewer than asked where a plateau stopped the phase).
+        best_step: With a plateau stop, the step whose weights are returned (0: the initial ones).
+        heldout_loss: With a plateau stop, ``[step, mean held-out loss]`` at every measurement.
+    """
 
     loss_start: list[float | None]
     loss_end: list[float | None]
     gain: list[float]
     train_loss: list[float]
     loss_samples: list[int]
+    steps: int = 0
+    best_step: int | None = None
+    heldout_loss: list[list[float]] | None = None
 
 
-def loss_split(
-    data: TrainingData, split: str, heldout_fraction: float, seed: int
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """Indices of the training frames and of the frames the per-task loss is measured on.
+@dataclass(frozen=True)
+class FrameSplit:
+    """Which frames a phase trains on, measures the per-task loss on, and holds out.
 
-    ``train``: train on everything, measure on up to LOSS_SAMPLES_PER_TASK frames per task.
-    ``heldout``: hold out ``heldout_fraction`` of each task's episodes OF EACH ROUND (at least one
-    where the round has two or more) and measure on them. The choice depends only on ``seed``, the
-    round and its episodes, so an episode held out in one phase is held out in every later phase
-    (pass the experiment's seed, not a per-phase one): a warm-started policy never trained on it.
+    Attributes:
+        train: Frames to train on.
+        loss: Frames the per-task loss (performance gain) is measured on.
+        heldout: Frames of the held-out episodes (empty when nothing is held out).
+    """
+
+    train: torch.Tensor
+    loss: torch.Tensor
+    heldout: torch.Tensor
+
+
+def split_frames(
+    data: TrainingData, gain_split: str, heldout_fraction: float, seed: int, hold_out: bool = False
+) -> FrameSplit:
+    """Splits the frames of D(k) into training, loss-measurement and held-out frames.
+
+    Episodes are held out (``heldout_episodes``) when ``gain_split == "heldout"`` or ``hold_out`` (a
+    plateau stop needs them); they are never trained on. The per-task loss is measured on them with
+    ``gain_split == "heldout"``, else on up to LOSS_SAMPLES_PER_TASK training frames per task. The
+    choice depends only on ``seed`` and the episodes, so an episode held out in one phase is held out
+    in every later phase (pass the experiment's seed, not a per-phase one): a warm-started policy never
+    trained on it.
     """
     all_index = torch.arange(len(data))
-    if split == "heldout":
+    held = torch.zeros(len(data), dtype=torch.bool)
+    if gain_split == "heldout" or hold_out:
         held_ids = heldout_episodes(data, heldout_fraction, seed)
         held = torch.from_numpy(np.isin(data.episode_id.numpy(), held_ids))
-        return all_index[~held], all_index[held]
+    train_index, heldout_index = all_index[~held], all_index[held]
+    if gain_split == "heldout":
+        return FrameSplit(train=train_index, loss=heldout_index, heldout=heldout_index)
     generator = np.random.default_rng(seed)
     measure = []
-    for task in torch.unique(data.task_index).tolist():
-        task_index = all_index[data.task_index == task].numpy()
-        size = min(LOSS_SAMPLES_PER_TASK, len(task_index))
-        measure.append(np.sort(generator.choice(task_index, size=size, replace=False)))
-    return all_index, torch.from_numpy(np.concatenate(measure))
+    for task in torch.unique(data.task_index[train_index]).tolist():
+        task_frames = train_index[data.task_index[train_index] == task].numpy()
+        size = min(LOSS_SAMPLES_PER_TASK, len(task_frames))
+        measure.append(np.sort(generator.choice(task_frames, size=size, replace=False)))
+    loss_index = torch.from_numpy(np.concatenate(measure))
+    return FrameSplit(train=train_index, loss=loss_index, heldout=heldout_index)
 
 
 def heldout_episodes(data: TrainingData, heldout_fraction: float, seed: int) -> list[int]:
-    """Episode ids held out, chosen per (round, task) from that round's episodes of the task alone."""
+    """Episode ids held out: systematic sampling over each task's episodes in round order.
+
+    A task's episodes are taken in id order (round, then episode). Its first one is always trained on
+    (a task never loses all its frames); of the others, the one at position ``j`` (0-based) is held
+    out when ``floor(f * (j + 1) + u)`` steps up at ``j``, with one uniform offset ``u`` per
+    (seed, task). So a task's first ``n`` episodes hold ``floor(f (n - 1))`` or ``ceil(f (n - 1))``
+    held-out ones however they are split into rounds (BC's one round and DAgger's many hold out the
+    same share), and a new round never moves an earlier episode to the other side.
+    """
     episode_ids = data.episode_id.numpy()
     task_index = data.task_index.numpy()
     chosen: list[int] = []
-    for round_position in np.unique(episode_ids // EPISODE_ID_STRIDE).tolist():
-        in_round = episode_ids // EPISODE_ID_STRIDE == round_position
-        for task in np.unique(task_index[in_round]).tolist():
-            episodes = np.unique(episode_ids[in_round & (task_index == task)])
-            count = int(round(heldout_fraction * len(episodes)))
-            count = min(max(count, 1 if len(episodes) > 1 else 0), len(episodes) - 1)
-            generator = np.random.default_rng(np.random.SeedSequence([seed, round_position, task]))
-            chosen += generator.choice(episodes, size=count, replace=False).tolist()
+    for task in np.unique(task_index).tolist():
+        episodes = np.unique(episode_ids[task_index == task])  # sorted: round order, then episode
+        chosen += episodes[heldout_mask(len(episodes), heldout_fraction, seed, task)].tolist()
     return chosen
+
+
+def heldout_mask(count: int, heldout_fraction: float, seed: int, task: int) -> np.ndarray:
+    """Which of a task's first ``count`` episodes (in round order) are held out (``heldout_episodes``)."""
+    offset = float(np.random.default_rng(np.random.SeedSequence([seed, HELDOUT_STREAM, task])).random())
+    later = max(count - 1, 0)  # the episodes after the first
+    level = np.floor(heldout_fraction * np.arange(later + 1) + offset)
+    steps_up = level[1:] > level[:-1]
+    return np.concatenate([np.zeros(min(count, 1), dtype=bool), steps_up])
 
 
 @torch.no_grad()
@@ -396,6 +446,81 @@ def make_optimizer(policy: MTDAggerPolicy, lr: float) -> torch.optim.AdamW:
     )
 
 
+@dataclass(frozen=True)
+class PlateauStop:
+    """Ends a phase when the loss on held-out frames stops improving (``steps_rule=plateau``).
+
+    The mean over tasks of the per-task loss on ``index`` is measured before the first step and every
+    ``every`` steps; the phase ends after ``patience`` measurements in a row without a new minimum (or
+    at the step cap) and returns the weights of the minimum.
+
+    Attributes:
+        index: The held-out frames (never trained on).
+        every: Steps between two measurements.
+        patience: Measurements without a new minimum before the phase ends.
+    """
+
+    index: torch.Tensor
+    every: int
+    patience: int
+
+
+class _PlateauTracker:
+    """The held-out loss curve of a phase and the weights of its minimum."""
+
+    def __init__(self, stop: PlateauStop, policy: MTDAggerPolicy, data: NormalisedData):
+        self.stop = stop
+        self.policy = policy
+        self.data = data
+        self.curve: list[list[float]] = []
+        self.best_loss = math.inf
+        self.best_step = 0
+        self.best_state: dict[str, torch.Tensor] = {}
+        self.since_best = 0
+
+    def measure(self, step: int) -> bool:
+        """Measures the held-out loss after ``step`` steps; True when the phase should end."""
+        losses, _ = per_task_loss(self.policy, self.data, self.stop.index, len(self.data.task_names))
+        self.policy.train()
+        measured = [loss for loss in losses if loss is not None]
+        mean = float(np.mean(measured))
+        self.curve.append([step, mean])
+        if mean < self.best_loss:
+            self.best_loss, self.best_step, self.since_best = mean, step, 0
+            self.best_state = {k: v.detach().clone() for k, v in self.policy.state_dict().items()}
+            return False
+        self.since_best += 1
+        return self.since_best >= self.stop.patience
+
+    def restore_best(self) -> None:
+        """Loads the weights of the lowest held-out loss into the policy."""
+        self.policy.load_state_dict(self.best_state)
+
+
+class _LossWindow:
+    """Step losses kept on the device and read back once per log interval."""
+
+    def __init__(self, on_step: Callable[[int, float], None] | None):
+        self.on_step = on_step
+        self.window: list[torch.Tensor] = []
+        self.tail = torch.empty(0)  # the last FINAL_LOSSES step losses, on the CPU
+
+    def add(self, loss: torch.Tensor) -> None:
+        """Keeps one step's loss (no sync)."""
+        self.window.append(loss.detach())
+
+    def flush(self, steps_done: int) -> None:
+        """Reads the pending losses back, checks them and reports progress."""
+        if not self.window:
+            return
+        losses = torch.stack(self.window).float().cpu()  # the one sync of the interval
+        _check_finite(losses, steps_done - len(self.window))
+        self.window = []
+        self.tail = torch.cat([self.tail, losses])[-FINAL_LOSSES:]
+        if self.on_step is not None:
+            self.on_step(steps_done, float(losses.double().mean()))
+
+
 def train_phase(
     policy: MTDAggerPolicy,
     data: NormalisedData,
@@ -409,8 +534,9 @@ def train_phase(
     on_step: Callable[[int, float], None] | None = None,
     log_interval: int = LOG_INTERVAL,
     sampling: str = "uniform",
+    plateau: PlateauStop | None = None,
 ) -> PhaseResult:
-    """Trains ``policy`` for ``steps`` AdamW steps and measures the per-task loss drop.
+    """Trains ``policy`` for ``steps`` AdamW steps (or until a plateau) and measures the per-task loss drop.
 
     Each step samples ``batch_size`` frames of ``train_index`` with replacement (uniformly, or with
     ``sampling="balanced"`` a task uniformly and then one of its frames uniformly) and takes
@@ -426,7 +552,7 @@ def train_phase(
         data: The normalised frames.
         train_index: Frames to train on.
         loss_index: Frames the per-task loss is measured on, before and after.
-        steps: Optimiser steps.
+        steps: Optimiser steps (the cap, with ``plateau``).
         batch_size: Frames per step (capped at ``len(train_index)``).
         lr: AdamW learning rate.
         seed: Seed of the batch sampling.
@@ -435,22 +561,19 @@ def train_phase(
             mean training loss over the steps since the previous call.
         log_interval: Steps between two reads of the loss.
         sampling: ``uniform`` over frames or ``balanced`` over tasks.
+        plateau: End the phase when the held-out loss stops improving and keep the weights of its
+            minimum (None: train all ``steps``).
 
     Returns:
-        The per-task losses at the start and at the end, the gain and the last FINAL_LOSSES step
-        losses.
+        The per-task losses at the start and at the end, the gain, the last FINAL_LOSSES step
+        losses and the steps taken (with ``plateau``, the held-out curve and the step kept).
 
     Raises:
-        ValueError: If the policy's task vocabulary differs from the data's, log_interval < 1 or
-            ``sampling`` is unknown.
+        ValueError: If the policy's task vocabulary differs from the data's, log_interval < 1,
+            ``sampling`` is unknown or ``plateau`` has no held-out frame.
         FloatingPointError: If the loss becomes NaN or infinite (nothing is committed then).
     """
-    if list(policy.config.task_names) != data.task_names:
-        raise UserError(
-            f"The policy's tasks {policy.config.task_names} differ from the data's {data.task_names}."
-        )
-    if log_interval < 1:
-        raise ValueError(f"log_interval must be >= 1, got {log_interval}.")
+    _check_phase_inputs(policy, data, log_interval, plateau)
     num_tasks = len(data.task_names)
     loss_start, _ = per_task_loss(policy, data, loss_index, num_tasks)
     generator = torch.Generator().manual_seed(seed)
@@ -459,44 +582,66 @@ def train_phase(
     parameters = [p for p in policy.parameters() if p.requires_grad]
     clip_norm = policy.config.optimizer_grad_clip_norm
     size = min(batch_size, len(train_index))
+    tracker = None if plateau is None else _PlateauTracker(plateau, policy, data)
+    stopped = tracker is not None and tracker.measure(0)
     policy.train()
-    window: list[torch.Tensor] = []
-    tail = torch.empty(0)  # the last FINAL_LOSSES step losses, on the CPU
+    losses = _LossWindow(on_step)
     picks = torch.empty(0, dtype=torch.long)
-    for step in range(steps):
-        offset = step % log_interval
+    done = 0
+    while done < steps and not stopped:
+        offset = done % log_interval
         if offset == 0:
             # One interval's batch indices at once, drawn on the CPU (device independent).
-            block = min(log_interval, steps - step)
-            picks = draw((block, size)).to(data.device)
+            picks = draw((min(log_interval, steps - done), size)).to(data.device)
         batch = data.batch(picks[offset])
         if offset == 0:
             loss, info = policy.forward(batch)
-            _check_finite(loss.detach().reshape(1), step)
+            _check_finite(loss.detach().reshape(1), done)
             info = info or {}
-            logger.debug("step %d: loss %s, per task %s", step, info.get("loss"), info.get("per_task_loss"))
+            logger.debug("step %d: loss %s, per task %s", done, info.get("loss"), info.get("per_task_loss"))
         else:
             loss = policy.imitation_loss(batch, task_index=batch["task_index"])
         optimizer.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(parameters, clip_norm, foreach=True)
         optimizer.step()
-        window.append(loss.detach())
-        if offset == log_interval - 1 or step == steps - 1:
-            losses = torch.stack(window).float().cpu()  # the one sync of the interval
-            _check_finite(losses, step + 1 - len(window))
-            window = []
-            tail = torch.cat([tail, losses])[-FINAL_LOSSES:]
-            if on_step is not None:
-                on_step(step + 1, float(losses.double().mean()))
+        losses.add(loss)
+        done += 1
+        if offset == log_interval - 1 or done == steps:
+            losses.flush(done)
+        if tracker is not None and (done % tracker.stop.every == 0 or done == steps):
+            losses.flush(done)
+            stopped = tracker.measure(done)
+    if tracker is not None:
+        tracker.restore_best()
     loss_end, counts = per_task_loss(policy, data, loss_index, num_tasks)
     return PhaseResult(
         loss_start=loss_start,
         loss_end=loss_end,
         gain=performance_gain(loss_start, loss_end),
-        train_loss=tail.tolist(),
+        train_loss=losses.tail.tolist(),
         loss_samples=counts,
+        steps=done,
+        best_step=None if tracker is None else tracker.best_step,
+        heldout_loss=None if tracker is None else tracker.curve,
     )
+
+
+def _check_phase_inputs(
+    policy: MTDAggerPolicy, data: NormalisedData, log_interval: int, plateau: PlateauStop | None
+) -> None:
+    """Refuses a policy of other tasks, a log interval < 1 and a plateau stop without held-out frames."""
+    if list(policy.config.task_names) != data.task_names:
+        raise UserError(
+            f"The policy's tasks {policy.config.task_names} differ from the data's {data.task_names}."
+        )
+    if log_interval < 1:
+        raise ValueError(f"log_interval must be >= 1, got {log_interval}.")
+    if plateau is not None and (len(plateau.index) == 0 or plateau.every < 1 or plateau.patience < 1):
+        raise ValueError(
+            f"A plateau stop needs held-out frames, every >= 1 and patience >= 1; got "
+            f"{len(plateau.index)} frames, every={plateau.every}, patience={plateau.patience}."
+        )
 
 
 def batch_sampler(

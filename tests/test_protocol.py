@@ -25,6 +25,7 @@ from lerobot_mtdagger.collect import COLLECT_STREAM, learner_success_by_task, ru
 from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.evaluate import PolicyRunner
 from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.train import (
@@ -34,10 +35,11 @@ from lerobot_mtdagger.train import (
     batch_sampler,
     build_processors,
     compute_stats,
-    loss_split,
+    heldout_episodes,
     per_task_loss,
     per_task_loss_of,
     performance_gain,
+    split_frames,
 )
 from lerobot_mtdagger.workers import BETA_STREAM, EnvWorkers, expert_episode_coin
 from tests.test_toy import TOY_RUN
@@ -182,15 +184,51 @@ def test_heldout_episodes_stay_held_out_when_rounds_are_added():
             episode_id=episode + position * EPISODE_ID_STRIDE,
         )
 
-    round0, round1 = round_data(0, 3), round_data(1, 4)
-    _, held0 = loss_split(round0, "heldout", 0.2, seed=5)
+    round0, round1 = round_data(0, 6), round_data(1, 4)
+    held0 = split_frames(round0, "heldout", 0.2, seed=5).heldout
     both = TrainingData.concat([round0, round1])
-    train_both, held_both = loss_split(both, "heldout", 0.2, seed=5)
+    split_both = split_frames(both, "heldout", 0.2, seed=5)
     before = set(round0.episode_id[held0].tolist())
-    after = set(both.episode_id[held_both].tolist())
+    after = set(both.episode_id[split_both.heldout].tolist())
     assert before and before == {e for e in after if e < EPISODE_ID_STRIDE}
-    assert not before & set(both.episode_id[train_both].tolist())
+    assert not before & set(both.episode_id[split_both.train].tolist())
     assert {e for e in after if e >= EPISODE_ID_STRIDE}, "the new round holds out episodes too"
+
+
+def rounds_of(episodes_per_task: list[int]) -> TrainingData:
+    """Rounds of 3 tasks, ``episodes_per_task[k]`` episodes each in round k (task = episode % 3)."""
+    parts = []
+    for position, count in enumerate(episodes_per_task):
+        episode = torch.arange(3 * count).repeat_interleave(4)
+        parts.append(
+            TrainingData(
+                inputs={"observation.state": torch.zeros(len(episode), 2)},
+                action=torch.zeros(len(episode), 2),
+                task_index=episode % 3,
+                episode_id=episode + position * EPISODE_ID_STRIDE,
+            )
+        )
+    return TrainingData.concat(parts)
+
+
+def held_per_task(data: TrainingData, fraction: float, seed: int) -> list[int]:
+    held = torch.from_numpy(np.isin(data.episode_id.numpy(), heldout_episodes(data, fraction, seed)))
+    return [len(torch.unique(data.episode_id[held & (data.task_index == t)])) for t in range(3)]
+
+
+@pytest.mark.parametrize("fraction", [0.2, 0.5])
+def test_bc_and_dagger_hold_out_the_same_share_of_each_tasks_episodes(fraction):
+    """12 episodes per task in one round (BC) or in four rounds of 3 (DAgger): the same share."""
+    for seed in range(5):
+        bc = held_per_task(rounds_of([12]), fraction, seed)
+        dagger = held_per_task(rounds_of([3, 3, 3, 3]), fraction, seed)
+        assert bc == dagger
+        assert all(np.floor(fraction * 11) <= n <= np.ceil(fraction * 11) for n in bc), bc
+
+
+def test_a_tasks_first_episode_is_never_held_out():
+    assert held_per_task(rounds_of([1]), 0.9, seed=0) == [0, 0, 0]
+    assert all(n <= 1 for n in held_per_task(rounds_of([2]), 0.9, seed=0))
 
 
 def test_the_previous_policy_is_measured_in_the_current_normalisation():
@@ -233,8 +271,38 @@ def test_bc_and_dagger_phases_train_by_one_rule():
     assert phase_steps("--mode=bc") == 4 * 1500, "warm start: BC gets the final DAgger policy's steps in all"
     epochs = ["--steps_rule=epochs", "--epochs=10"]
     assert phase_steps("--mode=bc", *epochs) == phase_steps(*epochs) == int(np.ceil(10 * 12_000 / 256))
+    plateau = ["--steps_rule=plateau", "--plateau_max_steps=9000"]
+    assert phase_steps("--mode=bc", *plateau) == phase_steps(*plateau) == 9000, "the cap"
     with pytest.raises(ValueError, match="steps_rule"):
         RunConfig(steps_rule="until-bored")
+    with pytest.raises(ValueError, match="plateau_patience must be > 0"):
+        RunConfig(steps_rule="plateau", plateau_patience=0)
+
+
+def test_a_plateau_run_stops_each_phase_on_held_out_episodes_and_records_where(tmp_path):
+    root = tmp_path / "plateau"
+    plateau = ["--steps_rule=plateau", "--plateau_every=5", "--plateau_patience=2", "--plateau_max_steps=60"]
+    config = draccus.parse(
+        RunConfig,
+        args=[*TOY_RUN, "--rounds=1", "--initial_demos=4", "--heldout_fraction=0.5", *plateau]
+        + [f"--output_dir={root}"],
+    )
+    run(config)
+    experiment = ExperimentDir(root)
+    for phase in experiment.committed_phases():
+        record = json.loads((experiment.policy_root(phase) / "training.json").read_text())
+        steps = [step for step, _ in record["heldout_loss"]]
+        assert steps[0] == 0 and steps[-1] == record["steps"] <= 60
+        assert record["best_step"] in steps
+        assert record["steps"] == 60 or len(steps) == steps.index(record["best_step"]) + 1 + 2
+
+
+def test_a_plateau_run_without_held_out_episodes_is_refused_before_anything_runs(tmp_path):
+    root = tmp_path / "plateau"
+    config = draccus.parse(RunConfig, args=[*TOY_RUN, "--steps_rule=plateau", f"--output_dir={root}"])
+    with pytest.raises(UserError, match="would hold none out.*Raise --heldout_fraction or --initial_demos"):
+        run(config)
+    assert not root.exists()
 
 
 def normaliser_stats(policy_root: Path) -> bytes:

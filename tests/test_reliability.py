@@ -230,6 +230,17 @@ def test_options_that_do_not_change_results_may_differ_on_resume(finished):
         experiment.check_resumable(changed)
 
 
+def test_a_run_made_before_an_option_existed_resumes_with_its_default(finished, tmp_path):
+    copy = tmp_path / "older"
+    shutil.copytree(finished, copy)
+    stored = json.loads((copy / "config.json").read_text())
+    older = {k: v for k, v in stored.items() if not k.startswith("plateau_")}  # options added later
+    (copy / "config.json").write_text(json.dumps(older))
+    assert run(toy_config(copy, "--rounds=1", "--resume=true")), "resumed: nothing to do"
+    with pytest.raises(UserError, match=r"different config \(plateau_every: None -> 7\)"):
+        run(toy_config(copy, "--rounds=1", "--resume=true", "--plateau_every=7"))
+
+
 def test_resume_refuses_a_round_changed_after_commit_before_running(finished, tmp_path):
     copy = damaged_copy(finished, tmp_path, lambda root: truncate(round_parquet(root)))
     before = sorted(p.relative_to(copy) for p in copy.rglob("*") if p.name != LOCK_FILE)

@@ -20,7 +20,7 @@ from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.records import DAGGER_ROUND, EXECUTED_ACTION, LEARNER_ACTED, RoundRecord, round_features
 from lerobot_mtdagger.rounds import STAGING_DIR, ExperimentDir
 from lerobot_mtdagger.scheduler import scheduling_methods
-from lerobot_mtdagger.train import LOSS_SAMPLES_PER_TASK, TrainingData, loss_split
+from lerobot_mtdagger.train import LOSS_SAMPLES_PER_TASK, TrainingData, split_frames
 from lerobot_mtdagger.verify import verify_experiment
 from lerobot_mtdagger.workers import EnvWorkers
 
@@ -180,21 +180,30 @@ def training_data(episodes_per_task: int = 5, frames_per_episode: int = 400) -> 
 
 def test_train_split_trains_on_everything_and_measures_a_capped_sample_per_task():
     data = training_data()
-    train_index, measure = loss_split(data, "train", 0.2, seed=0)
-    assert len(train_index) == len(data)
-    counts = torch.bincount(data.task_index[measure], minlength=3).tolist()
+    split = split_frames(data, "train", 0.2, seed=0)
+    assert len(split.train) == len(data) and len(split.heldout) == 0
+    counts = torch.bincount(data.task_index[split.loss], minlength=3).tolist()
     assert counts == [LOSS_SAMPLES_PER_TASK] * 3
-    assert torch.equal(measure, loss_split(data, "train", 0.2, seed=0)[1])
+    assert torch.equal(split.loss, split_frames(data, "train", 0.2, seed=0).loss)
 
 
 def test_heldout_split_holds_out_whole_episodes_of_every_task():
-    data = training_data()
-    train_index, heldout = loss_split(data, "heldout", 0.2, seed=0)
-    assert len(train_index) + len(heldout) == len(data)
-    held_episodes = set(data.episode_id[heldout].tolist())
-    assert not held_episodes & set(data.episode_id[train_index].tolist())
-    assert sorted(data.task_index[heldout].unique().tolist()) == [0, 1, 2]
-    assert len(held_episodes) == 3, "20% of 5 episodes = 1 per task"
+    data = training_data(episodes_per_task=6)
+    split = split_frames(data, "heldout", 0.2, seed=0)
+    assert torch.equal(split.loss, split.heldout)
+    assert len(split.train) + len(split.heldout) == len(data)
+    held_episodes = set(data.episode_id[split.heldout].tolist())
+    assert not held_episodes & set(data.episode_id[split.train].tolist())
+    assert sorted(data.task_index[split.heldout].unique().tolist()) == [0, 1, 2]
+    assert len(held_episodes) == 3, "20% of the 5 episodes after each task's first = 1 per task"
+
+
+def test_a_plateau_holds_episodes_out_of_training_and_measures_the_gain_on_training_frames():
+    data = training_data(episodes_per_task=6)
+    split = split_frames(data, "train", 0.2, seed=0, hold_out=True)
+    assert len(split.heldout) == 3 * 400 and len(split.train) == len(data) - 3 * 400
+    assert not set(split.loss.tolist()) & set(split.heldout.tolist())
+    assert torch.equal(split.heldout, split_frames(data, "heldout", 0.2, seed=0).heldout)
 
 
 # ---------------------------------------------------------------------------------------------

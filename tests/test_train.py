@@ -15,11 +15,13 @@ from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
 from lerobot_mtdagger.train import (
     EPISODE_ID_STRIDE,
     NormalisedData,
+    PlateauStop,
     TrainingData,
     build_processors,
     compute_stats,
     load_round,
     load_rounds,
+    per_task_loss,
     train_phase,
 )
 from tests.conftest import record_expert_dataset
@@ -286,6 +288,74 @@ def test_a_non_finite_loss_raises_naming_the_step(monkeypatch, bad_step, value):
     monkeypatch.setattr(MTDAggerPolicy, "_imitation_terms", poisoned)
     with pytest.raises(FloatingPointError, match=f"Training loss became {value} at step {bad_step};"):
         train(steps=30, log_interval=10)
+
+
+HELD_OUT = torch.arange(450, 600)  # the last three episodes (one per task)
+
+
+def plateau_train(held_out_sign: float, steps: int, log_interval: int = 100, every: int = 20):
+    """Trains on frames 0-449 with a plateau stop on the held-out frames 450-599.
+
+    ``held_out_sign=-1`` flips the held-out labels: the better the policy fits the training frames,
+    the worse it does on them, so the held-out loss soon stops improving.
+    """
+    data = synthetic_data()
+    data.action[HELD_OUT] *= held_out_sign
+    policy = small_policy()
+    prepared = normalised(data, policy)
+    result = train_phase(
+        policy,
+        prepared,
+        torch.arange(450),
+        torch.arange(0, 450, 3),
+        steps=steps,
+        batch_size=64,
+        lr=1e-3,
+        seed=0,
+        log_interval=log_interval,
+        plateau=PlateauStop(index=HELD_OUT, every=every, patience=3),
+    )
+    return policy, prepared, result
+
+
+def mean_loss(policy, data, index) -> float:
+    return float(np.mean(per_task_loss(policy, data, index, len(TASKS))[0]))
+
+
+def test_a_plateau_stop_ends_the_phase_and_keeps_the_weights_of_the_lowest_held_out_loss():
+    policy, data, result = plateau_train(held_out_sign=-1.0, steps=2000)
+    steps, losses = zip(*result.heldout_loss, strict=True)
+    assert steps[0] == 0 and all(b - a == 20 for a, b in zip(steps[:-1], steps[1:], strict=True))
+    best = int(np.argmin(losses))
+    assert result.best_step == steps[best] and len(steps) == best + 1 + 3, "stops 3 measurements later"
+    assert result.steps == steps[-1] < 2000
+    assert mean_loss(policy, data, HELD_OUT) == pytest.approx(losses[best], rel=1e-6)
+    assert mean_loss(policy, data, HELD_OUT) < losses[-1], "the last weights were not kept"
+    _, _, same = plateau_train(held_out_sign=-1.0, steps=2000, log_interval=7)
+    assert same == result, "the stop does not depend on the log interval"
+
+
+def test_a_plateau_stop_trains_to_the_cap_while_the_held_out_loss_falls():
+    _, _, result = plateau_train(held_out_sign=1.0, steps=100)
+    assert result.steps == 100 and result.best_step == 100
+    assert [step for step, _ in result.heldout_loss] == [0, 20, 40, 60, 80, 100]
+
+
+def test_a_plateau_stop_without_held_out_frames_is_refused():
+    data = synthetic_data()
+    policy = small_policy()
+    with pytest.raises(ValueError, match="plateau stop needs held-out frames"):
+        train_phase(
+            policy,
+            normalised(data, policy),
+            torch.arange(10),
+            torch.arange(10),
+            steps=5,
+            batch_size=4,
+            lr=1e-3,
+            seed=0,
+            plateau=PlateauStop(index=torch.empty(0, dtype=torch.long), every=2, patience=1),
+        )
 
 
 def test_a_policy_with_another_task_vocabulary_is_refused():
