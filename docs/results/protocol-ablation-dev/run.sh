@@ -23,3 +23,11 @@ variant retrain-epochs '[bc,uniform,need]' --warm_start=false --steps_rule=epoch
 variant sampling-balanced '[bc,uniform,need]' --sampling=balanced
 # Added 2026-11-22: rollouts cut at twice the expert's length on the same seed.
 variant rollout-expert-2x '[uniform,need]' --rollout_expert_multiple=2
+# Added 2026-11-22 (last session of the day): the beta schedule, the one protocol option of the
+# issue not yet ablated. The learner acts in every DAgger rollout (beta 0), and a slower decay
+# (0.5, 0.25, 0 over the 3 rounds instead of 0.5, 0, 0).
+variant beta-0 '[uniform,need]' --beta=0
+variant beta-decay-0.25 '[uniform,need]' --beta_decay=0.25
+# Added 2026-11-22 (same session): train each phase, BC's too, until the loss on held-out episodes
+# stops improving (the issue's third training rule; code of commit 7c77eaf, which adds it).
+variant plateau '[bc,uniform,need]' --steps_rule=plateau
