@@ -35,6 +35,7 @@ from lerobot.datasets.utils import dataset_to_policy_features
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
+from lerobot_mtdagger.sampling import systematic_picks
 
 logger = logging.getLogger(__name__)
 
@@ -370,10 +371,8 @@ def heldout_episodes(data: TrainingData, heldout_fraction: float, seed: int) -> 
 def heldout_mask(count: int, heldout_fraction: float, seed: int, task: int) -> np.ndarray:
     """Which of a task's first ``count`` episodes (in round order) are held out (``heldout_episodes``)."""
     offset = float(np.random.default_rng(np.random.SeedSequence([seed, HELDOUT_STREAM, task])).random())
-    later = max(count - 1, 0)  # the episodes after the first
-    level = np.floor(heldout_fraction * np.arange(later + 1) + offset)
-    steps_up = level[1:] > level[:-1]
-    return np.concatenate([np.zeros(min(count, 1), dtype=bool), steps_up])
+    later = systematic_picks(heldout_fraction, max(count - 1, 0), offset)  # the episodes after the first
+    return np.concatenate([np.zeros(min(count, 1), dtype=bool), later])
 
 
 @torch.no_grad()

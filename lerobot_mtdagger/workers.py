@@ -39,6 +39,7 @@ import numpy as np
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.records import dagger_columns
+from lerobot_mtdagger.sampling import systematic_picks
 
 logger = logging.getLogger(__name__)
 
@@ -172,7 +173,7 @@ def expert_episode_coin(beta_seed: tuple[int, ...], beta: float) -> bool:
     """
     *task_entropy, episode = beta_seed
     offset = float(np.random.default_rng(np.random.SeedSequence(list(task_entropy))).random())
-    return math.floor(beta * (episode + 1) + offset) > math.floor(beta * episode + offset)
+    return bool(systematic_picks(beta, episode + 1, offset)[episode])
 
 
 @dataclass

@@ -228,7 +228,10 @@ def test_bc_and_dagger_hold_out_the_same_share_of_each_tasks_episodes(fraction):
 
 def test_a_tasks_first_episode_is_never_held_out():
     assert held_per_task(rounds_of([1]), 0.9, seed=0) == [0, 0, 0]
-    assert all(n <= 1 for n in held_per_task(rounds_of([2]), 0.9, seed=0))
+    for seed in range(5):
+        held = set(heldout_episodes(rounds_of([2]), 0.9, seed))
+        assert not held & {0, 1, 2}, "episodes 0-2 are each task's first"
+        assert held, "at 0.9 the second episodes are held out"
 
 
 def test_the_previous_policy_is_measured_in_the_current_normalisation():

@@ -293,7 +293,7 @@ def test_a_non_finite_loss_raises_naming_the_step(monkeypatch, bad_step, value):
 HELD_OUT = torch.arange(450, 600)  # the last three episodes (one per task)
 
 
-def plateau_train(held_out_sign: float, steps: int, log_interval: int = 100, every: int = 20):
+def plateau_train(held_out_sign: float, steps: int, log_interval: int = 100, held_out=HELD_OUT):
     """Trains on frames 0-449 with a plateau stop on the held-out frames 450-599.
 
     ``held_out_sign=-1`` flips the held-out labels: the better the policy fits the training frames,
@@ -313,7 +313,7 @@ def plateau_train(held_out_sign: float, steps: int, log_interval: int = 100, eve
         lr=1e-3,
         seed=0,
         log_interval=log_interval,
-        plateau=PlateauStop(index=HELD_OUT, every=every, patience=3),
+        plateau=PlateauStop(index=held_out, every=20, patience=3),
     )
     return policy, prepared, result
 
@@ -342,20 +342,8 @@ def test_a_plateau_stop_trains_to_the_cap_while_the_held_out_loss_falls():
 
 
 def test_a_plateau_stop_without_held_out_frames_is_refused():
-    data = synthetic_data()
-    policy = small_policy()
     with pytest.raises(ValueError, match="plateau stop needs held-out frames"):
-        train_phase(
-            policy,
-            normalised(data, policy),
-            torch.arange(10),
-            torch.arange(10),
-            steps=5,
-            batch_size=4,
-            lr=1e-3,
-            seed=0,
-            plateau=PlateauStop(index=torch.empty(0, dtype=torch.long), every=2, patience=1),
-        )
+        plateau_train(held_out_sign=1.0, steps=5, held_out=torch.empty(0, dtype=torch.long))
 
 
 def test_a_policy_with_another_task_vocabulary_is_refused():
