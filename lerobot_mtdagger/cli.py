@@ -306,6 +306,15 @@ class ReportConfig:
             for run in (_compare_runs(Path(folder)) if (Path(folder) / "runs").is_dir() else [Path(folder)])
         }
 
+    @property
+    def runs_not_started(self) -> list[str]:
+        """The runs the compare folders plan (``compare.json``) that have no folder yet."""
+        from lerobot_mtdagger.compare import runs_not_started
+
+        folders = [self.compare_dir] if self.compare_dir is not None else []
+        folders += [Path(folder) for folder in self.variants.values() if (Path(folder) / "runs").is_dir()]
+        return [f"{name}: not started" for folder in folders for name in runs_not_started(folder)]
+
 
 def _compare_runs(compare_dir: Path) -> list[Path]:
     """The run folders of a ``compare`` folder."""
@@ -313,10 +322,30 @@ def _compare_runs(compare_dir: Path) -> list[Path]:
 
 
 def report_command(config: ReportConfig) -> str:
-    """Prints the learning curves (mean and std over seeds); writes the figures and summary."""
-    from lerobot_mtdagger.report import learning_curves, markdown_table
+    """Prints the learning curves (mean and std over seeds); writes the figures and summary.
 
-    roots, labels = config.experiment_dirs, config.labels  # each lists the run folders once
+    Runs still being written (or cut off) are reported as far as they got: a run without a committed
+    round is left out, and the report says which runs are unfinished.
+    """
+    from lerobot_mtdagger.report import check_comparable, learning_curves, markdown_table, run_progress
+
+    all_roots, labels = config.experiment_dirs, config.labels  # each lists the run folders once
+    check_comparable(all_roots, labels)
+    progress = [run_progress(root) for root in all_roots]
+    unfinished = [run.describe() for run in progress if not run.finished] + config.runs_not_started
+    if unfinished:
+        logger.warning(
+            "Interim report: %d run(s) unfinished (running, cut off or not started), reported as far "
+            "as they got: %s",
+            len(unfinished),
+            "; ".join(unfinished),
+        )
+    roots = [run.root for run in progress if run.rounds > 0]
+    if not roots:
+        raise UserError(
+            f"None of the {len(progress)} run(s) has a committed round yet: report once the first "
+            "round is written."
+        )
     table = markdown_table(learning_curves(roots, labels))
     print(table)
     if config.output is not None:
@@ -329,7 +358,7 @@ def report_command(config: ReportConfig) -> str:
         rows = results_rows(roots, labels)
         task_names = ExperimentDir(roots[0]).read_round_record(0).task_names
         write_results(rows, config.output_dir)
-        path = write_report(rows, task_names, config.output_dir, levels=config.levels)
+        path = write_report(rows, task_names, config.output_dir, levels=config.levels, unfinished=unfinished)
         print(f"figures and summary: {path}")
     return table
 

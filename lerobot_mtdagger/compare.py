@@ -41,6 +41,7 @@ from lerobot_mtdagger.scheduler import scheduling_methods
 logger = logging.getLogger(__name__)
 
 RUNS_DIR = "runs"
+COMPARE_FILE = "compare.json"
 
 
 @dataclass
@@ -145,6 +146,24 @@ def is_finished(folder: Path, last_phase: int) -> bool:
     return last_phase in ExperimentDir(folder).committed_phases()
 
 
+def runs_not_started(compare_dir: Path) -> list[str]:
+    """The runs ``compare_dir/compare.json`` plans that have no folder under ``runs/`` yet, in its order.
+
+    Empty for a folder without ``compare.json``.
+
+    Raises:
+        UserError: If ``compare.json`` is not a compare plan.
+    """
+    path = Path(compare_dir) / COMPARE_FILE
+    if not path.is_file():
+        return []
+    try:
+        jobs = json.loads(path.read_text())["jobs"]
+    except (json.JSONDecodeError, KeyError, TypeError) as error:
+        raise UserError(f"{path} is not a compare plan ({error!r}); rerun compare to rewrite it.") from None
+    return [name for name in jobs if not (Path(compare_dir) / RUNS_DIR / name).is_dir()]
+
+
 def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
     """Runs (or resumes, or skips) one job in its own process; returns its folder.
 
@@ -204,7 +223,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     workers = 0 if threads < 2 else threads
     runs_dir = compare_config.output_dir / RUNS_DIR
     runs_dir.mkdir(parents=True, exist_ok=True)
-    (compare_config.output_dir / "compare.json").write_text(
+    (compare_config.output_dir / COMPARE_FILE).write_text(
         json.dumps(
             {
                 "methods": compare_config.methods,

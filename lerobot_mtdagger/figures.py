@@ -69,21 +69,27 @@ def runs_by_method(rows: Sequence[Row]) -> dict[str, dict[int, list[Row]]]:
     return {method: dict(seeds) for method, seeds in sorted(grouped.items())}
 
 
-def curve_points(seeds: dict[int, list[Row]], x_key: str, y_of=None) -> list[tuple[float, Interval]]:
-    """Mean x and the interval of y over seeds, point by point (the k-th point of every seed).
+def point_columns(seeds: dict[int, list[Row]]) -> list[list[Row]]:
+    """The seeds' rows grouped point by point: one column per (round, mean demos per task), in order.
 
-    Raises:
-        ValueError: If the seeds' curves have different lengths (different budgets or rounds).
+    Every seed of a finished method has the same points (``report.check_comparable``); a run still
+    being written, or BC run at fewer budgets for one seed, has fewer, and its columns hold fewer
+    seeds.
     """
+    columns: dict[tuple[int, float], list[Row]] = defaultdict(list)
+    for curve in seeds.values():
+        for row in curve:
+            columns[(row["round"], round(row["demos_per_task_mean"], 6))].append(row)
+    return [columns[key] for key in sorted(columns, key=lambda key: (key[1], key[0]))]
+
+
+def curve_points(seeds: dict[int, list[Row]], x_key: str, y_of=None) -> list[tuple[float, Interval]]:
+    """Mean x and the interval of y over seeds, point by point (``point_columns``)."""
     y_of = y_of or (lambda row: row["eval_success_mean"])
-    lengths = {len(curve) for curve in seeds.values()}
-    if len(lengths) != 1:
-        raise UserError(f"Seeds with different numbers of points {sorted(lengths)}: rerun compare to finish.")
-    points = []
-    for k in range(lengths.pop()):
-        column = [curve[k] for curve in seeds.values()]
-        points.append((float(np.mean([r[x_key] for r in column])), mean_interval([y_of(r) for r in column])))
-    return points
+    return [
+        (float(np.mean([r[x_key] for r in column])), mean_interval([y_of(r) for r in column]))
+        for column in point_columns(seeds)
+    ]
 
 
 def seed_reach(curve: Sequence[Row], level: float, x_values) -> float | None:
@@ -267,7 +273,7 @@ def plot_hardest(rows: Sequence[Row], task_names: Sequence[str], path: Path) -> 
             points = curve_points(
                 seeds, "demos_per_task_mean", y_of=lambda row, t=task: row["eval_success"][t]
             )
-            x = [np.mean([c[k]["demos_per_task"][task] for c in seeds.values()]) for k in range(len(points))]
+            x = [np.mean([r["demos_per_task"][task] for r in column]) for column in point_columns(seeds)]
             mean = [i.mean for _, i in points]
             style = "s" if method in bc_names else "o-"
             axis.plot(x, mean, style, label=method)
@@ -484,9 +490,22 @@ def cost_lines(rows: Sequence[Row]) -> list[str]:
     return lines + [""]
 
 
+def interim_lines(unfinished: Sequence[str]) -> list[str]:
+    """The interim warning of a report with unfinished runs (none when every run finished)."""
+    if not unfinished:
+        return []
+    lines = [
+        f"**Interim report: {len(unfinished)} run(s) unfinished** (running, cut off or not started), "
+        "reported as far as they got: a method may average fewer seeds at its later budgets than at "
+        'its first, and its "final" success is that of its last committed phase.',
+        "",
+    ]
+    return lines + [f"- {line}" for line in unfinished] + [""]
+
+
 def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[str, Any], levels) -> str:
     """The report: figures embedded, paired differences and demo ratios per pair of methods."""
-    lines = ["# Method comparison", "", _caption(rows) + ".", ""]
+    lines = ["# Method comparison", "", _caption(rows) + ".", "", *interim_lines(notes.get("unfinished", ()))]
     for title, path in figures.items():
         lines += [f"## {title}", "", f"![{title}]({path.name})", ""]
     lines += [f"Pearson r, metric vs final success: {notes['correlations']}.", ""]
@@ -513,8 +532,22 @@ def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[
     return "\n".join(lines) + "\n"
 
 
-def write_report(rows: Sequence[Row], task_names: Sequence[str], folder: Path, levels=LEVELS) -> Path:
+def write_report(
+    rows: Sequence[Row],
+    task_names: Sequence[str],
+    folder: Path,
+    levels=LEVELS,
+    unfinished: Sequence[str] = (),
+) -> Path:
     """Writes every figure and ``report.md`` into ``folder``; returns the markdown path.
+
+    Args:
+        rows: The results rows (``results.results_rows``).
+        task_names: The suite's task names, in task-index order.
+        folder: Where the figures and ``report.md`` go.
+        levels: Success levels of the reach tables and figures.
+        unfinished: One line per unfinished run (``RunProgress.describe``); the report then says it
+            is interim and lists them.
 
     Raises:
         ValueError: If there is no row.
@@ -564,6 +597,7 @@ def write_report(rows: Sequence[Row], task_names: Sequence[str], folder: Path, l
         "correlations": {k: round(v, 3) for k, v in correlations.items()},
         "hardest": [task_names[t] for t in hardest],
         "hardest_indices": list(hardest),
+        "unfinished": list(unfinished),
     }
     path = folder / "report.md"
     path.write_text(summary_markdown(rows, figures, notes, levels))

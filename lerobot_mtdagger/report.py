@@ -40,6 +40,53 @@ class CurvePoint:
     seeds: int
 
 
+@dataclass(frozen=True)
+class RunProgress:
+    """How far one run has got: its committed rounds and training phases against its last phase.
+
+    Attributes:
+        root: The experiment folder.
+        rounds: Committed rounds (0 for a run that has just started).
+        phases: Indices of the committed training phases.
+        last_phase: The phase the run ends with: 0 for BC, ``rounds`` for DAgger (its config).
+    """
+
+    root: Path
+    rounds: int
+    phases: tuple[int, ...]
+    last_phase: int
+
+    @property
+    def finished(self) -> bool:
+        """Whether the last phase is committed."""
+        return self.last_phase in self.phases
+
+    def describe(self) -> str:
+        """One line for a report: the run's folder name and how far it has got."""
+        done = f"phases 0-{max(self.phases)}" if self.phases else "no phase yet"
+        return f"{self.root.name}: {done} of 0-{self.last_phase}"
+
+
+def run_progress(root: Path) -> RunProgress:
+    """How far the run in ``root`` has got (a run still being written is read as it stands).
+
+    Raises:
+        UserError: If ``root`` has no ``config.json`` or holds a corrupt round.
+    """
+    path = Path(root) / CONFIG_FILE
+    if not path.is_file():
+        raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
+    config = json.loads(path.read_text())
+    experiment = ExperimentDir(root)
+    last_phase = 0 if config.get("mode") == "bc" else int(config.get("rounds") or 0)
+    return RunProgress(
+        root=Path(root),
+        rounds=len(experiment.committed_rounds()),
+        phases=tuple(experiment.committed_phases()),
+        last_phase=last_phase,
+    )
+
+
 def experiment_curve(root: Path, label: str | None = None) -> tuple[str, int, list[tuple[int, float, float]]]:
     """``(method, seed, [(round, mean demos per task, mean eval success), ...])`` of one experiment.
 

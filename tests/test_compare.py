@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import csv
 import json
+import re
+import shutil
 
 import pytest
 
@@ -86,6 +88,39 @@ def test_report_writes_every_figure_and_the_paired_differences(compared, capsys)
     assert "| need | need_raw | 3.0 |" in summary  # the Kalman filter's own effect, paired
     assert "| need | uniform | 5.0 | " in summary.split("## The hardest tasks")[1]
     assert "bc (1 demos/task)" in capsys.readouterr().out  # the table keeps BC budgets apart
+    assert "Interim" not in summary  # every run finished
+
+
+def test_report_on_a_study_in_progress_reports_what_is_committed_and_lists_the_rest(
+    compared, tmp_path, capsys
+):
+    folder, _ = compared
+    study = tmp_path / "cmp"
+    shutil.copytree(folder, study, ignore=shutil.ignore_patterns("report"))
+    runs = study / "runs"
+    for k in (1, 2):  # need, seed 1: cut off after its first phase
+        shutil.rmtree(runs / "need-seed1" / "policies" / f"round-00{k}")
+        shutil.rmtree(runs / "need-seed1" / "rounds" / f"round-00{k}")
+    for sub in ("policies", "rounds"):  # gain, seed 1: just started (its config, no round yet)
+        shutil.rmtree(runs / "gain-seed1" / sub)
+        (runs / "gain-seed1" / sub).mkdir()
+    shutil.rmtree(runs / "bc-5demos-seed1")  # planned in compare.json, not started
+
+    assert main(["report", f"--compare_dir={study}"]) == 0
+
+    rows = json.loads((study / "report" / "results.json").read_text())
+    assert [r["round"] for r in rows if (r["method"], r["seed"]) == ("need", 1)] == [0]
+    assert not [r for r in rows if (r["method"], r["seed"]) == ("gain", 1)]
+    bc = {r["demos_per_task_mean"] for r in rows if (r["method"], r["seed"]) == ("bc", 1)}
+    assert bc == {1.0, 3.0}
+    summary = (study / "report" / "report.md").read_text()
+    assert "**Interim report: 3 run(s) unfinished**" in summary
+    assert "- need-seed1: phases 0-0 of 0-2" in summary
+    assert "- gain-seed1: no phase yet of 0-2" in summary
+    assert "- bc-5demos-seed1: not started" in summary
+    table = capsys.readouterr().out
+    assert re.search(r"\| need \| 0 \| 1\.0 \| [0-9.]+ \| [0-9.]+ \| 2 \|", table)  # both seeds
+    assert re.search(r"\| need \| 2 \| 5\.0 \| [0-9.]+ \| n/a \| 1 \|", table)  # seed 0 alone
 
 
 def test_bc_budgets_map_to_rounds_and_bad_ones_are_refused():
