@@ -261,20 +261,35 @@ class ReportConfig:
             or one experiment each, e.g. ``--variants='{bc-balanced: outputs/bc-balanced}'`` for BC
             trained with balanced sampling beside the ``bc`` of ``compare_dir``. A BC variant is a
             baseline like ``bc``.
+        results: A saved results table instead of run folders: the ``results.json`` that ``report
+            --output_dir`` or ``compare`` wrote, or its folder. Redraws the figures and ``report.md``
+            from the table alone (default ``output_dir``: the table's folder), e.g. after the run
+            folders are gone, or with other ``--levels``.
     """
 
     experiments: list[Path] = field(default_factory=list)
     compare_dir: Path | None = None
+    results: Path | None = None
     output_dir: Path | None = None
     output: Path | None = None
     levels: list[float] = field(default_factory=lambda: [0.5, 0.6, 0.7, 0.8])
     variants: dict[str, Path] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        if self.results is not None:
+            if self.experiments or self.compare_dir is not None or self.variants:
+                raise ValueError(
+                    "--results redraws a saved table: give it alone, without --experiments, "
+                    "--compare_dir or --variants (their runs are tabulated afresh instead)."
+                )
+            if self.output_dir is None:
+                self.output_dir = self.results if self.results.is_dir() else self.results.parent
+            return
         if not self.experiments and self.compare_dir is None:
             raise ValueError(
-                "--experiments or --compare_dir is required, e.g. "
-                "--experiments='[outputs/need-s0,outputs/bc-s0]' or --compare_dir=outputs/compare."
+                "--experiments, --compare_dir or --results is required, e.g. "
+                "--experiments='[outputs/need-s0,outputs/bc-s0]', --compare_dir=outputs/compare or "
+                "--results=docs/results/mt10-state-eval/report."
             )
         if self.compare_dir is not None and not (self.compare_dir / "runs").is_dir():
             raise ValueError(f"{self.compare_dir} is not a compare folder (no runs/ in it).")
@@ -325,8 +340,11 @@ def report_command(config: ReportConfig) -> str:
     """Prints the learning curves (mean and std over seeds); writes the figures and summary.
 
     Runs still being written (or cut off) are reported as far as they got: a run without a committed
-    round is left out, and the report says which runs are unfinished.
+    round is left out, and the report says which runs are unfinished. With ``--results``, the same
+    from a saved results table.
     """
+    if config.results is not None:
+        return _report_saved_table(config)
     from lerobot_mtdagger.report import check_comparable, learning_curves, markdown_table, run_progress
 
     all_roots, labels = config.experiment_dirs, config.labels  # each lists the run folders once
@@ -346,21 +364,45 @@ def report_command(config: ReportConfig) -> str:
             f"None of the {len(progress)} run(s) has a committed round yet: report once the first "
             "round is written."
         )
-    table = markdown_table(learning_curves(roots, labels))
-    print(table)
-    if config.output is not None:
-        config.output.write_text(table + "\n")
+    table = _print_table(markdown_table(learning_curves(roots, labels)), config)
     if config.output_dir is not None:
-        from lerobot_mtdagger.figures import write_report
         from lerobot_mtdagger.results import results_rows, write_results
         from lerobot_mtdagger.rounds import ExperimentDir
 
         rows = results_rows(roots, labels)
         task_names = ExperimentDir(roots[0]).read_round_record(0).task_names
-        write_results(rows, config.output_dir)
-        path = write_report(rows, task_names, config.output_dir, levels=config.levels, unfinished=unfinished)
-        print(f"figures and summary: {path}")
+        write_results(rows, config.output_dir, task_names, unfinished)
+        _write_figures(rows, task_names, config, unfinished)
     return table
+
+
+def _report_saved_table(config: ReportConfig) -> str:
+    """``report --results``: the table, figures and summary of a saved results table."""
+    from lerobot_mtdagger.report import curves_from_rows, markdown_table
+    from lerobot_mtdagger.results import read_results
+
+    rows, task_names, unfinished = read_results(config.results)
+    table = _print_table(markdown_table(curves_from_rows(rows)), config)
+    _write_figures(rows, task_names, config, unfinished)
+    return table
+
+
+def _print_table(table: str, config: ReportConfig) -> str:
+    """Prints the learning-curve table and writes it to ``--output`` when given; returns it."""
+    print(table)
+    if config.output is not None:
+        config.output.write_text(table + "\n")
+    return table
+
+
+def _write_figures(
+    rows: list[dict], task_names: list[str], config: ReportConfig, unfinished: list[str]
+) -> None:
+    """Writes every figure and ``report.md`` into ``--output_dir`` and prints where."""
+    from lerobot_mtdagger.figures import write_report
+
+    path = write_report(rows, task_names, config.output_dir, levels=config.levels, unfinished=unfinished)
+    print(f"figures and summary: {path}")
 
 
 def compare_command(config: CompareConfig, run_args: list[str]) -> list[dict]:

@@ -215,8 +215,8 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.results import results_rows, write_results
 
-    num_tasks = len(suite_from_config(base_run_config(run_args)).task_names)
-    jobs = jobs_for(compare_config, run_args, num_tasks)
+    task_names = suite_from_config(base_run_config(run_args)).task_names
+    jobs = jobs_for(compare_config, run_args, len(task_names))
     cores = default_worker_count()
     parallel = compare_config.jobs or cores
     threads = max(1, cores // parallel)
@@ -237,5 +237,5 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     with ThreadPoolExecutor(max_workers=parallel) as pool:
         folders = list(pool.map(lambda job: run_job(job, runs_dir, threads, workers), jobs))
     rows = results_rows(folders)
-    write_results(rows, compare_config.output_dir)
+    write_results(rows, compare_config.output_dir, task_names)
     return rows

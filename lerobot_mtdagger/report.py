@@ -87,8 +87,12 @@ def run_progress(root: Path) -> RunProgress:
     )
 
 
-def experiment_curve(root: Path, label: str | None = None) -> tuple[str, int, list[tuple[int, float, float]]]:
-    """``(method, seed, [(round, mean demos per task, mean eval success), ...])`` of one experiment.
+RunPoints = tuple[str, int, list[tuple[int, float, float]]]
+"""``(method, seed, [(round, mean demos per task, mean eval success), ...])`` of one run."""
+
+
+def experiment_curve(root: Path, label: str | None = None) -> RunPoints:
+    """The evaluated points of one experiment folder.
 
     Args:
         root: The experiment folder.
@@ -101,10 +105,17 @@ def experiment_curve(root: Path, label: str | None = None) -> tuple[str, int, li
         phase = experiment.read_phase_record(round_index)
         if phase.eval_mean is not None:
             points.append((round_index, float(np.mean(phase.demos_per_task)), phase.eval_mean))
-    method = label or record.method
-    if record.method == "bc":  # BC at several budgets: one group per budget (a point each)
-        method = f"{method} ({np.mean(record.demos_so_far):g} demos/task)"
-    return method, record.seed, points
+    is_bc = record.method == "bc"
+    return (
+        _curve_name(label or record.method, is_bc, float(np.mean(record.demos_so_far))),
+        record.seed,
+        points,
+    )
+
+
+def _curve_name(method: str, is_bc: bool, demos_per_task: float) -> str:
+    """BC at several budgets is one group per budget (a point each), named with its budget."""
+    return f"{method} ({demos_per_task:g} demos/task)" if is_bc else method
 
 
 def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> list[CurvePoint]:
@@ -122,16 +133,40 @@ def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = N
     """
     labels = labels or {}
     check_comparable(roots, labels)
+    return average_runs([experiment_curve(Path(root), labels.get(Path(root))) for root in roots])
+
+
+def curves_from_rows(rows: Sequence[Mapping]) -> list[CurvePoint]:
+    """The learning curves of a saved results table (``results.read_results``), as ``learning_curves``.
+
+    Raises:
+        ValueError: As ``average_runs``.
+    """
+    from lerobot_mtdagger.figures import is_bc
+
+    runs: dict[tuple[str, int], list[tuple[int, float, float]]] = defaultdict(list)
+    for row in rows:
+        name = _curve_name(row["method"], is_bc(row), float(row["demos_per_task_mean"]))
+        point = (int(row["round"]), float(row["demos_per_task_mean"]), float(row["eval_success_mean"]))
+        runs[(name, int(row["seed"]))].append(point)
+    return average_runs([(name, seed, sorted(points)) for (name, seed), points in runs.items()])
+
+
+def average_runs(runs: Sequence[RunPoints]) -> list[CurvePoint]:
+    """Averages the runs of each method over seeds, round by round (mean and sample std).
+
+    Raises:
+        ValueError: If two runs of one method have the same seed, or no run has an evaluated point.
+    """
     grouped: dict[str, dict[int, list[tuple[int, float, float]]]] = defaultdict(dict)
-    for root in roots:
-        method, seed, points = experiment_curve(Path(root), labels.get(Path(root)))
+    for method, seed, points in runs:
         if seed in grouped[method]:
             raise UserError(f"Two {method} experiments with seed {seed}; give each run its own seed.")
         grouped[method][seed] = points
     curves = []
-    for method, runs in sorted(grouped.items()):
+    for method, seeds in sorted(grouped.items()):
         by_round: dict[int, list[tuple[float, float]]] = defaultdict(list)
-        for points in runs.values():
+        for points in seeds.values():
             for round_index, demos, success in points:
                 by_round[round_index].append((demos, success))
         for round_index, values in sorted(by_round.items()):
@@ -143,7 +178,7 @@ def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = N
             )
     if not curves:
         raise UserError(
-            f"None of the {len(roots)} experiment(s) has an evaluated phase (they ran with "
+            f"None of the {len(runs)} experiment(s) has an evaluated phase (they ran with "
             "--eval_episodes=0?): evaluate their policies with `lerobot-mtdagger eval` or rerun them "
             "with --eval_episodes > 0."
         )

@@ -3,7 +3,14 @@
 A row describes the policy trained on rounds 0..k of one run: its method and seed, the expert data
 behind it (demos and expert-labelled frames per task, cumulative), its evaluation success, the
 scheduler's signals at that point and the wall time of the round. ``write_results`` stores the rows
-as CSV (list columns as JSON) and JSON next to the runs.
+as CSV (list columns as JSON) and JSON next to the runs, with the task names (and, for a study in
+progress, its unfinished runs) in ``results_meta.json``; ``read_results`` reads them back, so a
+report can be redrawn from the saved table alone, when the run folders are gone::
+
+    <folder>/
+        results.csv         one row per run x evaluated phase, list columns as JSON
+        results.json        the same rows as a JSON list (what ``read_results`` reads)
+        results_meta.json   {"task_names": [...], "unfinished": [...]}
 """
 
 from __future__ import annotations
@@ -20,6 +27,10 @@ import pyarrow.parquet as pq
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.rounds import ExperimentDir
 
+RESULTS_FILE = "results.json"
+META_FILE = "results_meta.json"
+REQUIRED_COLUMNS = ("method", "seed", "round", "demos_per_task_mean", "eval_success_mean", "eval_success")
+"""The columns every saved row must have to be reported (``read_results`` checks them)."""
 PHASE_TIMINGS = ("collect_s", "write_s", "load_s", "train_s", "eval_s")
 LIST_COLUMNS = (
     "demos_per_task",
@@ -110,20 +121,87 @@ def results_rows(roots: Sequence[Path], labels: Mapping[Path, str] | None = None
     return sorted(rows, key=lambda r: (r["method"], r["seed"], r["demos_per_task_mean"], r["round"]))
 
 
-def write_results(rows: Sequence[dict[str, Any]], folder: Path) -> tuple[Path, Path]:
-    """Writes ``results.csv`` and ``results.json`` into ``folder``; returns their paths.
+def write_results(
+    rows: Sequence[dict[str, Any]],
+    folder: Path,
+    task_names: Sequence[str],
+    unfinished: Sequence[str] = (),
+) -> tuple[Path, Path]:
+    """Writes ``results.csv``, ``results.json`` and ``results_meta.json`` into ``folder``.
+
+    Args:
+        rows: The rows (``results_rows``).
+        folder: Where they go (made if missing).
+        task_names: The suite's task names in task-index order (the per-task columns' order).
+        unfinished: One line per unfinished run of a study in progress (``RunProgress.describe``).
+
+    Returns:
+        The paths of ``results.csv`` and ``results.json``.
 
     Raises:
-        ValueError: If there is no row.
+        UserError: If there is no row.
     """
     if not rows:
         raise UserError("No evaluated training phase in these experiments: nothing to tabulate.")
     folder.mkdir(parents=True, exist_ok=True)
-    json_path, csv_path = folder / "results.json", folder / "results.csv"
+    json_path, csv_path = folder / RESULTS_FILE, folder / "results.csv"
     json_path.write_text(json.dumps(list(rows), indent=1))
+    meta = {"task_names": list(task_names), "unfinished": list(unfinished)}
+    (folder / META_FILE).write_text(json.dumps(meta, indent=1))
     with csv_path.open("w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
         writer.writeheader()
         for row in rows:
             writer.writerow({k: json.dumps(v) if k in LIST_COLUMNS else v for k, v in row.items()})
     return csv_path, json_path
+
+
+def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str], list[str]]:
+    """Reads a saved results table: ``(rows, task_names, unfinished)``.
+
+    Args:
+        path: A ``results.json`` written by ``write_results`` (``report`` or ``compare``), or the folder
+            that holds it with its ``results_meta.json``.
+
+    Raises:
+        UserError: If a file is missing or is not what ``write_results`` writes, naming the file and
+            the fix.
+    """
+    path = Path(path)
+    json_path = path / RESULTS_FILE if path.is_dir() else path
+    meta_path = json_path.parent / META_FILE
+    for needed in (json_path, meta_path):
+        if not needed.is_file():
+            raise UserError(
+                f"{needed} does not exist: pass the results.json that `report --output_dir` or `compare` "
+                f"wrote (it keeps {META_FILE} beside it), or the folder that holds both."
+            )
+    rows = _read_json(json_path)
+    if not isinstance(rows, list) or not rows or not all(isinstance(row, dict) for row in rows):
+        raise UserError(
+            f"{json_path} holds no results rows (a JSON list of objects): rewrite it with report."
+        )
+    missing = sorted({column for row in rows for column in REQUIRED_COLUMNS if column not in row})
+    if missing:
+        raise UserError(f"{json_path}: rows lack the column(s) {missing}; rewrite it with report.")
+    meta = _read_json(meta_path)
+    task_names = meta.get("task_names") if isinstance(meta, dict) else None
+    width = {len(row["eval_success"]) for row in rows}
+    if not isinstance(task_names, list) or width != {len(task_names)}:
+        raise UserError(
+            f"{meta_path} must name the {sorted(width)} task(s) of the rows' per-task columns in "
+            '"task_names": rewrite it with report.'
+        )
+    return rows, [str(name) for name in task_names], [str(line) for line in meta.get("unfinished", [])]
+
+
+def _read_json(path: Path) -> Any:
+    """The JSON in ``path``.
+
+    Raises:
+        UserError: If it is not JSON, naming the file.
+    """
+    try:
+        return json.loads(path.read_text())
+    except json.JSONDecodeError as error:
+        raise UserError(f"{path} is not JSON ({error}); rewrite it with report.") from None

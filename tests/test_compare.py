@@ -7,6 +7,7 @@ import csv
 import json
 import re
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -121,6 +122,82 @@ def test_report_on_a_study_in_progress_reports_what_is_committed_and_lists_the_r
     table = capsys.readouterr().out
     assert re.search(r"\| need \| 0 \| 1\.0 \| [0-9.]+ \| [0-9.]+ \| 2 \|", table)  # both seeds
     assert re.search(r"\| need \| 2 \| 5\.0 \| [0-9.]+ \| n/a \| 1 \|", table)  # seed 0 alone
+
+
+def _saved_table(report: Path, folder: Path) -> Path:
+    """A copy of a report's saved table alone (no run folder beside it)."""
+    folder.mkdir()
+    for name in ("results.json", "results_meta.json"):
+        shutil.copy(report / name, folder / name)
+    return folder
+
+
+def test_report_redrawn_from_the_saved_table_alone_equals_the_report_of_the_runs(compared, tmp_path, capsys):
+    folder, _ = compared
+    assert main(["report", f"--compare_dir={folder}", f"--output_dir={tmp_path / 'of-runs'}"]) == 0
+    table_of_runs = capsys.readouterr().out.split("figures and summary")[0]
+    saved = _saved_table(tmp_path / "of-runs", tmp_path / "saved")
+    rows_before = (saved / "results.json").read_bytes()
+
+    assert main(["report", f"--results={saved / 'results.json'}"]) == 0
+
+    assert capsys.readouterr().out.split("figures and summary")[0] == table_of_runs
+    assert (saved / "report.md").read_text() == (tmp_path / "of-runs" / "report.md").read_text()
+    for name in FIGURES:
+        assert (saved / name).stat().st_size > 10_000, name
+    assert (saved / "results.json").read_bytes() == rows_before  # the input is never rewritten
+    meta = json.loads((folder / "results_meta.json").read_text())  # compare's own table has it too
+    assert meta == {"task_names": ["toy-left", "toy-right", "toy-up-windy"], "unfinished": []}
+
+
+def test_a_redrawn_interim_report_still_lists_the_unfinished_runs(compared, tmp_path):
+    folder, _ = compared
+    study = tmp_path / "cmp"
+    shutil.copytree(folder, study, ignore=shutil.ignore_patterns("report"))
+    shutil.rmtree(study / "runs" / "bc-5demos-seed1")
+    assert main(["report", f"--compare_dir={study}"]) == 0
+    saved = _saved_table(study / "report", tmp_path / "saved")
+
+    assert main(["report", f"--results={saved}", "--levels=[0.5]"]) == 0
+
+    summary = (saved / "report.md").read_text()
+    assert (
+        "**Interim report: 1 run(s) unfinished**" in summary and "- bc-5demos-seed1: not started" in summary
+    )
+    assert "| need | uniform | 50% |" in summary and "| need | uniform | 60% |" not in summary
+
+
+@pytest.mark.parametrize(
+    ("damage", "message"),
+    [
+        (lambda saved: (saved / "results_meta.json").unlink(), "results_meta.json does not exist"),
+        (lambda saved: (saved / "results.json").write_text("[1, 2"), "results.json is not JSON"),
+        (lambda saved: (saved / "results.json").write_text("[]"), "holds no results rows"),
+        (
+            lambda saved: (saved / "results.json").write_text('[{"method": "bc"}]'),
+            r"rows lack the column\(s\) \['demos_per_task_mean'",
+        ),
+        (
+            lambda saved: (saved / "results_meta.json").write_text('{"task_names": ["a"]}'),
+            r"must name the \[3\] task\(s\)",
+        ),
+    ],
+)
+def test_report_refuses_a_damaged_saved_table_and_names_the_file(compared, tmp_path, capsys, damage, message):
+    folder, _ = compared
+    saved = _saved_table(folder, tmp_path / "saved")
+    damage(saved)
+    assert main(["report", f"--results={saved}"]) == 2
+    assert re.search(message, capsys.readouterr().err)
+    assert not (saved / "report.md").exists()
+
+
+def test_report_results_goes_alone(compared, tmp_path, capsys):
+    folder, _ = compared
+    assert main(["report", f"--results={folder}", f"--compare_dir={folder}"]) == 2
+    assert "give it alone" in capsys.readouterr().err
+    assert main(["report", f"--results={tmp_path / 'nowhere'}"]) == 2
+    assert "nowhere does not exist: pass the results.json" in capsys.readouterr().err
 
 
 def test_bc_budgets_map_to_rounds_and_bad_ones_are_refused():
