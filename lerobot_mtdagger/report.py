@@ -105,12 +105,8 @@ def experiment_curve(root: Path, label: str | None = None) -> RunPoints:
         phase = experiment.read_phase_record(round_index)
         if phase.eval_mean is not None:
             points.append((round_index, float(np.mean(phase.demos_per_task)), phase.eval_mean))
-    is_bc = record.method == "bc"
-    return (
-        _curve_name(label or record.method, is_bc, float(np.mean(record.demos_so_far))),
-        record.seed,
-        points,
-    )
+    name = _curve_name(label or record.method, record.method == "bc", float(np.mean(record.demos_so_far)))
+    return name, record.seed, points
 
 
 def _curve_name(method: str, is_bc: bool, demos_per_task: float) -> str:
