@@ -261,35 +261,30 @@ class ReportConfig:
             or one experiment each, e.g. ``--variants='{bc-balanced: outputs/bc-balanced}'`` for BC
             trained with balanced sampling beside the ``bc`` of ``compare_dir``. A BC variant is a
             baseline like ``bc``.
-        results: A saved results table instead of run folders: the ``results.json`` that ``report
-            --output_dir`` or ``compare`` wrote, or its folder. Redraws the figures and ``report.md``
-            from the table alone (default ``output_dir``: the table's folder), e.g. after the run
-            folders are gone, or with other ``--levels``.
+        results: Saved results tables instead of run folders: each a ``results.json`` that ``report
+            --output_dir`` or ``compare`` wrote, or its folder. Draws the figures and ``report.md`` from
+            the tables alone, e.g. after the run folders are gone, with other ``--levels``, or joining
+            seeds run on other machines (each point in one table only; the methods' configs must
+            agree). Default ``output_dir`` for one table: its folder.
     """
 
     experiments: list[Path] = field(default_factory=list)
     compare_dir: Path | None = None
-    results: Path | None = None
+    results: list[Path] = field(default_factory=list)
     output_dir: Path | None = None
     output: Path | None = None
     levels: list[float] = field(default_factory=lambda: [0.5, 0.6, 0.7, 0.8])
     variants: dict[str, Path] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if self.results is not None:
-            if self.experiments or self.compare_dir is not None or self.variants:
-                raise ValueError(
-                    "--results redraws a saved table: give it alone, without --experiments, "
-                    "--compare_dir or --variants (their runs are tabulated afresh instead)."
-                )
-            if self.output_dir is None:
-                self.output_dir = self.results if self.results.is_dir() else self.results.parent
+        if self.results:
+            self._check_results_options()
             return
         if not self.experiments and self.compare_dir is None:
             raise ValueError(
                 "--experiments, --compare_dir or --results is required, e.g. "
                 "--experiments='[outputs/need-s0,outputs/bc-s0]', --compare_dir=outputs/compare or "
-                "--results=docs/results/mt10-state-eval/report."
+                "--results='[docs/results/mt10-state-eval/report]'."
             )
         if self.compare_dir is not None and not (self.compare_dir / "runs").is_dir():
             raise ValueError(f"{self.compare_dir} is not a compare folder (no runs/ in it).")
@@ -303,6 +298,22 @@ class ReportConfig:
                     f"--variants: {folder} (for {name!r}) is neither a compare folder (runs/) nor an "
                     "experiment: give the folder compare or run wrote."
                 )
+
+    def _check_results_options(self) -> None:
+        """``--results`` goes without run folders; several tables need an ``--output_dir``."""
+        if self.experiments or self.compare_dir is not None or self.variants:
+            raise ValueError(
+                "--results draws saved tables: give it alone, without --experiments, --compare_dir or "
+                "--variants (their runs are tabulated afresh instead)."
+            )
+        if self.output_dir is None and len(self.results) > 1:
+            raise ValueError(
+                f"--results joins {len(self.results)} tables: give --output_dir for the joined report "
+                "(it is never written into one of the tables' folders unasked)."
+            )
+        if self.output_dir is None:
+            table = Path(self.results[0])
+            self.output_dir = table if table.is_dir() else table.parent
 
     @property
     def experiment_dirs(self) -> list[Path]:
@@ -343,12 +354,12 @@ def report_command(config: ReportConfig) -> str:
     round is left out, and the report says which runs are unfinished. With ``--results``, the same
     from a saved results table.
     """
-    if config.results is not None:
-        return _report_saved_table(config)
+    if config.results:
+        return _report_saved_tables(config)
     from lerobot_mtdagger.report import check_comparable, learning_curves, markdown_table, run_progress
 
     all_roots, labels = config.experiment_dirs, config.labels  # each lists the run folders once
-    check_comparable(all_roots, labels)
+    configs = check_comparable(all_roots, labels)
     progress = [run_progress(root) for root in all_roots]
     unfinished = [run.describe() for run in progress if not run.finished] + config.runs_not_started
     if unfinished:
@@ -371,19 +382,19 @@ def report_command(config: ReportConfig) -> str:
 
         rows = results_rows(roots, labels)
         task_names = ExperimentDir(roots[0]).read_round_record(0).task_names
-        write_results(rows, config.output_dir, task_names, unfinished)
+        write_results(rows, config.output_dir, task_names, configs, unfinished)
         _write_figures(rows, task_names, config, unfinished)
     return table
 
 
-def _report_saved_table(config: ReportConfig) -> str:
-    """``report --results``: the table, figures and summary of a saved results table."""
+def _report_saved_tables(config: ReportConfig) -> str:
+    """``report --results``: the table, figures and summary of saved results tables, joined."""
     from lerobot_mtdagger.report import curves_from_rows, markdown_table
-    from lerobot_mtdagger.results import read_results
+    from lerobot_mtdagger.results import merge_tables, read_results
 
-    rows, task_names, unfinished = read_results(config.results)
-    table = _print_table(markdown_table(curves_from_rows(rows)), config)
-    _write_figures(rows, task_names, config, unfinished)
+    saved = merge_tables([read_results(path) for path in config.results])
+    table = _print_table(markdown_table(curves_from_rows(saved.rows)), config)
+    _write_figures(saved.rows, saved.task_names, config, saved.unfinished)
     return table
 
 

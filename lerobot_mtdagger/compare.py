@@ -213,6 +213,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     if unknown:
         raise UserError(f"Unknown method(s) {unknown} in --methods; choose among {list(known)}.")
     from lerobot_mtdagger.envs import suite_from_config
+    from lerobot_mtdagger.report import check_comparable
     from lerobot_mtdagger.results import results_rows, write_results
 
     task_names = suite_from_config(base_run_config(run_args)).task_names
@@ -237,5 +238,5 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     with ThreadPoolExecutor(max_workers=parallel) as pool:
         folders = list(pool.map(lambda job: run_job(job, runs_dir, threads, workers), jobs))
     rows = results_rows(folders)
-    write_results(rows, compare_config.output_dir, task_names)
+    write_results(rows, compare_config.output_dir, task_names, configs=check_comparable(folders))
     return rows

@@ -181,11 +181,14 @@ def average_runs(runs: Sequence[RunPoints]) -> list[CurvePoint]:
     return curves
 
 
-def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> None:
+def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> dict[str, dict]:
     """Refuses to group runs of one method whose configs differ in more than ``PER_RUN_FIELDS``.
 
     BC runs may also differ in ``BC_BUDGET_FIELDS`` (one BC run per budget). A run given a label in
     ``labels`` is grouped under that label, not under its method.
+
+    Returns:
+        The config each method's runs share (without those fields), by method name.
 
     Raises:
         ValueError: Naming the method, the differing fields with their values and two such runs.
@@ -205,14 +208,20 @@ def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = 
             first_of_method[method] = (root, shared)
             continue
         other_root, other = first_of_method[method]
-        differing = sorted(key for key in set(shared) | set(other) if shared.get(key) != other.get(key))
+        differing = config_differences(other, shared)
         if differing:
-            details = ", ".join(f"{key}: {other.get(key)!r} vs {shared.get(key)!r}" for key in differing)
             raise UserError(
-                f"Refusing to average {method} runs with different configs ({details}) in {other_root} "
+                f"Refusing to average {method} runs with different configs ({differing}) in {other_root} "
                 f"and {root}: report them separately, give one set a label of its own (report "
                 "--variants), or rerun them with the same options."
             )
+    return {method: shared for method, (_, shared) in first_of_method.items()}
+
+
+def config_differences(first: Mapping, second: Mapping) -> str:
+    """``"key: a vs b, ..."`` for every top-level key whose value differs (empty when none does)."""
+    differing = sorted(key for key in set(first) | set(second) if first.get(key) != second.get(key))
+    return ", ".join(f"{key}: {first.get(key)!r} vs {second.get(key)!r}" for key in differing)
 
 
 def markdown_table(curves: Sequence[CurvePoint]) -> str:

@@ -3,14 +3,15 @@
 A row describes the policy trained on rounds 0..k of one run: its method and seed, the expert data
 behind it (demos and expert-labelled frames per task, cumulative), its evaluation success, the
 scheduler's signals at that point and the wall time of the round. ``write_results`` stores the rows
-as CSV (list columns as JSON) and JSON next to the runs, with the task names (and, for a study in
-progress, its unfinished runs) in ``results_meta.json``; ``read_results`` reads them back, so a
-report can be redrawn from the saved table alone, when the run folders are gone::
+as CSV (list columns as JSON) and JSON next to the runs, with the task names, the config each
+method's runs share and, for a study in progress, its unfinished runs in ``results_meta.json``.
+``read_results`` reads them back and ``merge_tables`` joins tables made apart (other seeds, other
+machines), so a report can be drawn from saved tables alone, when the run folders are gone::
 
     <folder>/
         results.csv         one row per run x evaluated phase, list columns as JSON
         results.json        the same rows as a JSON list (what ``read_results`` reads)
-        results_meta.json   {"task_names": [...], "unfinished": [...]}
+        results_meta.json   {"task_names": [...], "unfinished": [...], "configs": {method: config}}
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from __future__ import annotations
 import csv
 import json
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +27,7 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.report import config_differences
 from lerobot_mtdagger.rounds import ExperimentDir
 
 RESULTS_FILE = "results.json"
@@ -118,13 +121,19 @@ def results_rows(roots: Sequence[Path], labels: Mapping[Path, str] | None = None
     """
     labels = labels or {}
     rows = [row for root in roots for row in experiment_rows(Path(root), labels.get(Path(root)))]
-    return sorted(rows, key=lambda r: (r["method"], r["seed"], r["demos_per_task_mean"], r["round"]))
+    return sorted(rows, key=_row_order)
+
+
+def _row_order(row: Mapping[str, Any]) -> tuple:
+    """Rows sort by method, seed, demos per task and round."""
+    return (row["method"], row["seed"], row["demos_per_task_mean"], row["round"])
 
 
 def write_results(
     rows: Sequence[dict[str, Any]],
     folder: Path,
     task_names: Sequence[str],
+    configs: Mapping[str, dict],
     unfinished: Sequence[str] = (),
 ) -> tuple[Path, Path]:
     """Writes ``results.csv``, ``results.json`` and ``results_meta.json`` into ``folder``.
@@ -133,6 +142,7 @@ def write_results(
         rows: The rows (``results_rows``).
         folder: Where they go (made if missing).
         task_names: The suite's task names in task-index order (the per-task columns' order).
+        configs: The config each method's runs share (``report.check_comparable``).
         unfinished: One line per unfinished run of a study in progress (``RunProgress.describe``).
 
     Returns:
@@ -146,7 +156,7 @@ def write_results(
     folder.mkdir(parents=True, exist_ok=True)
     json_path, csv_path = folder / RESULTS_FILE, folder / "results.csv"
     json_path.write_text(json.dumps(list(rows), indent=1))
-    meta = {"task_names": list(task_names), "unfinished": list(unfinished)}
+    meta = {"task_names": list(task_names), "unfinished": list(unfinished), "configs": dict(configs)}
     (folder / META_FILE).write_text(json.dumps(meta, indent=1))
     with csv_path.open("w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
@@ -156,8 +166,27 @@ def write_results(
     return csv_path, json_path
 
 
-def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str], list[str]]:
-    """Reads a saved results table: ``(rows, task_names, unfinished)``.
+@dataclass
+class SavedTable:
+    """A results table read back from disk (``read_results``) or joined from several (``merge_tables``).
+
+    Attributes:
+        rows: One row per run and evaluated phase.
+        task_names: The task of each per-task column, in task-index order.
+        unfinished: One line per run that was unfinished when the table was written.
+        configs: The config each method's runs share; None for a table written before they were saved.
+        source: Where it was read from (for messages).
+    """
+
+    rows: list[dict[str, Any]]
+    task_names: list[str]
+    unfinished: list[str]
+    configs: dict[str, dict] | None
+    source: str
+
+
+def read_results(path: Path) -> SavedTable:
+    """Reads a saved results table.
 
     Args:
         path: A ``results.json`` written by ``write_results`` (``report`` or ``compare``), or the folder
@@ -179,20 +208,89 @@ def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str], list[str]
     rows = _read_json(json_path)
     if not isinstance(rows, list) or not rows or not all(isinstance(row, dict) for row in rows):
         raise UserError(
-            f"{json_path} holds no results rows (a JSON list of objects): rewrite it with report."
+            f"{json_path} holds no results rows (a JSON list of objects); rewrite it with report."
         )
     missing = sorted({column for row in rows for column in REQUIRED_COLUMNS if column not in row})
     if missing:
         raise UserError(f"{json_path}: rows lack the column(s) {missing}; rewrite it with report.")
     meta = _read_json(meta_path)
-    task_names = meta.get("task_names") if isinstance(meta, dict) else None
+    meta = meta if isinstance(meta, dict) else {}
+    task_names = meta.get("task_names")
     width = {len(row["eval_success"]) for row in rows}
     if not isinstance(task_names, list) or width != {len(task_names)}:
         raise UserError(
             f"{meta_path} must name the {sorted(width)} task(s) of the rows' per-task columns in "
             '"task_names": rewrite it with report.'
         )
-    return rows, [str(name) for name in task_names], [str(line) for line in meta.get("unfinished", [])]
+    return SavedTable(
+        rows=rows,
+        task_names=[str(name) for name in task_names],
+        unfinished=[str(line) for line in meta.get("unfinished", [])],
+        configs=meta.get("configs"),
+        source=str(json_path),
+    )
+
+
+def merge_tables(tables: Sequence[SavedTable]) -> SavedTable:
+    """Joins tables made apart (other seeds, other machines) into one, refusing what would mislead.
+
+    Raises:
+        UserError: If the tables name different tasks, one was written without the methods' configs,
+            a method's runs were made with different configs, or two tables hold the same point
+            (method, seed, demos per task, round), which the mean would count twice.
+    """
+    if len(tables) == 1:
+        return tables[0]
+    first = tables[0]
+    for table in tables:
+        if table.task_names != first.task_names:
+            raise UserError(
+                f"{table.source} and {first.source} name different tasks ({table.task_names} vs "
+                f"{first.task_names}): report them separately."
+            )
+        if table.configs is None:
+            raise UserError(
+                f"{table.source} was written without the methods' configs, so it cannot be checked against "
+                "the other tables: report it alone, or rewrite it with report from its runs."
+            )
+    configs: dict[str, dict] = {}
+    sources: dict[str, str] = {}
+    for table in tables:
+        for method, config in table.configs.items():
+            differing = config_differences(configs.get(method, config), config)
+            if differing:
+                raise UserError(
+                    f"Refusing to join {method} runs with different configs ({differing}) from "
+                    f"{sources[method]} and {table.source}: report them separately."
+                )
+            configs.setdefault(method, config)
+            sources.setdefault(method, table.source)
+    return SavedTable(
+        rows=_join_rows(tables),
+        task_names=first.task_names,
+        unfinished=[line for table in tables for line in table.unfinished],
+        configs=configs,
+        source=" + ".join(table.source for table in tables),
+    )
+
+
+def _join_rows(tables: Sequence[SavedTable]) -> list[dict[str, Any]]:
+    """The rows of every table, sorted as ``results_rows`` sorts them.
+
+    Raises:
+        UserError: If two tables hold the same (method, seed, demos per task, round).
+    """
+    seen: dict[tuple, str] = {}
+    for table in tables:
+        for row in table.rows:
+            key = _row_order(row)
+            if key in seen:
+                raise UserError(
+                    f"{seen[key]} and {table.source} both hold {key[0]} seed {key[1]} at {key[2]:g} demos "
+                    "per task: a point in two tables would be counted twice; give each table other seeds."
+                )
+            seen[key] = table.source
+    return sorted((row for table in tables for row in table.rows), key=_row_order)
 
 
 def _read_json(path: Path) -> Any:

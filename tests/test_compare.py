@@ -139,7 +139,7 @@ def test_report_redrawn_from_the_saved_table_alone_equals_the_report_of_the_runs
     saved = _saved_table(tmp_path / "of-runs", tmp_path / "saved")
     rows_before = (saved / "results.json").read_bytes()
 
-    assert main(["report", f"--results={saved / 'results.json'}"]) == 0
+    assert main(["report", f"--results=[{saved / 'results.json'}]"]) == 0
 
     assert capsys.readouterr().out.split("figures and summary")[0] == table_of_runs
     assert (saved / "report.md").read_text() == (tmp_path / "of-runs" / "report.md").read_text()
@@ -147,7 +147,9 @@ def test_report_redrawn_from_the_saved_table_alone_equals_the_report_of_the_runs
         assert (saved / name).stat().st_size > 10_000, name
     assert (saved / "results.json").read_bytes() == rows_before  # the input is never rewritten
     meta = json.loads((folder / "results_meta.json").read_text())  # compare's own table has it too
-    assert meta == {"task_names": ["toy-left", "toy-right", "toy-up-windy"], "unfinished": []}
+    assert meta["task_names"] == ["toy-left", "toy-right", "toy-up-windy"] and meta["unfinished"] == []
+    assert sorted(meta["configs"]) == ["bc", "gain", "need", "need_raw", "uniform"]
+    assert meta["configs"]["need"]["eval_episodes"] == 2 and "seed" not in meta["configs"]["need"]
 
 
 def test_a_redrawn_interim_report_still_lists_the_unfinished_runs(compared, tmp_path):
@@ -158,7 +160,7 @@ def test_a_redrawn_interim_report_still_lists_the_unfinished_runs(compared, tmp_
     assert main(["report", f"--compare_dir={study}"]) == 0
     saved = _saved_table(study / "report", tmp_path / "saved")
 
-    assert main(["report", f"--results={saved}", "--levels=[0.5]"]) == 0
+    assert main(["report", f"--results=[{saved}]", "--levels=[0.5]"]) == 0
 
     summary = (saved / "report.md").read_text()
     assert (
@@ -187,17 +189,100 @@ def test_report_refuses_a_damaged_saved_table_and_names_the_file(compared, tmp_p
     folder, _ = compared
     saved = _saved_table(folder, tmp_path / "saved")
     damage(saved)
-    assert main(["report", f"--results={saved}"]) == 2
+    assert main(["report", f"--results=[{saved}]"]) == 2
     assert re.search(message, capsys.readouterr().err)
     assert not (saved / "report.md").exists()
 
 
 def test_report_results_goes_alone(compared, tmp_path, capsys):
     folder, _ = compared
-    assert main(["report", f"--results={folder}", f"--compare_dir={folder}"]) == 2
+    assert main(["report", f"--results=[{folder}]", f"--compare_dir={folder}"]) == 2
     assert "give it alone" in capsys.readouterr().err
-    assert main(["report", f"--results={tmp_path / 'nowhere'}"]) == 2
+    assert main(["report", f"--results=[{tmp_path / 'nowhere'}]"]) == 2
     assert "nowhere does not exist: pass the results.json" in capsys.readouterr().err
+    assert main(["report", f"--results=[{folder},{folder}]"]) == 2
+    assert "give --output_dir for the joined report" in capsys.readouterr().err
+
+
+@pytest.fixture(scope="module")
+def seed_tables(compared, tmp_path_factory):
+    """The comparison saved as two tables, one per seed, as if each seed ran on its own machine."""
+    folder, _ = compared
+    tables = tmp_path_factory.mktemp("seed-tables")
+    for seed in (0, 1):
+        runs = ",".join(str(run) for run in sorted((folder / "runs").glob(f"*-seed{seed}")) if run.is_dir())
+        assert main(["report", f"--experiments=[{runs}]", f"--output_dir={tables / f'seed{seed}'}"]) == 0
+        for name in ("report.md", *FIGURES):  # keep the saved table alone
+            (tables / f"seed{seed}" / name).unlink()
+    return tables
+
+
+def test_tables_of_seeds_run_apart_join_into_the_report_of_all_runs(compared, seed_tables, tmp_path, capsys):
+    folder, _ = compared
+    assert main(["report", f"--compare_dir={folder}", f"--output_dir={tmp_path / 'of-runs'}"]) == 0
+    capsys.readouterr()
+    joined = tmp_path / "joined"
+
+    assert (
+        main(
+            [
+                "report",
+                f"--results=[{seed_tables / 'seed0'},{seed_tables / 'seed1'}]",
+                f"--output_dir={joined}",
+            ]
+        )
+        == 0
+    )
+
+    assert (joined / "report.md").read_text() == (tmp_path / "of-runs" / "report.md").read_text()
+    assert "| need | 2 | 5.0 | " in capsys.readouterr().out  # both seeds in each point
+    assert sorted(p.name for p in seed_tables.glob("seed0/*")) == [
+        "results.csv",
+        "results.json",
+        "results_meta.json",
+    ]
+
+
+def _with_meta(table: Path, folder: Path, change) -> Path:
+    """A copy of a saved table whose results_meta.json is changed by ``change(meta)``."""
+    shutil.copytree(table, folder)
+    meta = json.loads((folder / "results_meta.json").read_text())
+    change(meta)
+    (folder / "results_meta.json").write_text(json.dumps(meta))
+    return folder
+
+
+@pytest.mark.parametrize(
+    ("other_table", "message"),
+    [
+        (
+            lambda tables, copy: tables / "seed0",
+            r"seed0/results.json both hold bc seed 0 at 1 demos per task",
+        ),
+        (
+            lambda tables, copy: _with_meta(
+                tables / "seed1", copy, lambda meta: meta["configs"]["need"].update(eval_episodes=20)
+            ),
+            r"Refusing to join need runs with different configs \(eval_episodes: 2 vs 20\)",
+        ),
+        (
+            lambda tables, copy: _with_meta(tables / "seed1", copy, lambda meta: meta.pop("configs")),
+            "was written without the methods' configs",
+        ),
+        (
+            lambda tables, copy: _with_meta(
+                tables / "seed1", copy, lambda meta: meta.update(task_names=["a", "b", "c"])
+            ),
+            "name different tasks",
+        ),
+    ],
+)
+def test_tables_that_would_mislead_are_not_joined(seed_tables, tmp_path, capsys, other_table, message):
+    other = other_table(seed_tables, tmp_path / "other")
+    out = tmp_path / "joined"
+    assert main(["report", f"--results=[{seed_tables / 'seed0'},{other}]", f"--output_dir={out}"]) == 2
+    assert re.search(message, capsys.readouterr().err)
+    assert not out.exists()
 
 
 def test_bc_budgets_map_to_rounds_and_bad_ones_are_refused():
