@@ -4,7 +4,7 @@ The first attempt's run folders were lost with its machine; its seed-0 curves su
 table in ``README.md`` (average evaluation success at each budget, three decimals), copied below.
 The restart runs the same frozen code with the same settings and seeds, so every point it has made
 must equal the lost one. Reads the saved table of the interim or final report; prints each point
-that both have, and exits 1 if any differs. From the repository root, after ``snapshot.sh``:
+that both have, and exits 1 if any differs. From the repository root, after ``snapshot.py``:
 
     .venv/bin/python docs/results/mt50-state-eval/check_restart.py
 """
@@ -30,10 +30,9 @@ LOST_SEED0 = {
 
 def restarted_seed0(report: Path) -> dict[tuple[str, int], float]:
     """``(method, demos per task) -> eval success`` of the restart's seed-0 rows."""
-    rows, _, _ = read_results(report)
     return {
         (row["method"], round(row["demos_per_task_mean"])): row["eval_success_mean"]
-        for row in rows
+        for row in read_results(report).rows
         if row["seed"] == 0 and row["method"] in LOST_SEED0
     }
 
