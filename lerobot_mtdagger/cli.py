@@ -8,6 +8,9 @@ Commands:
         ``--rounds``, ``--budget``, ``--output_dir``, ``--resume``, ...; see ``RunConfig``), or the
         one-round behaviour-cloning baseline with ``--mode=bc``.
     eval: success per task of a pretrained policy (``--policy_path``, ``--suite``, ``--episodes``).
+    shift: covariate shift of a pretrained policy: its action error on the states of its own rollouts
+        against on the expert's, per task (the options of ``eval``); tells whether DAgger's
+        relabelled rollouts have much to add over more demonstrations.
     verify: recompute every round's allocation from its record (``--experiment_dir``).
     merge: rounds 0..k as one LeRobotDataset (``--experiment_dir``, ``--output``).
     compare: every method over every seed, and BC at every budget, as runs in a process pool, then
@@ -30,6 +33,7 @@ import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -40,6 +44,9 @@ from lerobot_mtdagger.hub import PushConfig, push_command
 from lerobot_mtdagger.parsing import parse_options
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
 from lerobot_mtdagger.simulate import SyntheticTasks, simulate
+
+if TYPE_CHECKING:
+    from lerobot_mtdagger.shift import ShiftResult
 
 logger = logging.getLogger(__name__)
 
@@ -247,6 +254,51 @@ def eval_command(config: EvalConfig) -> dict:
 
 
 @dataclass
+class ShiftConfig(EvalConfig):
+    """Options of ``lerobot-mtdagger shift``: a policy's action error on its own states vs the expert's.
+
+    The attributes are ``EvalConfig``'s; ``episodes`` episodes per task are run by the policy and
+    again by the expert from the same reset seeds (``shift.measure_shift``).
+    """
+
+    episodes: int = 5
+
+
+def shift_command(config: ShiftConfig) -> dict:
+    """Measures a pretrained policy's covariate shift per task and prints it."""
+    from lerobot_mtdagger.envs import suite_from_config
+    from lerobot_mtdagger.evaluate import PolicyRunner
+    from lerobot_mtdagger.shift import measure_shift
+    from lerobot_mtdagger.workers import EnvWorkers
+
+    suite = suite_from_config(config)
+    runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
+    runner.check_inputs(suite.features, config.obs_mode)
+    with EnvWorkers(suite, config.worker_count) as workers:
+        result = measure_shift(workers, runner, config.episodes, config.seed)
+    print(shift_table(result))
+    if config.output is not None:
+        config.output.write_text(json.dumps(result.to_dict(), indent=2))
+    return result.to_dict()
+
+
+def shift_table(result: ShiftResult) -> str:
+    """One line per task: success, mean squared action error on own and expert states, their ratio."""
+    lines = [f"{'task':<32} {'success':>7} {'own states':>10} {'expert states':>13} {'own/expert':>10}"]
+    rows = zip(
+        result.task_names, result.success, result.own_error, result.expert_error, result.ratio, strict=True
+    )
+    for task, success, own, expert, ratio in rows:
+        lines.append(f"{task:<32} {success:7.3f} {own:10.4f} {expert:13.4f} {ratio:10.2f}")
+    own, expert = float(np.mean(result.own_error)), float(np.mean(result.expert_error))
+    lines.append(
+        f"{'mean':<32} {np.mean(result.success):7.3f} {own:10.4f} {expert:13.4f} {result.mean_ratio:10.2f}"
+    )
+    lines.append(f"median task's own/expert ratio: {result.median_ratio:.2f}")
+    return "\n".join(lines)
+
+
+@dataclass
 class ReportConfig:
     """Options of ``lerobot-mtdagger report``: success against expert demos, method by method.
 
@@ -430,6 +482,7 @@ COMMANDS: dict[str, tuple[type, Callable]] = {
     "run": (RunConfig, run_experiment),
     "compare": (CompareConfig, compare_command),
     "eval": (EvalConfig, eval_command),
+    "shift": (ShiftConfig, shift_command),
     "verify": (VerifyConfig, verify_command),
     "merge": (MergeConfig, merge_command),
     "push": (PushConfig, push_command),

@@ -1,0 +1,182 @@
+"""Covariate shift of a policy: its action error on the states it reaches against on the expert's states.
+
+DAgger's premise is that a policy trained on expert states errs more on the states its own actions
+lead to than on expert states, and that labelling those states fixes it. ``measure_shift`` measures
+that gap for a trained policy, per task, on the evaluation reset seeds (which no training episode
+uses), without training anything:
+
+- the policy's own rollouts (it acts throughout, as in evaluation), with the expert labelling every
+  state: the squared action error ``|pi(s) - pi*(s)|^2`` on the policy's own states, split into its
+  successful and its failed episodes, and its success (equal to ``evaluate``'s on the same episodes);
+- the expert's rollouts from the same reset seeds: the policy's error on the expert's states.
+
+Errors are averaged over a task's frames. The ratio own / expert per task is the covariate shift
+factor: near 1, the policy meets no state it has not learnt to act in, and relabelled rollouts have
+little to add over more demonstrations; well above 1, its own states are where it goes wrong. Like
+evaluation, episodes end at the first success.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from lerobot_mtdagger.collect import EVAL_STREAM, PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.workers import EnvWorkers, Episode
+
+
+@dataclass
+class ShiftResult:
+    """Per-task action errors of a policy on its own states and on the expert's.
+
+    Attributes:
+        task_names: The suite's tasks.
+        success: The policy's success rate per task on the measured episodes.
+        own_error: Mean squared action error per frame on the policy's own states.
+        own_error_succeeded: The same on its successful episodes only (None: none succeeded).
+        own_error_failed: The same on its failed episodes only (None: none failed).
+        expert_error: Mean squared action error per frame on the expert's states.
+        episodes: Episodes per task, of the policy and of the expert each.
+        seed: Seed of the evaluation episodes.
+    """
+
+    task_names: list[str]
+    success: list[float]
+    own_error: list[float]
+    own_error_succeeded: list[float | None]
+    own_error_failed: list[float | None]
+    expert_error: list[float]
+    episodes: int
+    seed: int
+
+    @property
+    def ratio(self) -> list[float]:
+        """Own / expert error per task (1.0 where both are 0, inf where only the expert's is)."""
+        return [
+            shift_ratio(own, expert) for own, expert in zip(self.own_error, self.expert_error, strict=True)
+        ]
+
+    @property
+    def mean_ratio(self) -> float:
+        """Mean own error over tasks / mean expert error over tasks."""
+        return shift_ratio(float(np.mean(self.own_error)), float(np.mean(self.expert_error)))
+
+    @property
+    def median_ratio(self) -> float:
+        """The median task's own / expert ratio (robust to a few stuck tasks)."""
+        return float(np.median(self.ratio))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form (an infinite ratio is written as null)."""
+        return {
+            "task_names": self.task_names,
+            "success": self.success,
+            "own_error": self.own_error,
+            "own_error_succeeded": self.own_error_succeeded,
+            "own_error_failed": self.own_error_failed,
+            "expert_error": self.expert_error,
+            "ratio": [value if math.isfinite(value) else None for value in self.ratio],
+            "mean_ratio": self.mean_ratio if math.isfinite(self.mean_ratio) else None,
+            "median_ratio": self.median_ratio if math.isfinite(self.median_ratio) else None,
+            "episodes": self.episodes,
+            "seed": self.seed,
+        }
+
+
+def shift_ratio(own: float, expert: float) -> float:
+    """``own / expert``; 1.0 when both are 0 (no error anywhere), inf when only ``expert`` is 0."""
+    if expert > 0.0:
+        return own / expert
+    return 1.0 if own == 0.0 else math.inf
+
+
+def measure_shift(workers: EnvWorkers, policy: PolicyFn, episodes_per_task: int, seed: int) -> ShiftResult:
+    """Measures a policy's action error on its own states and on the expert's, per task.
+
+    Args:
+        workers: The env workers (their suite gives the tasks and the experts).
+        policy: The policy (``PolicyRunner`` or any callable of observations and task names).
+        episodes_per_task: Episodes per task, run once by the policy and once by the expert.
+        seed: Seed of the evaluation episodes (``evaluate``'s episodes for the same seed).
+
+    Returns:
+        The per-task success and errors.
+
+    Raises:
+        ValueError: If ``episodes_per_task`` is not positive.
+    """
+    if episodes_per_task <= 0:
+        raise ValueError(f"episodes_per_task must be > 0, got {episodes_per_task}.")
+    task_names = list(workers.suite.task_names)
+    counts = [episodes_per_task] * len(task_names)
+    own = _labelled_rollouts(workers, counts, policy, seed)
+    expert = _labelled_rollouts(workers, counts, None, seed)
+    own_errors = _episode_errors(policy, own, task_names)
+    expert_errors = _episode_errors(policy, expert, task_names)
+    rates, _ = success_by_task(own, len(task_names))
+    tasks = range(len(task_names))
+    return ShiftResult(
+        task_names=task_names,
+        success=[rate if rate is not None else 0.0 for rate in rates],
+        own_error=[_every_episode_mean(own_errors, own, task) for task in tasks],
+        own_error_succeeded=[_task_mean(own_errors, own, task, success=True) for task in tasks],
+        own_error_failed=[_task_mean(own_errors, own, task, success=False) for task in tasks],
+        expert_error=[_every_episode_mean(expert_errors, expert, task) for task in tasks],
+        episodes=episodes_per_task,
+        seed=seed,
+    )
+
+
+def _labelled_rollouts(
+    workers: EnvWorkers, counts: Sequence[int], policy: PolicyFn | None, seed: int
+) -> list[Episode]:
+    """Recorded evaluation episodes with the expert's label at every state; the expert acts if no policy."""
+    return run_episodes(
+        workers,
+        counts,
+        policy=policy,
+        beta=1.0 if policy is None else 0.0,
+        seed=seed,
+        round_index=0,
+        stream=EVAL_STREAM,
+        record=True,
+        max_steps=None,
+        steps_after_success=0,
+    )
+
+
+def _episode_errors(policy: PolicyFn, episodes: Sequence[Episode], task_names: list[str]) -> list[np.ndarray]:
+    """``|pi(s) - label|^2`` at every frame of each recorded episode, the policy queried once per episode."""
+    errors = []
+    for episode in episodes:
+        frames = episode.frames
+        predicted = np.asarray(
+            policy(frames, [task_names[episode.task_index]] * len(frames)), dtype=np.float64
+        )
+        labels = np.stack([np.asarray(frame["action"], dtype=np.float64) for frame in frames])
+        errors.append(np.sum((predicted - labels) ** 2, axis=1))
+    return errors
+
+
+def _task_mean(
+    errors: Sequence[np.ndarray], episodes: Sequence[Episode], task: int, success: bool | None = None
+) -> float | None:
+    """Mean error per frame over a task's episodes (only those with ``success`` if given; None: none)."""
+    chosen = [
+        error
+        for error, episode in zip(errors, episodes, strict=True)
+        if episode.task_index == task and (success is None or episode.success == success)
+    ]
+    return float(np.mean(np.concatenate(chosen))) if chosen else None
+
+
+def _every_episode_mean(errors: Sequence[np.ndarray], episodes: Sequence[Episode], task: int) -> float:
+    """Mean error per frame over all of a task's episodes (every task has some)."""
+    mean = _task_mean(errors, episodes, task)
+    if mean is None:
+        raise ValueError(f"No episode of task {task} was measured.")
+    return mean
