@@ -1,0 +1,78 @@
+"""How much covariate shift do the study's policies meet? Their error on their own states vs the expert's.
+
+``lerobot-mtdagger shift`` (``shift.measure_shift``) for BC at several budgets and Uniform DAgger's
+policy at the same demos per task, seed 0 of the study, on the first ``EPISODES`` evaluation episodes
+of every task (reset seeds no policy trained on). Per task: the squared action error
+``|pi(s) - pi*(s)|^2`` on the states of the policy's own rollouts (also split into its successful and
+failed episodes) and on the expert's rollouts from the same reset seeds; then averaged over tasks.
+From the repository root, after the study's seed 0 (one core; about two minutes per policy):
+
+    .venv/bin/python docs/results/mt50-state-eval/covariate_shift.py
+
+It prints a table (kept in ``covariate_shift.txt``) and writes every per-task value to
+``covariate_shift.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.evaluate import PolicyRunner
+from lerobot_mtdagger.shift import ShiftResult, measure_shift
+from lerobot_mtdagger.workers import EnvWorkers
+
+RUNS = Path("outputs/mt50-state-eval/runs")
+OUTPUT = Path("docs/results/mt50-state-eval/covariate_shift.json")
+EPISODES = 5
+SEED = 0
+BC_BUDGETS = (3, 6, 12, 21, 33)
+UNIFORM_PHASES = (1, 3, 6, 10)  # 3 (phase + 1) demos per task
+POLICIES = [
+    *[(f"BC, {d} demos", RUNS / f"bc-{d}demos-seed{SEED}" / "policies" / "round-000") for d in BC_BUDGETS],
+    *[
+        (f"uniform, {3 * (p + 1)} demos", RUNS / f"uniform-seed{SEED}" / "policies" / f"round-{p:03d}")
+        for p in UNIFORM_PHASES
+    ],
+]
+
+
+def summary_line(label: str, result: ShiftResult) -> str:
+    """One table row: success, mean errors over tasks, ratio of the means, median per-task ratio."""
+    succeeded = np.mean([e for e in result.own_error_succeeded if e is not None])
+    failed = np.mean([e for e in result.own_error_failed if e is not None])
+    return (
+        f"| {label} | {np.mean(result.success):.3f} | {np.mean(result.own_error):.3f} | {succeeded:.3f} "
+        f"| {failed:.3f} | {np.mean(result.expert_error):.3f} | {result.mean_ratio:.1f} "
+        f"| {result.median_ratio:.1f} |"
+    )
+
+
+def main() -> int:
+    """Prints one table row per policy and writes every per-task value to ``OUTPUT``."""
+    torch.set_num_threads(1)
+    config = json.loads((POLICIES[0][1].parents[1] / "config.json").read_text())
+    suite = make_suite(config["suite"], obs_mode=config["obs_mode"])
+    print(f"{len(suite.task_names)} tasks, {EPISODES} evaluation episodes per task (seed {SEED})\n")
+    print(
+        "| policy | success | error, own states | own, successful episodes | own, failed episodes "
+        "| error, expert states | own / expert (means) | own / expert (median task) |"
+    )
+    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    results = {}
+    with EnvWorkers(suite, 0) as workers:
+        for label, folder in POLICIES:
+            result = measure_shift(workers, PolicyRunner.from_pretrained(folder), EPISODES, SEED)
+            results[label] = result.to_dict()
+            print(summary_line(label, result), flush=True)
+    OUTPUT.write_text(json.dumps(results, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
