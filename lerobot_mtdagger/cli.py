@@ -295,6 +295,14 @@ def shift_table(result: ShiftResult) -> str:
         f"{'mean':<32} {np.mean(result.success):7.3f} {own:10.4f} {expert:13.4f} {result.mean_ratio:10.2f}"
     )
     lines.append(f"median task's own/expert ratio: {result.median_ratio:.2f}")
+    own_by_dimension = np.mean(result.own_error_by_dimension, axis=0)
+    expert_by_dimension = np.mean(result.expert_error_by_dimension, axis=0)
+    lines.append(
+        f"mean error per action dimension, own states:    {np.array2string(own_by_dimension, precision=4)}"
+    )
+    lines.append(
+        f"mean error per action dimension, expert states: {np.array2string(expert_by_dimension, precision=4)}"
+    )
     return "\n".join(lines)
 
 

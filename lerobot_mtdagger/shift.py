@@ -40,6 +40,8 @@ class ShiftResult:
         own_error_succeeded: The same on its successful episodes only (None: none succeeded).
         own_error_failed: The same on its failed episodes only (None: none failed).
         expert_error: Mean squared action error per frame on the expert's states.
+        own_error_by_dimension: ``own_error`` per action dimension (it sums to ``own_error``).
+        expert_error_by_dimension: ``expert_error`` per action dimension.
         episodes: Episodes per task, of the policy and of the expert each.
         seed: Seed of the evaluation episodes.
     """
@@ -50,12 +52,14 @@ class ShiftResult:
     own_error_succeeded: list[float | None]
     own_error_failed: list[float | None]
     expert_error: list[float]
+    own_error_by_dimension: list[list[float]]
+    expert_error_by_dimension: list[list[float]]
     episodes: int
     seed: int
 
     @property
     def ratio(self) -> list[float]:
-        """Own / expert error per task (1.0 where both are 0, inf where only the expert's is)."""
+        """Own / expert error per task (1.0 where both are 0, inf where only the expert's is 0)."""
         return [
             shift_ratio(own, expert) for own, expert in zip(self.own_error, self.expert_error, strict=True)
         ]
@@ -79,6 +83,8 @@ class ShiftResult:
             "own_error_succeeded": self.own_error_succeeded,
             "own_error_failed": self.own_error_failed,
             "expert_error": self.expert_error,
+            "own_error_by_dimension": self.own_error_by_dimension,
+            "expert_error_by_dimension": self.expert_error_by_dimension,
             "ratio": [value if math.isfinite(value) else None for value in self.ratio],
             "mean_ratio": self.mean_ratio if math.isfinite(self.mean_ratio) else None,
             "median_ratio": self.median_ratio if math.isfinite(self.median_ratio) else None,
@@ -122,10 +128,14 @@ def measure_shift(workers: EnvWorkers, policy: PolicyFn, episodes_per_task: int,
     return ShiftResult(
         task_names=task_names,
         success=[rate if rate is not None else 0.0 for rate in rates],
-        own_error=[_every_episode_mean(own_errors, own, task) for task in tasks],
-        own_error_succeeded=[_task_mean(own_errors, own, task, success=True) for task in tasks],
-        own_error_failed=[_task_mean(own_errors, own, task, success=False) for task in tasks],
-        expert_error=[_every_episode_mean(expert_errors, expert, task) for task in tasks],
+        own_error=[float(_every_episode_mean(own_errors, own, task).sum()) for task in tasks],
+        own_error_succeeded=[_total(_task_mean(own_errors, own, task, success=True)) for task in tasks],
+        own_error_failed=[_total(_task_mean(own_errors, own, task, success=False)) for task in tasks],
+        expert_error=[float(_every_episode_mean(expert_errors, expert, task).sum()) for task in tasks],
+        own_error_by_dimension=[_every_episode_mean(own_errors, own, task).tolist() for task in tasks],
+        expert_error_by_dimension=[
+            _every_episode_mean(expert_errors, expert, task).tolist() for task in tasks
+        ],
         episodes=episodes_per_task,
         seed=seed,
     )
@@ -150,33 +160,44 @@ def _labelled_rollouts(
 
 
 def _episode_errors(policy: PolicyFn, episodes: Sequence[Episode], task_names: list[str]) -> list[np.ndarray]:
-    """``|pi(s) - label|^2`` at every frame of each recorded episode, the policy queried once per episode."""
+    """``(pi(s) - label)^2`` per frame and action dimension, (frames, dims), of each recorded episode.
+
+    The policy is queried once per episode, on all of its frames.
+    """
     errors = []
     for episode in episodes:
         frames = episode.frames
-        predicted = np.asarray(
-            policy(frames, [task_names[episode.task_index]] * len(frames)), dtype=np.float64
-        )
+        tasks = [task_names[episode.task_index]] * len(frames)
+        predicted = np.asarray(policy(frames, tasks), dtype=np.float64)
         labels = np.stack([np.asarray(frame["action"], dtype=np.float64) for frame in frames])
-        errors.append(np.sum((predicted - labels) ** 2, axis=1))
+        errors.append((predicted - labels) ** 2)
     return errors
 
 
 def _task_mean(
     errors: Sequence[np.ndarray], episodes: Sequence[Episode], task: int, success: bool | None = None
-) -> float | None:
-    """Mean error per frame over a task's episodes (only those with ``success`` if given; None: none)."""
+) -> np.ndarray | None:
+    """Mean error per frame and dimension over a task's episodes (those with ``success`` if given).
+
+    Returns:
+        The mean per action dimension, or None without an episode.
+    """
     chosen = [
         error
         for error, episode in zip(errors, episodes, strict=True)
         if episode.task_index == task and (success is None or episode.success == success)
     ]
-    return float(np.mean(np.concatenate(chosen))) if chosen else None
+    return np.concatenate(chosen).mean(axis=0) if chosen else None
 
 
-def _every_episode_mean(errors: Sequence[np.ndarray], episodes: Sequence[Episode], task: int) -> float:
-    """Mean error per frame over all of a task's episodes (every task has some)."""
+def _every_episode_mean(errors: Sequence[np.ndarray], episodes: Sequence[Episode], task: int) -> np.ndarray:
+    """Mean error per frame and dimension over all of a task's episodes (every task has some)."""
     mean = _task_mean(errors, episodes, task)
     if mean is None:
         raise ValueError(f"No episode of task {task} was measured.")
     return mean
+
+
+def _total(per_dimension: np.ndarray | None) -> float | None:
+    """The squared error summed over action dimensions (None stays None)."""
+    return None if per_dimension is None else float(per_dimension.sum())

@@ -64,6 +64,9 @@ def test_a_policy_that_acts_as_the_expert_has_no_error_anywhere(suite):
 def test_a_policy_wrong_everywhere_alike_meets_no_shift(suite):
     result = shift_of(suite, biased)
     assert result.own_error == pytest.approx([0.02] * 3) and result.expert_error == pytest.approx([0.02] * 3)
+    assert np.allclose(result.own_error_by_dimension, 0.01) and np.allclose(
+        result.expert_error_by_dimension, 0.01
+    )
     assert result.ratio == pytest.approx([1.0] * 3) and result.median_ratio == pytest.approx(1.0)
 
 
@@ -72,6 +75,7 @@ def test_a_policy_lost_off_the_experts_states_shows_its_shift_on_its_failed_epis
     assert result.success == [0.0, 0.0, 0.0], "it stops at the start box, short of every goal"
     assert result.own_error_succeeded == [None, None, None]
     assert result.own_error_failed == result.own_error
+    assert [sum(dims) for dims in result.own_error_by_dimension] == pytest.approx(result.own_error)
     assert all(ratio > 2.0 for ratio in result.ratio), result.ratio
     assert result.mean_ratio > 2.0 and result.median_ratio > 2.0
 
@@ -98,7 +102,7 @@ def test_the_measurement_is_reproducible_under_its_seed(suite):
 
 def test_ratios_without_any_error_on_expert_states():
     assert shift_ratio(0.0, 0.0) == 1.0 and math.isinf(shift_ratio(0.5, 0.0))
-    result = ShiftResult(["a"], [0.0], [0.5], [None], [0.5], [0.0], episodes=1, seed=0)
+    result = ShiftResult(["a"], [0.0], [0.5], [None], [0.5], [0.0], [[0.5]], [[0.0]], episodes=1, seed=0)
     assert result.to_dict()["ratio"] == [None] and result.to_dict()["mean_ratio"] is None
 
 
@@ -139,7 +143,11 @@ def test_the_shift_command_measures_a_trained_policy_and_writes_json(tmp_path, c
     saved = json.loads(output.read_text())
     assert saved["task_names"] == list(TOY_TASKS) and saved["episodes"] == 2
     assert all(error > 0 for error in saved["expert_error"])
-    assert "median task's own/expert ratio" in printed and all(task in printed for task in TOY_TASKS)
+    assert (
+        "median task's own/expert ratio" in printed
+        and "per action dimension" in printed
+        and all(task in printed for task in TOY_TASKS)
+    )
 
 
 def test_the_shift_command_refuses_a_missing_policy_naming_the_fix(tmp_path, capsys):
