@@ -9,7 +9,7 @@ From the repository root, after the study's seed 0 (one core; about two minutes 
 
     .venv/bin/python docs/results/mt50-state-eval/covariate_shift.py
 
-It prints a table (kept in ``covariate_shift.txt``) and writes every per-task value to
+It prints two tables (kept in ``covariate_shift.txt``) and writes every per-task value to
 ``covariate_shift.json``.
 """
 
@@ -53,6 +53,13 @@ def summary_line(label: str, result: ShiftResult) -> str:
     )
 
 
+def dimension_line(label: str, result: ShiftResult) -> str:
+    """One row of the second table: the mean error per action dimension, own states then expert states."""
+    own = np.mean(result.own_error_by_dimension, axis=0)
+    expert = np.mean(result.expert_error_by_dimension, axis=0)
+    return f"| {label} | " + " | ".join(f"{value:.3f}" for value in [*own, *expert]) + " |"
+
+
 def main() -> int:
     """Prints one table row per policy and writes every per-task value to ``OUTPUT``."""
     torch.set_num_threads(1)
@@ -67,10 +74,16 @@ def main() -> int:
     results = {}
     with EnvWorkers(suite, 0) as workers:
         for label, folder in POLICIES:
-            result = measure_shift(workers, PolicyRunner.from_pretrained(folder), EPISODES, SEED)
-            results[label] = result.to_dict()
-            print(summary_line(label, result), flush=True)
-    OUTPUT.write_text(json.dumps(results, indent=1))
+            results[label] = measure_shift(workers, PolicyRunner.from_pretrained(folder), EPISODES, SEED)
+            print(summary_line(label, results[label]), flush=True)
+    print("\nMean squared error per action dimension (MetaWorld: x, y, z of the hand, gripper):\n")
+    print(
+        "| policy | own x | own y | own z | own gripper | expert x | expert y | expert z | expert gripper |"
+    )
+    print("|---|" + "---:|" * 8)
+    for label, result in results.items():
+        print(dimension_line(label, result))
+    OUTPUT.write_text(json.dumps({label: result.to_dict() for label, result in results.items()}, indent=1))
     return 0
 
 
