@@ -7,10 +7,11 @@ of every task (reset seeds no policy trained on). Per task: the squared action e
 failed episodes) and on the expert's rollouts from the same reset seeds; then averaged over tasks.
 From the repository root, after the study's seed 0 (one core; about two minutes per policy):
 
-    .venv/bin/python docs/results/mt50-state-eval/covariate_shift.py
+    .venv/bin/python docs/results/mt50-state-eval/covariate_shift.py [SEED]
 
-It prints two tables (kept in ``covariate_shift.txt``) and writes every per-task value to
-``covariate_shift.json``.
+SEED is the study's seed (default 0); a policy whose run has not made it yet is left out. It prints
+two tables (kept in ``covariate_shift_seed<SEED>.txt``) and writes every per-task value to
+``covariate_shift_seed<SEED>.json``.
 """
 
 from __future__ import annotations
@@ -28,18 +29,20 @@ from lerobot_mtdagger.shift import ShiftResult, measure_shift
 from lerobot_mtdagger.workers import EnvWorkers
 
 RUNS = Path("outputs/mt50-state-eval/runs")
-OUTPUT = Path("docs/results/mt50-state-eval/covariate_shift.json")
+HERE = Path("docs/results/mt50-state-eval")
 EPISODES = 5
-SEED = 0
 BC_BUDGETS = (3, 6, 12, 21, 33)
 UNIFORM_PHASES = (1, 3, 6, 10)  # 3 (phase + 1) demos per task
-POLICIES = [
-    *[(f"BC, {d} demos", RUNS / f"bc-{d}demos-seed{SEED}" / "policies" / "round-000") for d in BC_BUDGETS],
-    *[
-        (f"uniform, {3 * (p + 1)} demos", RUNS / f"uniform-seed{SEED}" / "policies" / f"round-{p:03d}")
+
+
+def policies(seed: int) -> list[tuple[str, Path]]:
+    """(label, policy folder) of BC at ``BC_BUDGETS`` and Uniform DAgger at the same demos per task."""
+    bc = [(f"BC, {d} demos", RUNS / f"bc-{d}demos-seed{seed}" / "policies" / "round-000") for d in BC_BUDGETS]
+    uniform = [
+        (f"uniform, {3 * (p + 1)} demos", RUNS / f"uniform-seed{seed}" / "policies" / f"round-{p:03d}")
         for p in UNIFORM_PHASES
-    ],
-]
+    ]
+    return [(label, folder) for label, folder in [*bc, *uniform] if (folder / "model.safetensors").is_file()]
 
 
 def summary_line(label: str, result: ShiftResult) -> str:
@@ -61,11 +64,13 @@ def dimension_line(label: str, result: ShiftResult) -> str:
 
 
 def main() -> int:
-    """Prints one table row per policy and writes every per-task value to ``OUTPUT``."""
+    """Prints one table row per policy and writes every per-task value to ``covariate_shift_seed<S>.json``."""
+    seed = int(sys.argv[1]) if len(sys.argv) > 1 else 0
     torch.set_num_threads(1)
-    config = json.loads((POLICIES[0][1].parents[1] / "config.json").read_text())
+    chosen = policies(seed)
+    config = json.loads((chosen[0][1].parents[1] / "config.json").read_text())
     suite = make_suite(config["suite"], obs_mode=config["obs_mode"])
-    print(f"{len(suite.task_names)} tasks, {EPISODES} evaluation episodes per task (seed {SEED})\n")
+    print(f"{len(suite.task_names)} tasks, {EPISODES} evaluation episodes per task (seed {seed})\n")
     print(
         "| policy | success | error, own states | own, successful episodes | own, failed episodes "
         "| error, expert states | own / expert (means) | own / expert (median task) |"
@@ -73,8 +78,8 @@ def main() -> int:
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
     results = {}
     with EnvWorkers(suite, 0) as workers:
-        for label, folder in POLICIES:
-            results[label] = measure_shift(workers, PolicyRunner.from_pretrained(folder), EPISODES, SEED)
+        for label, folder in chosen:
+            results[label] = measure_shift(workers, PolicyRunner.from_pretrained(folder), EPISODES, seed)
             print(summary_line(label, results[label]), flush=True)
     print("\nMean squared error per action dimension (MetaWorld: x, y, z of the hand, gripper):\n")
     print(
@@ -83,7 +88,8 @@ def main() -> int:
     print("|---|" + "---:|" * 8)
     for label, result in results.items():
         print(dimension_line(label, result))
-    OUTPUT.write_text(json.dumps({label: result.to_dict() for label, result in results.items()}, indent=1))
+    output = HERE / f"covariate_shift_seed{seed}.json"
+    output.write_text(json.dumps({label: result.to_dict() for label, result in results.items()}, indent=1))
     return 0
 
 
