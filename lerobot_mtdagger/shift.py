@@ -10,7 +10,10 @@ uses), without training anything:
   successful and its failed episodes, and its success (equal to ``evaluate``'s on the same episodes);
 - the expert's rollouts from the same reset seeds: the policy's error on the expert's states.
 
-Errors are averaged over a task's frames. The ratio own / expert per task is the covariate shift
+The policy's action is clipped to the env's action space before it is compared, as the env clips what
+it executes: a policy fed a state far outside its training data (a MuJoCo instability resets the
+simulation mid-episode) may output actions of any size, and an unclipped error would then measure
+only that. Errors are averaged over a task's frames. The ratio own / expert per task is the covariate shift
 factor: near 1, the policy meets no state it has not learnt to act in, and relabelled rollouts have
 little to add over more demonstrations; well above 1, its own states are where it goes wrong. Like
 evaluation, episodes end at the first success.
@@ -23,9 +26,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 
 from lerobot_mtdagger.collect import EVAL_STREAM, PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.workers import EnvWorkers, Episode
 
 
@@ -121,8 +126,9 @@ def measure_shift(workers: EnvWorkers, policy: PolicyFn, episodes_per_task: int,
     counts = [episodes_per_task] * len(task_names)
     own = _labelled_rollouts(workers, counts, policy, seed)
     expert = _labelled_rollouts(workers, counts, None, seed)
-    own_errors = _episode_errors(policy, own, task_names)
-    expert_errors = _episode_errors(policy, expert, task_names)
+    bounds = action_bounds(workers.suite)
+    own_errors = _episode_errors(policy, own, task_names, bounds)
+    expert_errors = _episode_errors(policy, expert, task_names, bounds)
     rates, _ = success_by_task(own, len(task_names))
     tasks = range(len(task_names))
     return ShiftResult(
@@ -139,6 +145,22 @@ def measure_shift(workers: EnvWorkers, policy: PolicyFn, episodes_per_task: int,
         episodes=episodes_per_task,
         seed=seed,
     )
+
+
+def action_bounds(suite: TaskSuite) -> tuple[np.ndarray, np.ndarray]:
+    """The (low, high) of the suite's action space, read from the env of its first task.
+
+    Raises:
+        ValueError: If that env's action space is not a box.
+    """
+    env = suite.make_env(suite.task_names[0])
+    try:
+        space = env.action_space
+        if not isinstance(space, gym.spaces.Box):
+            raise ValueError(f"Suite {suite.name!r} has a {type(space).__name__} action space, not a Box.")
+        return np.asarray(space.low, dtype=np.float64), np.asarray(space.high, dtype=np.float64)
+    finally:
+        env.close()
 
 
 def _labelled_rollouts(
@@ -159,16 +181,21 @@ def _labelled_rollouts(
     )
 
 
-def _episode_errors(policy: PolicyFn, episodes: Sequence[Episode], task_names: list[str]) -> list[np.ndarray]:
-    """``(pi(s) - label)^2`` per frame and action dimension, (frames, dims), of each recorded episode.
+def _episode_errors(
+    policy: PolicyFn,
+    episodes: Sequence[Episode],
+    task_names: list[str],
+    bounds: tuple[np.ndarray, np.ndarray],
+) -> list[np.ndarray]:
+    """``(clip(pi(s)) - label)^2`` per frame and action dimension, (frames, dims), of each recorded episode.
 
-    The policy is queried once per episode, on all of its frames.
+    The policy is queried once per episode, on all of its frames; its actions are clipped to ``bounds``.
     """
     errors = []
     for episode in episodes:
         frames = episode.frames
         tasks = [task_names[episode.task_index]] * len(frames)
-        predicted = np.asarray(policy(frames, tasks), dtype=np.float64)
+        predicted = np.clip(np.asarray(policy(frames, tasks), dtype=np.float64), *bounds)
         labels = np.stack([np.asarray(frame["action"], dtype=np.float64) for frame in frames])
         errors.append((predicted - labels) ** 2)
     return errors

@@ -36,8 +36,14 @@ def copy_expert(observations, tasks):
 
 
 def biased(observations, tasks):
-    """The expert's action plus a constant offset: the same error everywhere (the env clips the rest)."""
-    return copy_expert(observations, tasks) + np.float32(0.1)
+    """The expert's action moved 0.1 towards 0 in each dimension: the same error everywhere, never clipped."""
+    actions = copy_expert(observations, tasks)
+    return np.where(actions >= 0.0, actions - np.float32(0.1), actions + np.float32(0.1))
+
+
+def huge(observations, tasks):
+    """Actions far outside the action space, as a policy fed a state far outside its data may output."""
+    return np.full((len(observations), 2), 1e6, dtype=np.float32)
 
 
 def lost_outside_the_start_box(observations, tasks):
@@ -68,6 +74,11 @@ def test_a_policy_wrong_everywhere_alike_meets_no_shift(suite):
         result.expert_error_by_dimension, 0.01
     )
     assert result.ratio == pytest.approx([1.0] * 3) and result.median_ratio == pytest.approx(1.0)
+
+
+def test_actions_are_clipped_to_the_action_space_as_the_env_clips_what_it_executes(suite):
+    result = shift_of(suite, huge, episodes=2)
+    assert all(0.0 < error <= 2 * 2.0**2 for error in [*result.own_error, *result.expert_error])
 
 
 def test_a_policy_lost_off_the_experts_states_shows_its_shift_on_its_failed_episodes(suite):
