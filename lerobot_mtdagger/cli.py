@@ -46,6 +46,8 @@ from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, Scheduler
 from lerobot_mtdagger.simulate import SyntheticTasks, simulate
 
 if TYPE_CHECKING:
+    from lerobot_mtdagger.envs.base import TaskSuite
+    from lerobot_mtdagger.evaluate import PolicyRunner
     from lerobot_mtdagger.shift import ShiftResult
 
 logger = logging.getLogger(__name__)
@@ -234,15 +236,23 @@ class EvalConfig:
             raise ValueError(f"episodes must be > 0, got {self.episodes}.")
 
 
-def eval_command(config: EvalConfig) -> dict:
-    """Evaluates a pretrained policy per task with the pure policy acting."""
+def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
+    """The suite the config names and its pretrained policy, checked to take the suite's observations."""
     from lerobot_mtdagger.envs import suite_from_config
-    from lerobot_mtdagger.evaluate import PolicyRunner, evaluate
-    from lerobot_mtdagger.workers import EnvWorkers
+    from lerobot_mtdagger.evaluate import PolicyRunner
 
     suite = suite_from_config(config)
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
     runner.check_inputs(suite.features, config.obs_mode)
+    return suite, runner
+
+
+def eval_command(config: EvalConfig) -> dict:
+    """Evaluates a pretrained policy per task with the pure policy acting."""
+    from lerobot_mtdagger.evaluate import evaluate
+    from lerobot_mtdagger.workers import EnvWorkers
+
+    suite, runner = _suite_and_policy(config)
     with EnvWorkers(suite, config.worker_count) as workers:
         result, _ = evaluate(workers, runner, config.episodes, config.seed)
     for task, success in zip(result.task_names, result.success, strict=True):
@@ -266,14 +276,10 @@ class ShiftConfig(EvalConfig):
 
 def shift_command(config: ShiftConfig) -> dict:
     """Measures a pretrained policy's covariate shift per task and prints it."""
-    from lerobot_mtdagger.envs import suite_from_config
-    from lerobot_mtdagger.evaluate import PolicyRunner
     from lerobot_mtdagger.shift import measure_shift
     from lerobot_mtdagger.workers import EnvWorkers
 
-    suite = suite_from_config(config)
-    runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
-    runner.check_inputs(suite.features, config.obs_mode)
+    suite, runner = _suite_and_policy(config)
     with EnvWorkers(suite, config.worker_count) as workers:
         result = measure_shift(workers, runner, config.episodes, config.seed)
     print(shift_table(result))

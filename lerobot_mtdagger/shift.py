@@ -131,17 +131,17 @@ def measure_shift(workers: EnvWorkers, policy: PolicyFn, episodes_per_task: int,
     expert_errors = _episode_errors(policy, expert, task_names, bounds)
     rates, _ = success_by_task(own, len(task_names))
     tasks = range(len(task_names))
+    own_by_dimension = [_every_episode_mean(own_errors, own, task) for task in tasks]
+    expert_by_dimension = [_every_episode_mean(expert_errors, expert, task) for task in tasks]
     return ShiftResult(
         task_names=task_names,
         success=[rate if rate is not None else 0.0 for rate in rates],
-        own_error=[float(_every_episode_mean(own_errors, own, task).sum()) for task in tasks],
+        own_error=[float(mean.sum()) for mean in own_by_dimension],
         own_error_succeeded=[_total(_task_mean(own_errors, own, task, success=True)) for task in tasks],
         own_error_failed=[_total(_task_mean(own_errors, own, task, success=False)) for task in tasks],
-        expert_error=[float(_every_episode_mean(expert_errors, expert, task).sum()) for task in tasks],
-        own_error_by_dimension=[_every_episode_mean(own_errors, own, task).tolist() for task in tasks],
-        expert_error_by_dimension=[
-            _every_episode_mean(expert_errors, expert, task).tolist() for task in tasks
-        ],
+        expert_error=[float(mean.sum()) for mean in expert_by_dimension],
+        own_error_by_dimension=[mean.tolist() for mean in own_by_dimension],
+        expert_error_by_dimension=[mean.tolist() for mean in expert_by_dimension],
         episodes=episodes_per_task,
         seed=seed,
     )

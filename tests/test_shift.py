@@ -105,8 +105,10 @@ def test_the_policys_success_is_evaluations_on_the_same_episodes(suite):
 
 
 def test_the_measurement_is_reproducible_under_its_seed(suite):
-    first, again = shift_of(suite, biased, seed=3), shift_of(suite, biased, seed=3)
-    other = shift_of(suite, biased, seed=4)
+    # The lost policy's error depends on where it starts (how long it stands at the box's edge).
+    first = shift_of(suite, lost_outside_the_start_box, seed=3)
+    again = shift_of(suite, lost_outside_the_start_box, seed=3)
+    other = shift_of(suite, lost_outside_the_start_box, seed=4)
     assert first.to_dict() == again.to_dict()
     assert first.own_error != other.own_error
 
