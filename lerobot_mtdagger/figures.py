@@ -354,7 +354,8 @@ def demos_ratio(
     return (float(np.mean(ratios)) if ratios else None), len(ratios), len(seeds)
 
 
-def _format(interval: Interval) -> str:
+def format_difference(interval: Interval) -> str:
+    """``+0.012 [-0.004, +0.028]``, with `` *`` when the interval excludes 0 (one seed: no interval)."""
     if math.isnan(interval.low):
         return f"{interval.mean:+.3f} (one seed, no interval)"
     mark = " *" if interval.excludes_zero() else ""
@@ -439,7 +440,7 @@ def task_gap_lines(rows: Sequence[Row], hardest: Sequence[int]) -> list[str]:
             hard.append(float(difference[list(hardest)].mean()))
             other.append(float(np.delete(difference, list(hardest)).mean()))
         if hard:
-            cells = f"{_format(mean_interval(hard))} | {_format(mean_interval(other))}"
+            cells = f"{format_difference(mean_interval(hard))} | {format_difference(mean_interval(other))}"
             lines.append(f"| {method} | {baseline} | {budget:.1f} | {cells} |")
     return lines + [""]
 
@@ -516,7 +517,7 @@ def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[
     pairs = comparison_pairs(rows)
     for method, baseline in pairs:
         for budget, interval in paired_rows(rows, method, baseline):
-            lines.append(f"| {method} | {baseline} | {budget:.1f} | {_format(interval)} |")
+            lines.append(f"| {method} | {baseline} | {budget:.1f} | {format_difference(interval)} |")
     lines += ["", "## Demos needed to reach a level, ratio method / baseline (mean over paired seeds)", ""]
     lines += [
         "| method | baseline | level | ratio | seeds where both reached it |",

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lerobot_mtdagger.figures import format_difference
 from lerobot_mtdagger.results import SavedTable, merge_tables, read_results
 from lerobot_mtdagger.stats import Interval, mean_interval, paired_difference
 
@@ -106,12 +107,6 @@ def split_difference(success: dict, method: str, baseline: str) -> tuple[Interva
     return mean_interval(hard), mean_interval(other)
 
 
-def formatted(interval: Interval) -> str:
-    """``+0.012 [-0.004, +0.028]``, with ``*`` when the interval excludes 0."""
-    star = " *" if interval.excludes_zero() else ""
-    return f"{interval.mean:+.3f} [{interval.low:+.3f}, {interval.high:+.3f}]{star}"
-
-
 def parted_lines(success: dict) -> list[str]:
     """Markdown table of summary 1."""
     lines = [
@@ -132,7 +127,7 @@ def parted_lines(success: dict) -> list[str]:
             continue
         first = [parted_mean(success, method, seed) for seed in seeds_of(success)]
         second = [parted_mean(success, baseline, seed) for seed in seeds_of(success)]
-        lines.append(f"| {method} - {baseline} | {formatted(paired_difference(first, second))} |")
+        lines.append(f"| {method} - {baseline} | {format_difference(paired_difference(first, second))} |")
     return lines
 
 
@@ -149,7 +144,7 @@ def hardest_lines(success: dict, task_names: Sequence[str]) -> list[str]:
     lines += ["", "| method - baseline | hardest tasks | other tasks |", "|---|---|---|"]
     for method, baseline in PAIRS[:4]:
         hard, other = split_difference(success, method, baseline)
-        lines.append(f"| {method} - {baseline} | {formatted(hard)} | {formatted(other)} |")
+        lines.append(f"| {method} - {baseline} | {format_difference(hard)} | {format_difference(other)} |")
     return lines
 
 
