@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lerobot_mtdagger.compare import CompareConfig, split_arguments
+from lerobot_mtdagger.compare import CompareConfig, follow_parent, split_arguments
 from lerobot_mtdagger.configs import RunConfig, renamed_option_error, resolve_workers
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.hub import PushConfig, push_command
@@ -118,6 +118,7 @@ def run_experiment(config: RunConfig) -> list[str]:
     """Runs ``lerobot-mtdagger run`` and prints the per-round summary."""
     from lerobot_mtdagger.dagger import run
 
+    follow_parent()
     print(f"experiment {config.output_dir} ({config.method}, seed {config.seed}):", flush=True)
     return run(config, on_summary=lambda line: print(line, flush=True))
 

@@ -17,6 +17,8 @@ trains it by the same rule as DAgger's phase k (``RunConfig.phase_steps``).
 Runs are independent processes (``--jobs`` at once, default one per core); each gets
 ``cores / jobs`` torch threads and env workers so the jobs do not oversubscribe the cores. A
 finished run is skipped, a cut-off run is resumed (``--resume=true``), so ``compare`` itself resumes.
+A run started by ``compare`` ends itself within a second of ``compare`` ending (``follow_parent``), so a
+``compare`` that is killed leaves no run writing on into its folder.
 Asked again with more ``--rounds``, it extends the finished DAgger runs by the new rounds and adds BC
 at the new budgets; the rounds already made are kept as they are.
 """
@@ -26,8 +28,11 @@ from __future__ import annotations
 import json
 import logging
 import os
+import signal
 import subprocess
 import sys
+import threading
+import time
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -42,6 +47,9 @@ logger = logging.getLogger(__name__)
 
 RUNS_DIR = "runs"
 COMPARE_FILE = "compare.json"
+PARENT_PID_ENV = "LEROBOT_MTDAGGER_PARENT_PID"
+"""Set by ``compare`` in each run's environment: the process id the run must not outlive."""
+PARENT_POLL_S = 0.5
 
 
 @dataclass
@@ -188,13 +196,52 @@ def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
         "--progress=false",
         *resume,
     ]
-    env = {**os.environ, "OMP_NUM_THREADS": str(threads), "MKL_NUM_THREADS": str(threads)}
+    env = {
+        **os.environ,
+        "OMP_NUM_THREADS": str(threads),
+        "MKL_NUM_THREADS": str(threads),
+        PARENT_PID_ENV: str(os.getpid()),
+    }
     log_path = runs_dir / f"{job.name}.log"
     with log_path.open("a") as log:
         status = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT, env=env, check=False)
     if status.returncode != 0:
         raise UserError(f"Run {job.name} failed (exit {status.returncode}); see {log_path}.")
     return folder
+
+
+def follow_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread | None:
+    """Ends this process (SIGTERM) once the ``compare`` that started it has ended.
+
+    Called by ``lerobot-mtdagger run`` at start. Without it, a ``compare`` killed by ``kill`` or
+    ``kill -9`` leaves its runs going on in the background, writing into run folders that a new
+    ``compare`` then resumes at the same time. The run ends as a killed run does: committed rounds and
+    phases stay, the next ``compare`` resumes it. Does nothing when ``PARENT_PID_ENV`` is not set
+    (a run started by hand).
+
+    Args:
+        poll_s: Seconds between two checks of the parent process.
+
+    Returns:
+        The daemon thread that watches the parent, or None when there is no parent to follow.
+    """
+    expected = os.environ.get(PARENT_PID_ENV)
+    if not expected:
+        return None
+    parent = int(expected)
+    watcher = threading.Thread(
+        target=_end_when_orphaned, args=(parent, poll_s), name="follow-parent", daemon=True
+    )
+    watcher.start()
+    return watcher
+
+
+def _end_when_orphaned(parent: int, poll_s: float) -> None:
+    """Waits until this process's parent is no longer ``parent`` (it ended), then ends this process."""
+    while os.getppid() == parent:
+        time.sleep(poll_s)
+    logger.error("compare (pid %d) has ended; ending this run, which compare resumes when run again.", parent)
+    os.kill(os.getpid(), signal.SIGTERM)
 
 
 def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict]:

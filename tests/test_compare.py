@@ -5,16 +5,30 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import re
 import shutil
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.compare import CompareConfig, bc_rounds_for, jobs_for, split_arguments
+from lerobot_mtdagger.compare import (
+    PARENT_PID_ENV,
+    CompareConfig,
+    bc_rounds_for,
+    follow_parent,
+    is_finished,
+    jobs_for,
+    split_arguments,
+)
 from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.figures import hardest_tasks, seed_reach
+from tests.test_dagger import _children, _running
 
 TINY = [
     "--suite=toy",
@@ -70,6 +84,38 @@ def test_a_second_compare_skips_finished_runs(compared):
     assert main([*args, "--jobs=1", *TINY]) == 0
     after = {p.name: p.stat().st_mtime_ns for p in (folder / "runs").glob("*/policies/round-*")}
     assert before == after
+
+
+def test_a_killed_compare_leaves_no_run_writing_on_and_the_next_compare_finishes_it(tmp_path):
+    """kill -9 of compare: its run (and the run's env workers) end within seconds; compare resumes it."""
+    folder = tmp_path / "cmp"
+    longer = [*(o for o in TINY if not o.startswith("--steps_per_round")), "--steps_per_round=1500"]
+    args = ["compare", "--methods=[need]", "--seeds=[0]", f"--output_dir={folder}", "--jobs=1", *longer]
+    cli = str(Path(sys.executable).parent / "lerobot-mtdagger")
+    process = subprocess.Popen([cli, *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    round_zero = folder / "runs" / "need-seed0" / "rounds" / "round-000"  # 3 phases of 1 500 steps to go
+    deadline = time.time() + 120
+    while not round_zero.exists() and process.poll() is None and time.time() < deadline:
+        time.sleep(0.05)
+    assert process.poll() is None, "compare ended before it could be killed"
+    runs = _children(process.pid)
+    spawned = runs + [worker for run in runs for worker in _children(run)]
+    assert runs, "compare should have started its run"
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    deadline = time.time() + 3
+    while any(_running(pid) for pid in spawned) and time.time() < deadline:
+        time.sleep(0.1)
+    assert not any(_running(pid) for pid in spawned), "the run outlived the compare that started it"
+    assert not is_finished(folder / "runs" / "need-seed0", 2)
+    assert main(args) == 0
+    assert is_finished(folder / "runs" / "need-seed0", 2)
+    assert "has ended; ending this run" in (folder / "runs" / "need-seed0.log").read_text()
+
+
+def test_a_run_started_by_hand_follows_no_parent(monkeypatch):
+    monkeypatch.delenv(PARENT_PID_ENV, raising=False)
+    assert follow_parent() is None
 
 
 def test_report_writes_every_figure_and_the_paired_differences(compared, capsys):
