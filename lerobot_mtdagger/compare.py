@@ -176,7 +176,7 @@ def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
     """Runs (or resumes, or skips) one job in its own process; returns its folder.
 
     Raises:
-        RuntimeError: If the run fails (its log is named).
+        UserError: If the run fails (its log is named).
     """
     from lerobot_mtdagger.rounds import CONFIG_FILE
 
@@ -208,6 +208,29 @@ def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
     if status.returncode != 0:
         raise UserError(f"Run {job.name} failed (exit {status.returncode}); see {log_path}.")
     return folder
+
+
+def run_jobs(jobs: Sequence[Job], runs_dir: Path, parallel: int, threads: int, workers: int) -> list[Path]:
+    """Runs every job, ``parallel`` at once; one failed run stops none of the others.
+
+    Returns:
+        The run folders, in the order of ``jobs``.
+
+    Raises:
+        UserError: Once every job has ended, if any run failed; each failed run and its log are named.
+    """
+    with ThreadPoolExecutor(max_workers=parallel) as pool:
+        futures = [pool.submit(run_job, job, runs_dir, threads, workers) for job in jobs]
+    errors = [future.exception() for future in futures if future.exception() is not None]
+    for error in errors:
+        if not isinstance(error, UserError):
+            raise error  # a fault of this code rather than of one run: keep its traceback
+    if errors:
+        raise UserError(
+            f"{len(errors)} of {len(jobs)} runs failed; the others finished. Fix the cause and run the same "
+            "compare again to resume: " + " ".join(str(error) for error in errors)
+        )
+    return [future.result() for future in futures]
 
 
 def follow_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread | None:
@@ -249,7 +272,8 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
 
     Raises:
         ValueError: On a bad option (nothing is run).
-        RuntimeError: If a run fails (the others still finish; rerun to resume).
+        UserError: If a run fails, once every other run has finished (rerun to resume); every failed
+            run and its log are named.
     """
     if compare_config.jobs is not None and compare_config.jobs < 1:
         raise UserError(f"--jobs must be >= 1, got {compare_config.jobs}.")
@@ -282,8 +306,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
             indent=1,
         )
     )
-    with ThreadPoolExecutor(max_workers=parallel) as pool:
-        folders = list(pool.map(lambda job: run_job(job, runs_dir, threads, workers), jobs))
+    folders = run_jobs(jobs, runs_dir, parallel, threads, workers)
     rows = results_rows(folders)
     write_results(rows, compare_config.output_dir, task_names, configs=check_comparable(folders))
     return rows

@@ -113,6 +113,19 @@ def test_a_killed_compare_leaves_no_run_writing_on_and_the_next_compare_finishes
     assert "has ended; ending this run" in (folder / "runs" / "need-seed0.log").read_text()
 
 
+def test_one_failed_run_stops_none_of_the_runs_queued_after_it(tmp_path, capsys):
+    folder = tmp_path / "cmp"
+    blocked = folder / "runs" / "bc-1demos-seed0"
+    blocked.mkdir(parents=True)
+    (blocked / "notes.txt").write_text("not an experiment")  # run refuses a non-empty folder
+    args = ["compare", "--methods=[bc,need]", "--seeds=[0]", "--bc_budgets=[1]", f"--output_dir={folder}"]
+    assert main([*args, "--jobs=1", *TINY]) == 2
+    error = capsys.readouterr().err
+    assert "1 of 2 runs failed; the others finished" in error and "bc-1demos-seed0.log" in error
+    assert is_finished(folder / "runs" / "need-seed0", 2)
+    assert (blocked / "notes.txt").read_text() == "not an experiment"
+
+
 def test_a_run_started_by_hand_follows_no_parent(monkeypatch):
     monkeypatch.delenv(PARENT_PID_ENV, raising=False)
     assert follow_parent() is None
