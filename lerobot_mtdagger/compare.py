@@ -34,7 +34,7 @@ import sys
 import threading
 import time
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -172,18 +172,10 @@ def runs_not_started(compare_dir: Path) -> list[str]:
     return [name for name in jobs if not (Path(compare_dir) / RUNS_DIR / name).is_dir()]
 
 
-def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
-    """Runs (or resumes, or skips) one job in its own process; returns its folder.
-
-    Raises:
-        UserError: If the run fails (its log is named).
-    """
+def run_command(job: Job, folder: Path, threads: int, workers: int) -> tuple[list[str], dict[str, str]]:
+    """The command line and environment of one job's ``lerobot-mtdagger run`` (resumed if started)."""
     from lerobot_mtdagger.rounds import CONFIG_FILE
 
-    folder = runs_dir / job.name
-    if is_finished(folder, job.last_phase):
-        logger.info("%s: finished, skipped", job.name)
-        return folder
     resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []
     command = [
         sys.executable,
@@ -202,35 +194,94 @@ def run_job(job: Job, runs_dir: Path, threads: int, workers: int) -> Path:
         "MKL_NUM_THREADS": str(threads),
         PARENT_PID_ENV: str(os.getpid()),
     }
-    log_path = runs_dir / f"{job.name}.log"
-    with log_path.open("a") as log:
-        status = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT, env=env, check=False)
-    if status.returncode != 0:
-        raise UserError(f"Run {job.name} failed (exit {status.returncode}); see {log_path}.")
-    return folder
+    return command, env
 
 
-def run_jobs(jobs: Sequence[Job], runs_dir: Path, parallel: int, threads: int, workers: int) -> list[Path]:
-    """Runs every job, ``parallel`` at once; one failed run stops none of the others.
+class RunPool:
+    """The runs of one ``compare``, ``parallel`` at once, each in its own process.
 
-    Returns:
-        The run folders, in the order of ``jobs``.
-
-    Raises:
-        UserError: Once every job has ended, if any run failed; each failed run and its log are named.
+    One failed run stops none of the others. An interrupt (Ctrl-C, or any exception in the waiting
+    thread) starts no further run and ends the running ones, which the next ``compare`` resumes.
     """
-    with ThreadPoolExecutor(max_workers=parallel) as pool:
-        futures = [pool.submit(run_job, job, runs_dir, threads, workers) for job in jobs]
-    errors = [future.exception() for future in futures if future.exception() is not None]
-    for error in errors:
-        if not isinstance(error, UserError):
-            raise error  # a fault of this code rather than of one run: keep its traceback
-    if errors:
-        raise UserError(
-            f"{len(errors)} of {len(jobs)} runs failed; the others finished. Fix the cause and run the same "
-            "compare again to resume: " + " ".join(str(error) for error in errors)
-        )
-    return [future.result() for future in futures]
+
+    def __init__(self, runs_dir: Path, parallel: int, threads: int, workers: int) -> None:
+        """Prepares the pool; nothing runs before ``run_all``.
+
+        Args:
+            runs_dir: The compare folder's ``runs/``.
+            parallel: Runs at once.
+            threads: Torch threads per run.
+            workers: Env worker processes per run.
+        """
+        self.runs_dir = runs_dir
+        self.parallel = parallel
+        self.threads = threads
+        self.workers = workers
+        self._lock = threading.Lock()
+        self._live: set[subprocess.Popen] = set()
+        self._stopping = False
+
+    def run_all(self, jobs: Sequence[Job]) -> list[Path]:
+        """Runs (or resumes, or skips) every job; returns the run folders in the order of ``jobs``.
+
+        Raises:
+            UserError: Once every job has ended, if any run failed; each failed run and its log are named.
+        """
+        executor = ThreadPoolExecutor(max_workers=self.parallel)
+        futures = [executor.submit(self.run_one, job) for job in jobs]
+        try:
+            wait(futures)
+        except BaseException:
+            executor.shutdown(wait=False, cancel_futures=True)
+            self._end_running()
+            raise
+        finally:
+            executor.shutdown(wait=True)
+        errors = [future.exception() for future in futures if future.exception() is not None]
+        for error in errors:
+            if not isinstance(error, UserError):
+                raise error  # a fault of this code rather than of one run: keep its traceback
+        if errors:
+            raise UserError(
+                f"{len(errors)} of {len(jobs)} runs failed; the others finished. Fix the cause and run the "
+                "same compare again to resume: " + " ".join(str(error) for error in errors)
+            )
+        return [future.result() for future in futures]
+
+    def run_one(self, job: Job) -> Path:
+        """Runs (or resumes, or skips) one job in its own process; returns its folder.
+
+        Raises:
+            UserError: If the run fails, or the pool was interrupted before it started (its log is named).
+        """
+        folder = self.runs_dir / job.name
+        if is_finished(folder, job.last_phase):
+            logger.info("%s: finished, skipped", job.name)
+            return folder
+        command, env = run_command(job, folder, self.threads, self.workers)
+        log_path = self.runs_dir / f"{job.name}.log"
+        with log_path.open("a") as log:
+            with self._lock:
+                if self._stopping:
+                    raise UserError(f"Run {job.name} not started: compare was interrupted.")
+                process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env)
+                self._live.add(process)
+            try:
+                returncode = process.wait()
+            finally:
+                with self._lock:
+                    self._live.discard(process)
+        if returncode != 0:
+            raise UserError(f"Run {job.name} failed (exit {returncode}); see {log_path}.")
+        return folder
+
+    def _end_running(self) -> None:
+        """Starts no further run and ends (SIGTERM) every running one."""
+        with self._lock:
+            self._stopping = True
+            for process in self._live:
+                process.terminate()
+        logger.warning("compare interrupted: no further run starts; the running ones were ended.")
 
 
 def follow_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread | None:
@@ -306,7 +357,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
             indent=1,
         )
     )
-    folders = run_jobs(jobs, runs_dir, parallel, threads, workers)
+    folders = RunPool(runs_dir, parallel, threads, workers).run_all(jobs)
     rows = results_rows(folders)
     write_results(rows, compare_config.output_dir, task_names, configs=check_comparable(folders))
     return rows

@@ -113,6 +113,25 @@ def test_a_killed_compare_leaves_no_run_writing_on_and_the_next_compare_finishes
     assert "has ended; ending this run" in (folder / "runs" / "need-seed0.log").read_text()
 
 
+def test_ctrl_c_on_compare_ends_its_run_and_starts_no_other(tmp_path):
+    folder = tmp_path / "cmp"
+    longer = [*(o for o in TINY if not o.startswith("--steps_per_round")), "--steps_per_round=1500"]
+    args = ["compare", "--methods=[need]", "--seeds=[0,1]", f"--output_dir={folder}", "--jobs=1", *longer]
+    cli = str(Path(sys.executable).parent / "lerobot-mtdagger")
+    process = subprocess.Popen([cli, *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    round_zero = folder / "runs" / "need-seed0" / "rounds" / "round-000"
+    deadline = time.time() + 120
+    while not round_zero.exists() and process.poll() is None and time.time() < deadline:
+        time.sleep(0.05)
+    assert process.poll() is None, "compare ended before it could be interrupted"
+    runs = _children(process.pid)
+    assert runs, "compare should have started its first run"
+    os.kill(process.pid, signal.SIGINT)  # to compare alone, not to its process group
+    process.wait(timeout=20)
+    assert not any(_running(pid) for pid in runs), "the running run was not ended"
+    assert not (folder / "runs" / "need-seed1").exists(), "a queued run started after the interrupt"
+
+
 def test_one_failed_run_stops_none_of_the_runs_queued_after_it(tmp_path, capsys):
     folder = tmp_path / "cmp"
     blocked = folder / "runs" / "bc-1demos-seed0"
