@@ -86,21 +86,28 @@ def test_a_second_compare_skips_finished_runs(compared):
     assert before == after
 
 
-def test_a_killed_compare_leaves_no_run_writing_on_and_the_next_compare_finishes_it(tmp_path):
-    """kill -9 of compare: its run (and the run's env workers) end within seconds; compare resumes it."""
-    folder = tmp_path / "cmp"
+def _compare_in_its_first_run(folder: Path, seeds: str) -> tuple[subprocess.Popen, list[str], list[int]]:
+    """Starts ``compare`` (need, 1 500 steps per phase) in a process and returns once its first run has
+    committed round 0, with 3 phases to go: (compare, its arguments, the run processes it started)."""
     longer = [*(o for o in TINY if not o.startswith("--steps_per_round")), "--steps_per_round=1500"]
-    args = ["compare", "--methods=[need]", "--seeds=[0]", f"--output_dir={folder}", "--jobs=1", *longer]
+    args = ["compare", "--methods=[need]", f"--seeds={seeds}", f"--output_dir={folder}", "--jobs=1", *longer]
     cli = str(Path(sys.executable).parent / "lerobot-mtdagger")
     process = subprocess.Popen([cli, *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    round_zero = folder / "runs" / "need-seed0" / "rounds" / "round-000"  # 3 phases of 1 500 steps to go
+    round_zero = folder / "runs" / "need-seed0" / "rounds" / "round-000"
     deadline = time.time() + 120
     while not round_zero.exists() and process.poll() is None and time.time() < deadline:
         time.sleep(0.05)
-    assert process.poll() is None, "compare ended before it could be killed"
+    assert process.poll() is None, "compare ended before its first run had committed round 0"
     runs = _children(process.pid)
+    assert runs, "compare should have started its first run"
+    return process, args, runs
+
+
+def test_a_killed_compare_leaves_no_run_writing_on_and_the_next_compare_finishes_it(tmp_path):
+    """kill -9 of compare: its run (and the run's env workers) end within seconds; compare resumes it."""
+    folder = tmp_path / "cmp"
+    process, args, runs = _compare_in_its_first_run(folder, "[0]")
     spawned = runs + [worker for run in runs for worker in _children(run)]
-    assert runs, "compare should have started its run"
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
     deadline = time.time() + 3
@@ -115,17 +122,7 @@ def test_a_killed_compare_leaves_no_run_writing_on_and_the_next_compare_finishes
 
 def test_ctrl_c_on_compare_ends_its_run_and_starts_no_other(tmp_path):
     folder = tmp_path / "cmp"
-    longer = [*(o for o in TINY if not o.startswith("--steps_per_round")), "--steps_per_round=1500"]
-    args = ["compare", "--methods=[need]", "--seeds=[0,1]", f"--output_dir={folder}", "--jobs=1", *longer]
-    cli = str(Path(sys.executable).parent / "lerobot-mtdagger")
-    process = subprocess.Popen([cli, *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    round_zero = folder / "runs" / "need-seed0" / "rounds" / "round-000"
-    deadline = time.time() + 120
-    while not round_zero.exists() and process.poll() is None and time.time() < deadline:
-        time.sleep(0.05)
-    assert process.poll() is None, "compare ended before it could be interrupted"
-    runs = _children(process.pid)
-    assert runs, "compare should have started its first run"
+    process, _, runs = _compare_in_its_first_run(folder, "[0,1]")
     os.kill(process.pid, signal.SIGINT)  # to compare alone, not to its process group
     process.wait(timeout=20)
     assert not any(_running(pid) for pid in runs), "the running run was not ended"
