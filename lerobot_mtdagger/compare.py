@@ -172,7 +172,7 @@ def runs_not_started(compare_dir: Path) -> list[str]:
     return [name for name in jobs if not (Path(compare_dir) / RUNS_DIR / name).is_dir()]
 
 
-def run_command(job: Job, folder: Path, threads: int, workers: int) -> tuple[list[str], dict[str, str]]:
+def job_command(job: Job, folder: Path, threads: int, workers: int) -> tuple[list[str], dict[str, str]]:
     """The command line and environment of one job's ``lerobot-mtdagger run`` (resumed if started)."""
     from lerobot_mtdagger.rounds import CONFIG_FILE
 
@@ -258,7 +258,7 @@ class RunPool:
         if is_finished(folder, job.last_phase):
             logger.info("%s: finished, skipped", job.name)
             return folder
-        command, env = run_command(job, folder, self.threads, self.workers)
+        command, env = job_command(job, folder, self.threads, self.workers)
         log_path = self.runs_dir / f"{job.name}.log"
         with log_path.open("a") as log:
             with self._lock:
