@@ -746,6 +746,80 @@ def _write_vector_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFr
     logger.debug("Wrote %d episodes (%d frames) to %s", episode_index, start, dataset.root)
 
 
+RENUMBERED_COLUMNS = ("episode_index", "index", "task_index")
+"""The columns LeRobot's ``update_data_df`` renumbers when it aggregates datasets."""
+
+
+@contextlib.contextmanager
+def _data_files_merged_in_arrow(features: Mapping[str, Mapping[str, Any]]) -> Iterator[None]:
+    """Lets LeRobot 0.4's ``aggregate_datasets`` merge data files with multi-dimensional features.
+
+    Without images, ``aggregate_data`` reads each data file into pandas and writes it back with
+    ``DataFrame.to_parquet``, which fails on a 2-D feature such as an (N, 3) point cloud ("Conversion
+    failed for column observation.pointcloud"). While this context is open, the data files of such a
+    dataset are merged in Arrow instead (``_append_data_file``): the source file's own table, with
+    the index columns LeRobot renumbered taken from its DataFrame. Metadata files are unchanged.
+
+    Args:
+        features: The datasets' LeRobot features (every round has the same).
+    """
+    from lerobot.datasets import aggregate
+    from lerobot.datasets.utils import DEFAULT_DATA_PATH
+
+    if not any(
+        len(spec["shape"]) > 1 and spec["dtype"] not in ("image", "video") for spec in features.values()
+    ):
+        yield
+        return
+    original = aggregate.append_or_create_parquet_file
+
+    def write(df: Any, src_path: Path, idx: dict[str, int], *args: Any, **kwargs: Any) -> Any:
+        max_mb, chunk_size, default_path = args[:3]
+        if default_path != DEFAULT_DATA_PATH:
+            return original(df, src_path, idx, *args, **kwargs)
+        return _append_data_file(df, src_path, idx, max_mb, chunk_size, kwargs["aggr_root"] / default_path)
+
+    aggregate.append_or_create_parquet_file = write
+    try:
+        yield
+    finally:
+        aggregate.append_or_create_parquet_file = original
+
+
+def _append_data_file(
+    df: Any, src_path: Path, idx: dict[str, int], max_mb: float, chunk_size: int, path_format: Path
+) -> tuple[dict[str, int], tuple[int, int]]:
+    """``append_or_create_parquet_file`` for data files, in Arrow (same file rotation rule).
+
+    Args:
+        df: The source file's frames as LeRobot renumbered them (``RENUMBERED_COLUMNS`` are taken).
+        src_path: The source data file.
+        idx: The destination's current ``chunk`` and ``file`` (updated on rotation).
+        max_mb: Size at which a destination file is closed.
+        chunk_size: Files per chunk.
+        path_format: Destination path with ``{chunk_index}`` and ``{file_index}``.
+
+    Returns:
+        ``idx`` and the (chunk, file) the frames were written to.
+    """
+    table = pq.read_table(src_path)
+    for name in RENUMBERED_COLUMNS:
+        if name in df.columns:
+            column = table.schema.get_field_index(name)
+            values = pa.array(df[name].to_numpy(), type=table.schema.field(name).type)
+            table = table.set_column(column, table.schema.field(name), values)
+    path = Path(str(path_format).format(chunk_index=idx["chunk"], file_index=idx["file"]))
+    if path.exists():
+        if path.stat().st_size + src_path.stat().st_size >= max_mb * 1024 * 1024:
+            idx["chunk"], idx["file"] = update_chunk_file_indices(idx["chunk"], idx["file"], chunk_size)
+            path = Path(str(path_format).format(chunk_index=idx["chunk"], file_index=idx["file"]))
+        else:
+            table = pa.concat_tables([pq.read_table(path), table])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    pq.write_table(table, path)
+    return idx, (idx["chunk"], idx["file"])
+
+
 def merge_rounds(
     experiment: ExperimentDir, rounds: Sequence[int], output: Path, repo_id: str = "local/merged"
 ) -> Path:
@@ -772,7 +846,8 @@ def merge_rounds(
     staging = output.parent / f".{output.name}.merging"
     if staging.exists():
         shutil.rmtree(staging)
-    with quiet_third_party():
+    features = json.loads((experiment.round_root(rounds[0]) / INFO_FILE).read_text())["features"]
+    with quiet_third_party(), _data_files_merged_in_arrow(features):
         aggregate_datasets(
             repo_ids=[f"local/{round_name(k)}" for k in rounds],
             aggr_repo_id=repo_id,

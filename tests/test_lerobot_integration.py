@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 import torch
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.policies.factory import make_pre_post_processors
@@ -20,15 +21,22 @@ BIN = Path(sys.executable).parent
 TASKS = ["reach-v3", "button-press-topdown-v3"]
 
 
-def lerobot_eval(checkpoint: Path, output_dir: Path, obs_mode: str, extra: list[str]) -> dict:
+def lerobot_eval(
+    checkpoint: Path,
+    output_dir: Path,
+    obs_mode: str,
+    extra: list[str],
+    suite: str = "metaworld-mt10",
+    task: str = "reach-v3",
+) -> dict:
     command = [
         str(BIN / "lerobot-eval"),
         f"--policy.path={checkpoint}",
         "--policy.device=cpu",
         "--env.discover_packages_path=lerobot_mtdagger.envs",
         "--env.type=mtdagger_suite",
-        "--env.suite=metaworld-mt10",
-        "--env.task=reach-v3",
+        f"--env.suite={suite}",
+        f"--env.task={task}",
         f"--env.obs_mode={obs_mode}",
         "--env.num_points=128",
         "--env.image_size=32",
@@ -93,5 +101,55 @@ def test_stock_lerobot_eval_on_point_clouds_through_the_rename_map(tmp_path, exp
     assert config["input_features"]["observation.pointcloud"]["shape"] == [128, 3]
     rename = '--rename_map={"observation.environment_state": "observation.pointcloud"}'
     info = lerobot_eval(checkpoint, tmp_path / "eval", "pointcloud", [rename])
+    assert info["overall"]["n_episodes"] == 1
+    assert np.isfinite(info["overall"]["avg_sum_reward"])
+
+
+@pytest.mark.slow
+def test_stock_lerobot_train_and_eval_on_a_merged_point_cloud_experiment(tmp_path):
+    """The README's route for the paper's main setting: point-cloud rounds -> D(k) -> stock tools."""
+    import draccus
+
+    from lerobot_mtdagger.configs import RunConfig
+    from lerobot_mtdagger.dagger import run
+    from lerobot_mtdagger.rounds import ExperimentDir, merge_rounds
+
+    drawers = ["drawer-bar-wide", "drawer-knob-small"]
+    args = [
+        "--suite=drawers",
+        "--obs_mode=pointcloud",
+        f"--tasks=[{','.join(drawers)}]",
+        "--rounds=1",
+        "--initial_demos=1",
+        "--budget_per_task=1",
+        "--scheduler.n_min=1",
+        "--steps_per_round=5",
+        "--eval_episodes=1",
+        "--num_points=64",
+        "--max_rollout_steps=30",
+        "--workers=0",
+        "--progress=false",
+        f"--output_dir={tmp_path / 'run'}",
+    ]
+    run(draccus.parse(RunConfig, args=args))
+    experiment = ExperimentDir(tmp_path / "run")
+    merged = merge_rounds(experiment, [0, 1], tmp_path / "d1", repo_id="local/d1")
+    dataset = LeRobotDataset("local/d1", root=merged)
+    rounds = [LeRobotDataset("local/r", root=experiment.round_root(k)) for k in (0, 1)]
+    assert len(dataset) == sum(len(r) for r in rounds)
+    assert dataset.num_episodes == sum(r.num_episodes for r in rounds)
+    last = rounds[1][len(rounds[1]) - 1]
+    torch.testing.assert_close(
+        dataset[len(dataset) - 1]["observation.pointcloud"], last["observation.pointcloud"]
+    )
+    assert dataset[len(dataset) - 1]["task"] == last["task"]
+
+    checkpoint = lerobot_train(merged, tmp_path / "train", steps=4, repo_id="local/d1")
+    config = json.loads((checkpoint / "config.json").read_text())
+    assert config["input_features"]["observation.pointcloud"]["shape"] == [64, 3]
+    assert config["task_names"] == drawers
+    rename = '--rename_map={"observation.environment_state": "observation.pointcloud"}'
+    extra = [rename, "--env.num_points=64"]
+    info = lerobot_eval(checkpoint, tmp_path / "eval", "pointcloud", extra, suite="drawers", task=drawers[1])
     assert info["overall"]["n_episodes"] == 1
     assert np.isfinite(info["overall"]["avg_sum_reward"])
