@@ -3,14 +3,22 @@
 It must label any state a learner reaches (DAgger asks it about the learner's states), so it keeps
 no memory: each action follows from the privileged state alone (``DRAWER_STATE_NAMES``).
 
-1. Gripper open, hand not above the grasp pose: rise to a safe height (``SAFE_HEIGHT`` above the
-   grasp pose), move over the grasp pose, keeping the gripper open.
-2. Gripper open and over the grasp pose: descend until the rear finger pad is behind the handle.
-3. At the grasp pose: close the gripper (the rear pad pulls the handle into the grip).
-4. Gripper closed on the handle: pull along the drawer's axis until it is open by
+1. Gripper open: servo the hand towards a target above the grasp pose whose height grows with the
+   planar misalignment (``clearance``: 0 within ``ALIGN_TOLERANCE``, ``FUNNEL_SLOPE`` metres per
+   metre beyond it, at most ``SAFE_HEIGHT``): a funnel that ends at the grasp pose. A hand more than
+   ``RISE_FIRST`` below the funnel rises before it moves sideways (the fingers clear the handle).
+2. Aligned at the grasp pose: close the gripper (the rear pad pulls the handle into the grip).
+3. Gripper closed on the handle: pull along the drawer's axis until it is open by
    ``OPEN_TARGET`` of its travel, correcting sideways and vertical drift; then hold.
-5. Gripper closed anywhere else (a learner closed it, or the grip slipped): open it and back off
-   upwards before approaching again.
+4. Gripper closed anywhere else (a learner closed it, or the grip slipped): open it, rising to the
+   funnel's height if below it, before approaching again.
+
+The command is a continuous function of the hand's position everywhere except the gripper's
+open/close decision. DAgger needs that: a point-cloud learner localises the handle to about a
+centimetre, and an earlier version of this controller, which retreated to the safe height whenever
+the open hand was low and more than 8 mm off, gave its learner states labels that flipped from
+"descend" to "rise at full speed" within that centimetre (54% of the states its BC student visited;
+visual DAgger rounds then lowered success, ``docs/results/visual-collapse-dev/README.md``).
 
 The grasp pose comes from the env (``grasp_x/y/z``: the hand position that puts the open
 gripper's rear pad behind the handle); it moves with the drawer, so the controller also recovers
@@ -19,6 +27,7 @@ from drawers a learner left half open.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -33,6 +42,11 @@ OPEN_GRIPPER = 0.9  # gripper reading (finger distance / 10 cm) above which the 
 CLOSED_GRIPPER = 0.75  # below which it holds something (or nothing) closed
 ALIGN_TOLERANCE = 0.008
 DEPTH_TOLERANCE = 0.012
+FUNNEL_SLOPE = 4.0  # metres of height above the grasp pose per metre of planar misalignment
+RISE_FIRST = 0.02  # below the funnel by more than this, the hand rises before it moves sideways
+BRANCHES = ("align", "clear", "descend", "close", "grip", "pull", "release")
+"""What ``decide`` reports: move over the grasp pose at a safe height, rise to clear the handle, descend
+onto the grasp pose, close on the handle, hold it closed, pull, open the gripper and back off."""
 
 
 def _unpack(state: np.ndarray) -> dict[str, np.ndarray | float]:
@@ -61,6 +75,10 @@ class DrawerScriptedExpert:
 
     def act(self, privileged_state: np.ndarray) -> np.ndarray:
         """One action: end-effector displacement xyz (1 = 1 cm) and gripper effort (+1 closes)."""
+        return self.decide(privileged_state)[1]
+
+    def decide(self, privileged_state: np.ndarray) -> tuple[str, np.ndarray]:
+        """The branch of the controller that acts (one of ``BRANCHES``) and its action."""
         s = _unpack(np.asarray(privileged_state, dtype=np.float64))
         hand, grasp, axis = s["hand"], s["grasp"], s["axis"]
         lateral_axis = np.array([-axis[1], axis[0], 0.0])
@@ -76,32 +94,47 @@ class DrawerScriptedExpert:
         if at_depth and holding_zone and (s["gripper"] < OPEN_GRIPPER or aligned):
             return self._grip_and_pull(s, lateral, lateral_axis, depth)
         if s["gripper"] < OPEN_GRIPPER:
-            return self._release(hand, grasp)
-        return self._approach(hand, grasp, aligned, depth)
+            return "release", self._release(hand, grasp, lateral, along)
+        return self._approach(hand, grasp, lateral, along, depth)
 
-    def _grip_and_pull(self, s: dict, lateral: float, lateral_axis: np.ndarray, depth: float) -> np.ndarray:
+    def _grip_and_pull(
+        self, s: dict, lateral: float, lateral_axis: np.ndarray, depth: float
+    ) -> tuple[str, np.ndarray]:
         correction = GAIN * (lateral * lateral_axis + np.array([0.0, 0.0, depth]))
-        move = correction
         if s["gripper"] < CLOSED_GRIPPER and s["opening"] < OPEN_TARGET * s["travel"]:
-            move = correction + PULL_SPEED * s["axis"]
-        return self._action(move, grip=1.0)
+            return "pull", self._action(correction + PULL_SPEED * s["axis"], grip=1.0)
+        return "grip", self._action(correction, grip=1.0)
 
-    def _release(self, hand: np.ndarray, grasp: np.ndarray) -> np.ndarray:
-        safe_z = grasp[2] + SAFE_HEIGHT
-        move = np.array([0.0, 0.0, 1.0]) if hand[2] < safe_z else np.zeros(3)
-        return self._action(move, grip=-1.0)
+    @staticmethod
+    def clearance(lateral: float, along: float) -> float:
+        """Height above the grasp pose the hand keeps at a planar misalignment (the approach funnel).
 
-    def _approach(self, hand: np.ndarray, grasp: np.ndarray, aligned: bool, depth: float) -> np.ndarray:
-        safe_z = grasp[2] + SAFE_HEIGHT
-        if not aligned:
-            if hand[2] < safe_z - 0.02 and np.linalg.norm((grasp - hand)[:2]) < 0.12:
-                # Near the drawer and low: rise first, so the fingers clear the handle.
-                return self._action(np.array([0.0, 0.0, 1.0]), grip=-1.0)
-            target = np.array([grasp[0], grasp[1], max(hand[2], safe_z)])
-            return self._action(GAIN * (target - hand), grip=-1.0)
-        if abs(depth) >= DEPTH_TOLERANCE:
-            return self._action(GAIN * (grasp - hand), grip=-1.0)
-        return self._action(GAIN * (grasp - hand), grip=1.0)
+        0 within ``ALIGN_TOLERANCE``, rising by ``FUNNEL_SLOPE`` metres per metre of misalignment
+        beyond it, at most ``SAFE_HEIGHT``: continuous, so a centimetre of misalignment asks for a few
+        centimetres of height, not for a retreat to the safe height.
+        """
+        planar = math.hypot(lateral, along)
+        return min(SAFE_HEIGHT, FUNNEL_SLOPE * max(0.0, planar - ALIGN_TOLERANCE))
+
+    def _release(self, hand: np.ndarray, grasp: np.ndarray, lateral: float, along: float) -> np.ndarray:
+        target_z = grasp[2] + self.clearance(lateral, along)
+        return self._action(np.array([0.0, 0.0, max(0.0, GAIN * (target_z - hand[2]))]), grip=-1.0)
+
+    def _approach(
+        self, hand: np.ndarray, grasp: np.ndarray, lateral: float, along: float, depth: float
+    ) -> tuple[str, np.ndarray]:
+        clearance = self.clearance(lateral, along)
+        if clearance == 0.0 and abs(depth) < DEPTH_TOLERANCE:
+            return "close", self._action(GAIN * (grasp - hand), grip=1.0)
+        target = grasp + np.array([0.0, 0.0, clearance])
+        below = target[2] - hand[2]
+        # Further below the funnel than RISE_FIRST: rise only (the fingers clear the handle first);
+        # within it, blend the planar correction in.
+        planar_weight = float(np.clip(1.0 - below / RISE_FIRST, 0.0, 1.0))
+        move = GAIN * (target - hand)
+        move[:2] *= planar_weight
+        branch = "clear" if planar_weight < 1.0 else ("descend" if clearance == 0.0 else "align")
+        return branch, self._action(move, grip=-1.0)
 
     @staticmethod
     def _action(move: np.ndarray, grip: float) -> np.ndarray:
