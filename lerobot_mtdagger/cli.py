@@ -45,6 +45,9 @@ from lerobot_mtdagger.parsing import parse_options
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
 from lerobot_mtdagger.simulate import SyntheticTasks, simulate
 
+HELDOUT_TASKS = "heldout"
+"""``--tasks=heldout``: the suite's unseen tasks (``eval``, ``shift``)."""
+
 if TYPE_CHECKING:
     from lerobot_mtdagger.envs.base import TaskSuite
     from lerobot_mtdagger.evaluate import PolicyRunner
@@ -200,7 +203,8 @@ class EvalConfig:
     Attributes:
         policy_path: Pretrained model folder or Hub id (with its processors).
         suite: Task suite.
-        tasks: Tasks to evaluate (all the suite's when empty).
+        tasks: Tasks to evaluate (all the suite's when empty; ``heldout``: the suite's unseen tasks,
+            which a policy trained with ``task_dropout > 0`` acts on with its shared embedding).
         obs_mode: Observation mode the policy was trained on.
         episodes: Episodes per task.
         seed: Seed of the evaluation episodes.
@@ -242,7 +246,14 @@ def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.evaluate import PolicyRunner
 
-    suite = suite_from_config(config)
+    if list(config.tasks) == [HELDOUT_TASKS]:
+        suite = suite_from_config(config, tasks=None).heldout_suite()
+        if suite is None:
+            raise UserError(
+                f"Suite {config.suite!r} has no held-out tasks: --tasks=heldout is for the drawers."
+            )
+    else:
+        suite = suite_from_config(config)
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
     runner.check_inputs(suite.features, config.obs_mode)
     return suite, runner
@@ -256,9 +267,11 @@ def eval_command(config: EvalConfig) -> dict:
     suite, runner = _suite_and_policy(config)
     with EnvWorkers(suite, config.worker_count) as workers:
         result, _ = evaluate(workers, runner, config.episodes, config.seed)
-    for task, success in zip(result.task_names, result.success, strict=True):
-        print(f"{task:<32} {success:.3f}")
-    print(f"{'mean':<32} {result.mean:.3f}")
+    progress = result.progress or [None] * len(result.task_names)
+    for task, success, score in zip(result.task_names, result.success, progress, strict=True):
+        print(f"{task:<32} {success:.3f}" + ("" if score is None else f"  progress {score:.2f}/3"))
+    mean_progress = "" if result.progress is None else f"  progress {np.mean(result.progress):.2f}/3"
+    print(f"{'mean':<32} {result.mean:.3f}{mean_progress}")
     if config.output is not None:
         config.output.write_text(json.dumps(result.to_dict(), indent=2))
     return result.to_dict()

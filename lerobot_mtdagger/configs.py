@@ -43,6 +43,9 @@ class PolicyOptions:
         head_hidden_dims: Hidden sizes of the action head.
         pointnet_dims: PointNet per-point MLP sizes.
         task_embedding_dim: Task embedding size.
+        task_dropout: Probability of training a sample on the shared "any task" embedding instead of
+            its own (``MTDAggerConfig.task_dropout``: what lets the policy act on unseen tasks). None:
+            ``UNSEEN_TASK_DROPOUT`` for a suite with held-out tasks (the drawers), else 0.
         device: Torch device.
     """
 
@@ -52,7 +55,18 @@ class PolicyOptions:
     head_hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
     pointnet_dims: list[int] = field(default_factory=lambda: [64, 128, 256])
     task_embedding_dim: int = 32
+    task_dropout: float | None = None
     device: str = "cpu"
+
+    def resolved_task_dropout(self, has_heldout_tasks: bool) -> float:
+        """``task_dropout``, with None resolved for a suite with or without held-out tasks."""
+        if self.task_dropout is not None:
+            return self.task_dropout
+        return UNSEEN_TASK_DROPOUT if has_heldout_tasks else 0.0
+
+
+UNSEEN_TASK_DROPOUT = 0.1
+"""Task dropout of runs on suites with held-out tasks: one sample in ten trains the shared embedding."""
 
 
 RUN_MODES: tuple[str, ...] = ("dagger", "bc")

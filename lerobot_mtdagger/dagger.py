@@ -97,6 +97,7 @@ class RunContext:
     experiment: ExperimentDir
     workers: EnvWorkers
     show_progress: bool
+    heldout_suite: TaskSuite | None = None
     timings: dict[int, dict[str, float]] = field(default_factory=dict)
     rounds_in_memory: list[TrainingData] = field(default_factory=list)
 
@@ -296,7 +297,10 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     """Trains on D(round_index), evaluates and commits the phase."""
     config = ctx.config
     start = time.perf_counter()
-    policy_cfg = policy_config(ctx.suite.features, ctx.task_names, config.policy, config.policy.device)
+    task_dropout = config.policy.resolved_task_dropout(bool(ctx.suite.heldout_task_names))
+    policy_cfg = policy_config(
+        ctx.suite.features, ctx.task_names, config.policy, config.policy.device, task_dropout
+    )
     input_keys = list(policy_cfg.input_features)
     image_keys = [k for k in input_keys if k.startswith(IMAGE_KEY)]
     data = rounds_in_memory(ctx, round_index, input_keys)
@@ -341,7 +345,13 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     trained = time.perf_counter()
     staging = ctx.experiment.staging_policy_root(round_index)
     save_policy(policy, preprocessor, postprocessor, staging)
-    eval_result = evaluate_phase(ctx, PolicyRunner(policy, preprocessor, postprocessor))
+    runner = PolicyRunner(policy, preprocessor, postprocessor)
+    eval_result = evaluate_phase(ctx, runner, ctx.workers)
+    heldout_result = None
+    if ctx.heldout_suite is not None:
+        # Workers of their own, only while they evaluate: each holds its drawers' envs and renderers.
+        with EnvWorkers(ctx.heldout_suite, ctx.config.worker_count) as heldout_workers:
+            heldout_result = evaluate_phase(ctx, runner, heldout_workers)
     evaluated = time.perf_counter()
     demos = ctx.experiment.read_round_record(round_index).demos_so_far
     timing = {"load_s": loaded - start, "train_s": trained - loaded, "eval_s": evaluated - trained}
@@ -359,6 +369,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
         loss_samples=result.loss_samples,
         final_train_loss=result.train_loss,
         eval=None if eval_result is None else eval_result.to_dict(),
+        heldout_eval=None if heldout_result is None else heldout_result.to_dict(),
         demos_per_task=demos,
         timings=ctx.timings[round_index],
         best_step=result.best_step,
@@ -388,14 +399,18 @@ def rounds_in_memory(ctx: RunContext, round_index: int, input_keys: list[str]) -
     return TrainingData.concat(ctx.rounds_in_memory[: round_index + 1])
 
 
-def evaluate_phase(ctx: RunContext, runner: PolicyRunner) -> EvalResult | None:
-    """Evaluates the freshly trained policy (None when eval_episodes is 0)."""
+def evaluate_phase(ctx: RunContext, runner: PolicyRunner, workers: EnvWorkers) -> EvalResult | None:
+    """Evaluates the freshly trained policy on the tasks of ``workers`` (None when eval_episodes is 0).
+
+    ``ctx.workers`` step the training tasks; workers of ``ctx.heldout_suite`` the unseen ones, whose
+    result is recorded beside the training tasks' and never reaches the scheduler.
+    """
     if ctx.config.eval_episodes == 0:
         return None
-    episodes = ctx.config.eval_episodes * len(ctx.task_names)
+    episodes = ctx.config.eval_episodes * len(workers.suite.task_names)
     with tqdm(total=episodes, desc="eval", leave=False, disable=not ctx.show_progress) as bar:
         result, _ = evaluate(
-            ctx.workers,
+            workers,
             runner,
             ctx.config.eval_episodes,
             ctx.config.seed,
@@ -414,6 +429,8 @@ def summary_line(ctx: RunContext, round_index: int) -> str:
     record = ctx.experiment.read_round_record(round_index)
     phase = ctx.experiment.read_phase_record(round_index)
     success = "n/a" if phase.eval_mean is None else f"{phase.eval_mean:.3f}"
+    if phase.heldout_eval is not None:
+        success += f" | unseen {phase.heldout_eval['mean']:.3f}"
     demos = np.mean(record.demos_so_far)
     timing = " ".join(f"{k}={v:.1f}" for k, v in phase.timings.items())
     return (
@@ -486,6 +503,23 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         return _run_locked(config, suite, experiment, on_summary)
 
 
+def unseen_task_suite(config: RunConfig, suite: TaskSuite) -> TaskSuite | None:
+    """The held-out tasks every phase is also evaluated on.
+
+    None where the suite has none, the policy has no shared task embedding to act on them with
+    (``--policy.task_dropout=0``), or nothing is evaluated.
+    """
+    heldout = suite.heldout_suite()
+    if heldout is None or config.eval_episodes == 0:
+        return None
+    if config.policy.resolved_task_dropout(True) == 0.0:
+        logger.info(
+            "Unseen tasks are not evaluated: --policy.task_dropout=0 gives no embedding to act on them."
+        )
+        return None
+    return heldout
+
+
 def _run_locked(
     config: RunConfig, suite: TaskSuite, experiment: ExperimentDir, on_summary: Callable[[str], None] | None
 ) -> list[str]:
@@ -498,9 +532,8 @@ def _run_locked(
     rounds_done, phases_done = set(experiment.committed_rounds()), set(experiment.committed_phases())
     try:
         with EnvWorkers(suite, config.worker_count) as workers:
-            ctx = RunContext(
-                config=config, suite=suite, experiment=experiment, workers=workers, show_progress=show
-            )
+            heldout = unseen_task_suite(config, suite)
+            ctx = RunContext(config, suite, experiment, workers, show, heldout_suite=heldout)
             for round_index in range(ctx.last_round + 1):
                 if round_index not in rounds_done:
                     collect_round(ctx, round_index)

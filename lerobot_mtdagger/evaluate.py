@@ -139,11 +139,12 @@ class PolicyRunner:
 
 @dataclass
 class EvalResult:
-    """Success of the pure policy per task."""
+    """Success of the pure policy per task (and the mean 0-3 progress score where the suite has one)."""
 
     task_names: list[str]
     success: list[float]
     episodes: list[int]
+    progress: list[float] | None = None
 
     @property
     def mean(self) -> float:
@@ -152,12 +153,15 @@ class EvalResult:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form."""
-        return {
+        values: dict[str, Any] = {
             "task_names": self.task_names,
             "success": self.success,
             "episodes": self.episodes,
             "mean": self.mean,
         }
+        if self.progress is not None:
+            values |= {"progress": self.progress, "mean_progress": float(np.mean(self.progress))}
+        return values
 
 
 def evaluate(
@@ -196,5 +200,9 @@ def evaluate(
         progress=progress,
     )
     rates, counts = success_by_task(episodes, len(suite.task_names))
-    result = EvalResult(list(suite.task_names), [r if r is not None else 0.0 for r in rates], counts)
-    return result, episodes
+    progress = None
+    if suite.reports_progress:
+        totals = np.bincount([e.task_index for e in episodes], [e.progress for e in episodes], len(counts))
+        progress = [float(total / max(count, 1)) for total, count in zip(totals, counts, strict=True)]
+    success = [r if r is not None else 0.0 for r in rates]
+    return EvalResult(list(suite.task_names), success, counts, progress), episodes

@@ -143,15 +143,28 @@ def _caption(rows: Sequence[Row]) -> str:
     return f"mean over {seeds} seeds, 95% t interval; {'/'.join(map(str, episodes))} eval episodes per task"
 
 
-def plot_success(rows: Sequence[Row], x_key: str, x_label: str, path: Path, methods=None) -> Path:
-    """Figure 1 (and 5 with ``methods``): success against demos or frames, one curve per method."""
+def plot_success(
+    rows: Sequence[Row],
+    x_key: str,
+    x_label: str,
+    path: Path,
+    methods=None,
+    y_key: str = "eval_success_mean",
+    title: str | None = None,
+) -> Path:
+    """Figure 1 (and 5 with ``methods``): success against demos or frames, one curve per method.
+
+    ``y_key="unseen_success_mean"`` draws the success on the unseen tasks instead (rows without it
+    are left out).
+    """
+    rows = [row for row in rows if row.get(y_key) is not None]
     plt = _pyplot()
     figure, axis = plt.subplots(figsize=(7, 4.5))
     bc_names = bc_methods(rows)
     for method, seeds in runs_by_method(rows).items():
         if methods is not None and method not in methods:
             continue
-        points = curve_points(seeds, x_key)
+        points = curve_points(seeds, x_key, lambda row: row[y_key])
         x = [p for p, _ in points]
         mean = np.array([i.mean for _, i in points])
         # Success is a fraction: the band is drawn within [0, 1] (a t interval over few seeds is wide).
@@ -172,7 +185,9 @@ def plot_success(rows: Sequence[Row], x_key: str, x_label: str, path: Path, meth
     axis.set_xlabel(x_label)
     axis.set_ylabel("average evaluation success (fraction of episodes)")
     axis.set_ylim(-0.02, 1.02)
-    axis.set_title("Success against expert data" if methods is None else "Task need with and without Kalman")
+    if title is None:
+        title = "Success against expert data" if methods is None else "Task need with and without Kalman"
+    axis.set_title(title)
     _legend(axis)
     axis.grid(alpha=0.3)
     figure.text(0.01, 0.01, _caption(rows), fontsize=8)
@@ -491,6 +506,44 @@ def cost_lines(rows: Sequence[Row]) -> list[str]:
     return lines + [""]
 
 
+def unseen_lines(rows: Sequence[Row]) -> list[str]:
+    """Markdown: the paper's in-domain / unseen table, per method at each point (none without unseen tasks).
+
+    In-domain: the training tasks; unseen: the suite's held-out tasks (the drawers a policy has no
+    task index for), evaluated after every phase and never given to the scheduler. Progress is the
+    0-3 score (touch the handle, pull, open). Mean over seeds with a 95% t interval.
+    """
+    if not any(row.get("unseen_success_mean") is not None for row in rows):
+        return []
+    lines = ["## In-domain and unseen tasks", ""]
+    lines += [
+        "Mean over seeds (95% t interval) after each phase; unseen = held-out tasks, acted on with the "
+        "policy's shared task embedding. Progress: 0-3.",
+        "",
+        "| method | demos per task | in-domain success | unseen success | in-domain progress "
+        "| unseen progress |",
+        "|---|---:|---|---|---|---|",
+    ]
+
+    def cell(column: list[Row], key: str) -> str:
+        values = [row[key] for row in column if row.get(key) is not None]
+        if not values:
+            return "n/a"
+        interval = mean_interval(values)
+        if math.isnan(interval.low):
+            return f"{interval.mean:.3f}"
+        return f"{interval.mean:.3f} [{interval.low:.3f}, {interval.high:.3f}]"
+
+    for method, seeds in runs_by_method(rows).items():
+        for column in point_columns(seeds):
+            demos = float(np.mean([row["demos_per_task_mean"] for row in column]))
+            keys = ("eval_success_mean", "unseen_success_mean", "eval_progress_mean", "unseen_progress_mean")
+            lines.append(
+                f"| {method} | {demos:.1f} | " + " | ".join(cell(column, key) for key in keys) + " |"
+            )
+    return lines + [""]
+
+
 def interim_lines(unfinished: Sequence[str]) -> list[str]:
     """The interim warning of a report with unfinished runs (none when every run finished)."""
     if not unfinished:
@@ -529,7 +582,7 @@ def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[
             shown = "n/a" if ratio is None else f"{ratio:.2f}"
             lines.append(f"| {method} | {baseline} | {level:.0%} | {shown} | {paired}/{seeds} |")
     lines += ["", *reach_lines(rows, levels), *task_gap_lines(rows, notes["hardest_indices"])]
-    lines += [*stability_lines(rows), *cost_lines(rows)]
+    lines += [*unseen_lines(rows), *stability_lines(rows), *cost_lines(rows)]
     return "\n".join(lines) + "\n"
 
 
@@ -594,6 +647,15 @@ def write_report(
         folder / "kalman_ablation.png",
         methods={"need", "need_raw"},
     )
+    if any(row.get("unseen_success_mean") is not None for row in rows):
+        figures["Success on the unseen tasks"] = plot_success(
+            rows,
+            "demos_per_task_mean",
+            "expert demos per task (episodes, training tasks)",
+            folder / "unseen_success_vs_demos.png",
+            y_key="unseen_success_mean",
+            title="Success on unseen tasks (no task index: shared embedding)",
+        )
     notes = {
         "correlations": {k: round(v, 3) for k, v in correlations.items()},
         "hardest": [task_names[t] for t in hardest],

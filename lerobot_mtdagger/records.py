@@ -206,6 +206,8 @@ class PhaseRecord:
             loss; 0: the phase's initial weights); None otherwise.
         heldout_loss: With ``steps_rule=plateau``, ``[step, mean held-out loss]`` at every
             measurement; None otherwise.
+        heldout_eval: ``EvalResult.to_dict()`` on the suite's unseen tasks (the held-out drawers),
+            recorded beside ``eval`` and never given to the scheduler; None where not evaluated.
     """
 
     round: int
@@ -225,6 +227,7 @@ class PhaseRecord:
     files: dict[str, str] | None = None
     best_step: int | None = None
     heldout_loss: list[list[float]] | None = None
+    heldout_eval: dict[str, Any] | None = None
 
     @property
     def eval_mean(self) -> float | None:

@@ -43,6 +43,8 @@ LIST_COLUMNS = (
     "kalman_p",
     "raw_success",
     "gain",
+    "unseen_success",
+    "unseen_tasks",
 )
 
 
@@ -108,7 +110,20 @@ def _row(
         "kalman_p": following.kalman_posterior.get("p") if following is not None else None,
         "raw_success": following.success_rate if following is not None else None,
         "gain": None if phase.gain is None else [float(g) for g in phase.gain],
+        **_progress_and_unseen(phase),
         **{name: float(phase.timings.get(name, 0.0)) for name in PHASE_TIMINGS},
+    }
+
+
+def _progress_and_unseen(phase: Any) -> dict[str, Any]:
+    """Progress on the training tasks, success and progress on the unseen ones (None: not measured)."""
+    unseen = phase.heldout_eval
+    return {
+        "eval_progress_mean": phase.eval.get("mean_progress"),
+        "unseen_success_mean": None if unseen is None else float(unseen["mean"]),
+        "unseen_success": None if unseen is None else [float(s) for s in unseen["success"]],
+        "unseen_progress_mean": None if unseen is None else unseen.get("mean_progress"),
+        "unseen_tasks": None if unseen is None else list(unseen["task_names"]),
     }
 
 
@@ -159,7 +174,8 @@ def write_results(
     meta = {"task_names": list(task_names), "unfinished": list(unfinished), "configs": dict(configs)}
     (folder / META_FILE).write_text(json.dumps(meta, indent=1))
     with csv_path.open("w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        # Tables joined from several reports may mix rows written before a column existed.
+        writer = csv.DictWriter(handle, fieldnames=list(dict.fromkeys(k for row in rows for k in row)))
         writer.writeheader()
         for row in rows:
             writer.writerow({k: json.dumps(v) if k in LIST_COLUMNS else v for k, v in row.items()})

@@ -211,7 +211,11 @@ def compute_stats(data: TrainingData, image_keys: Sequence[str]) -> dict[str, di
 
 
 def policy_config(
-    suite_features: dict[str, Any], task_names: Sequence[str], options: Any, device: str = "cpu"
+    suite_features: dict[str, Any],
+    task_names: Sequence[str],
+    options: Any,
+    device: str = "cpu",
+    task_dropout: float = 0.0,
 ) -> MTDAggerConfig:
     """The ``mtdagger`` config for a suite's features and the run's policy options."""
     features = dataset_to_policy_features(suite_features)
@@ -225,6 +229,7 @@ def policy_config(
         head_hidden_dims=tuple(options.head_hidden_dims),
         pointnet_dims=tuple(options.pointnet_dims),
         task_embedding_dim=options.task_embedding_dim,
+        task_dropout=task_dropout,
         push_to_hub=False,
     )
 

@@ -93,6 +93,7 @@ class Episode:
         frames: Recorded frames (empty when not recording).
         learner_steps: Steps where the learner's action was executed.
         steps: Episode length.
+        progress: Best ``info["progress"]`` of the episode (suites that report a progress score).
     """
 
     task_index: int
@@ -102,6 +103,7 @@ class Episode:
     frames: list[dict[str, Any]] = field(default_factory=list)
     learner_steps: int = 0
     steps: int = 0
+    progress: int = 0
 
     @property
     def learner_only(self) -> bool:
@@ -340,6 +342,7 @@ class RolloutWorker:
         running.privileged = info["privileged_state"]
         episode.steps += 1
         episode.learner_steps += int(not expert_acts)
+        episode.progress = max(episode.progress, int(info.get("progress", 0)))
         if info["success"] and not episode.success:
             episode.success = True
             running.steps_since_success = 0

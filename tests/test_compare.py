@@ -228,6 +228,26 @@ def test_report_redrawn_from_the_saved_table_alone_equals_the_report_of_the_runs
     assert meta["configs"]["need"]["eval_episodes"] == 2 and "seed" not in meta["configs"]["need"]
 
 
+def test_a_table_written_before_the_unseen_columns_joins_a_new_one(compared, tmp_path):
+    """Saved seeds of a study outlive the toolkit's new columns: ``report --results`` still joins them."""
+    folder, _ = compared
+    assert main(["report", f"--compare_dir={folder}", f"--output_dir={tmp_path / 'report'}"]) == 0
+    new_columns = ("eval_progress_mean", "unseen_success_mean", "unseen_success", "unseen_progress_mean")
+    tables = {}
+    for seed in (0, 1):
+        table = _saved_table(tmp_path / "report", tmp_path / f"seed{seed}")
+        rows = [row for row in json.loads((table / "results.json").read_text()) if row["seed"] == seed]
+        assert rows and all(column in row for row in rows for column in new_columns)
+        if seed == 0:  # as written before the columns existed
+            rows = [{k: v for k, v in row.items() if k not in (*new_columns, "unseen_tasks")} for row in rows]
+        (table / "results.json").write_text(json.dumps(rows))
+        tables[seed] = table / "results.json"
+    joined = tmp_path / "joined"
+    assert main(["report", f"--results=[{tables[0]},{tables[1]}]", f"--output_dir={joined}"]) == 0
+    header = (joined / "results.csv").read_text().splitlines()[0].split(",")
+    assert set(new_columns) <= set(header)
+
+
 def test_a_redrawn_interim_report_still_lists_the_unfinished_runs(compared, tmp_path):
     folder, _ = compared
     study = tmp_path / "cmp"

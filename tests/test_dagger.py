@@ -18,6 +18,7 @@ import torch
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.dagger import run
+from lerobot_mtdagger.envs.drawers import HELDOUT_TASKS
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.records import RoundRecord
@@ -217,7 +218,8 @@ def test_foreign_dataset_in_the_output_dir_is_refused(tmp_path):
     assert (root / "rounds" / "round-000" / "meta" / "info.json").exists()
 
 
-def test_drawer_suite_runs_with_point_clouds(tmp_path):
+@pytest.mark.slow
+def test_drawer_suite_runs_with_point_clouds_and_evaluates_the_unseen_drawers(tmp_path):
     import draccus
 
     args = [
@@ -244,6 +246,35 @@ def test_drawer_suite_runs_with_point_clouds(tmp_path):
 
     dataset = LeRobotDataset("local/drawers", root=experiment.round_root(1))
     assert tuple(dataset[0]["observation.pointcloud"].shape) == (128, 3)
+
+    # Every phase is also evaluated on the unseen drawers (task dropout gives the policy a shared
+    # embedding to act on them), beside the training drawers' success and never given to the scheduler.
+    for phase in (0, 1):
+        record = experiment.read_phase_record(phase)
+        assert record.heldout_eval["task_names"] == list(HELDOUT_TASKS)
+        assert record.heldout_eval["episodes"] == [1] * len(HELDOUT_TASKS)
+        assert all(0 <= p <= 3 for p in record.heldout_eval["progress"] + record.eval["progress"])
+    assert experiment.read_round_record(1).episodes_per_task == [1, 1]
+
+    from lerobot_mtdagger.cli import EvalConfig, eval_command
+
+    policy = experiment.policy_root(1)
+    args = [f"--policy_path={policy}", "--suite=drawers", "--tasks=[heldout]", "--obs_mode=pointcloud"]
+    result = eval_command(
+        draccus.parse(EvalConfig, args=[*args, "--num_points=128", "--episodes=1", "--workers=0"])
+    )
+    assert result["task_names"] == list(HELDOUT_TASKS) and len(result["progress"]) == len(HELDOUT_TASKS)
+
+    # report carries them: the in-domain / unseen table and the unseen-success figure.
+    from lerobot_mtdagger.figures import write_report
+    from lerobot_mtdagger.results import results_rows
+
+    rows = results_rows([experiment.root])
+    assert [row["unseen_tasks"] for row in rows] == [list(HELDOUT_TASKS)] * 2
+    task_names = experiment.read_round_record(0).task_names
+    markdown = write_report(rows, task_names, tmp_path / "report").read_text()
+    assert "## In-domain and unseen tasks" in markdown
+    assert (tmp_path / "report" / "unseen_success_vs_demos.png").stat().st_size > 0
 
 
 def _cli(output_dir: Path, *extra: str) -> list[str]:

@@ -124,9 +124,41 @@ def test_unknown_task_string_is_a_clear_error():
     batch = make_batch(inputs, batch_size=1)
     batch["task"] = ["pick-place-v3"]
     with pytest.raises(
-        ValueError, match=r"Unknown task\(s\) \['pick-place-v3'\]: this policy was trained on"
+        ValueError, match=r"Unknown task\(s\) \['pick-place-v3'\]: this policy was trained on.*task_dropout"
     ):
         policy.select_action(batch)
+
+
+def test_task_dropout_gives_unseen_tasks_the_shared_embedding(tmp_path):
+    inputs = MODALITIES["state"]
+    torch.manual_seed(0)
+    policy = MTDAggerPolicy(make_config(inputs, task_dropout=0.5))
+    assert policy.task_embedding.num_embeddings == len(TASKS) + 1
+    batch = make_batch(inputs, batch_size=2)
+    batch["task"] = ["pick-place-v3", "reach-v3"]
+    assert policy.task_indices(batch).tolist() == [len(TASKS), 0]
+    unseen = policy.select_action(batch)
+    assert unseen.shape == (2, 4)
+
+    # The shared row learns from the dropped samples of every task; evaluation drops nothing.
+    policy.train()
+    loss, info = policy.forward(make_batch(inputs, batch_size=64))
+    loss.backward()
+    assert policy.task_embedding.weight.grad[len(TASKS)].abs().sum() > 0
+    assert set(info["per_task_loss"]) == {"reach-v3", "push-v3"}
+    policy.eval()
+    again = make_batch(inputs, batch_size=2)
+    again["task"] = ["pick-place-v3", "reach-v3"]
+    torch.testing.assert_close(policy.select_action(again), policy.select_action(again), rtol=0, atol=0)
+
+    policy.save_pretrained(tmp_path / "model")
+    loaded = MTDAggerPolicy.from_pretrained(tmp_path / "model")
+    torch.testing.assert_close(loaded.select_action(again), policy.select_action(again), rtol=0, atol=0)
+
+
+def test_a_policy_without_task_dropout_keeps_its_checkpoint_layout():
+    policy = MTDAggerPolicy(make_config(MODALITIES["state"]))
+    assert policy.task_embedding.num_embeddings == len(TASKS)
 
 
 def test_save_and_load_round_trip_gives_identical_actions(tmp_path):
@@ -207,6 +239,8 @@ def test_bad_feature_configs_are_clear_errors(kwargs, match):
         ("task_embedding_dim", 0, "task_embedding_dim must be > 0"),
         ("pointnet_dims", (16, -1), "pointnet_dims must hold positive sizes"),
         ("dropout", 1.0, "dropout"),
+        ("task_dropout", 1.0, r"task_dropout must be in \[0, 1\)"),
+        ("task_dropout", -0.1, "task_dropout"),
         ("n_obs_steps", 2, "n_obs_steps"),
     ],
 )

@@ -128,10 +128,17 @@ class TaskSuite(abc.ABC):
         # Unseen tasks the suite builds envs and experts for (evaluation only; no task index).
         self.heldout_task_names: list[str] = []
 
+    reports_progress: bool = False
+    """Whether the envs' ``info`` carries ``progress`` (the drawers' 0-3 score)."""
+
     @property
     def obs_mode(self) -> str:
         """The observation mode of every env of the suite."""
         return self.observation.obs_mode
+
+    def heldout_suite(self) -> TaskSuite | None:
+        """A suite whose tasks are this suite's held-out tasks (same observations), or None without any."""
+        return None
 
     def task_index(self, task_name: str) -> int:
         """Index of ``task_name`` in ``task_names``.

@@ -66,6 +66,7 @@ class DrawerSuite(TaskSuite):
 
     name = "drawers"
     expert_family = "drawers"
+    reports_progress = True
 
     def __init__(
         self,
@@ -95,6 +96,15 @@ class DrawerSuite(TaskSuite):
         super().__init__(task_names, observation)
         self.max_episode_steps = max_episode_steps
         self.heldout_task_names = [t for t in HELDOUT_TASKS if t not in self.task_names]
+        self._user_variants = list(variants or ())
+
+    def heldout_suite(self) -> DrawerSuite | None:
+        """The unseen drawers as a suite of their own (for evaluation: the policy has no index for them)."""
+        if not self.heldout_task_names:
+            return None
+        return DrawerSuite(
+            self.heldout_task_names, self.observation, self.max_episode_steps, variants=self._user_variants
+        )
 
     @property
     def action_dim(self) -> int:

@@ -45,6 +45,11 @@ class MTDAggerConfig(PreTrainedConfig):
         pointcloud_embedding_dim: Output size of the point-cloud encoder (after the max-pool projection).
         head_hidden_dims: Hidden layer sizes of the action head.
         dropout: Dropout in the action head.
+        task_dropout: Probability, per training sample, of replacing its task embedding by one shared
+            "any task" embedding (learned alongside the tasks' own). With ``task_dropout > 0`` the
+            policy also acts on a task it was not trained on (an unseen drawer): any task string
+            outside ``task_names`` gets the shared embedding. With 0 (the default) such a task is an
+            error, and the checkpoint has no shared embedding.
         optimizer_lr: AdamW learning rate (the paper: 3e-4 on MetaWorld, 1e-4 on the drawers).
         optimizer_weight_decay: AdamW weight decay.
         optimizer_grad_clip_norm: Gradient clipping norm.
@@ -64,6 +69,7 @@ class MTDAggerConfig(PreTrainedConfig):
     pointcloud_embedding_dim: int = 256
     head_hidden_dims: tuple[int, ...] = (256, 256)
     dropout: float = 0.0
+    task_dropout: float = 0.0
     optimizer_lr: float = 3e-4
     optimizer_weight_decay: float = 0.0
     optimizer_grad_clip_norm: float = 10.0
@@ -101,6 +107,8 @@ class MTDAggerConfig(PreTrainedConfig):
             raise ValueError("image_channels and pointnet_dims need at least one layer each.")
         if not 0.0 <= self.dropout < 1.0:
             raise ValueError(f"dropout must be in [0, 1), got {self.dropout}.")
+        if not 0.0 <= self.task_dropout < 1.0:
+            raise ValueError(f"task_dropout must be in [0, 1), got {self.task_dropout}.")
         if self.optimizer_lr <= 0:
             raise ValueError(f"optimizer_lr must be > 0, got {self.optimizer_lr}.")
 

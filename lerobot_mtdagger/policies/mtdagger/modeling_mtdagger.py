@@ -7,6 +7,7 @@ trained with MSE on the experts' actions.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from typing import Any
 
@@ -16,6 +17,8 @@ from lerobot.utils.constants import ACTION
 from torch import Tensor, nn
 
 from lerobot_mtdagger.policies.mtdagger.configuration_mtdagger import MTDAggerConfig
+
+logger = logging.getLogger(__name__)
 
 TASK_KEY = "task"
 TASK_INDEX_KEY = "task_index"
@@ -92,7 +95,11 @@ class MTDAggerPolicy(PreTrainedPolicy):
         config.validate_features()
         self.config = config
         self._task_lookup = {name: i for i, name in enumerate(config.task_names)}
-        self.task_embedding = nn.Embedding(len(config.task_names), config.task_embedding_dim)
+        # Row len(task_names): the shared "any task" embedding, present only with task dropout.
+        self.any_task_index = len(config.task_names) if config.task_dropout > 0 else None
+        rows = len(config.task_names) + int(self.any_task_index is not None)
+        self.task_embedding = nn.Embedding(rows, config.task_embedding_dim)
+        self._unseen_logged: set[str] = set()
         fused = config.task_embedding_dim
 
         self.vector_keys = sorted(config.vector_features)
@@ -140,11 +147,16 @@ class MTDAggerPolicy(PreTrainedPolicy):
             if isinstance(tasks, str):
                 tasks = [tasks]
             unknown = sorted({t for t in tasks if t not in self._task_lookup})
-            if unknown:
+            if unknown and self.any_task_index is None:
                 raise ValueError(
-                    f"Unknown task(s) {unknown}: this policy was trained on {self.config.task_names}."
+                    f"Unknown task(s) {unknown}: this policy was trained on {self.config.task_names} "
+                    "(a policy trained with --policy.task_dropout > 0 acts on unseen tasks)."
                 )
-            return torch.tensor([self._task_lookup[t] for t in tasks], device=device, dtype=torch.long)
+            for task in set(unknown) - self._unseen_logged:
+                logger.info("Task %r is not a training task: the shared embedding acts on it.", task)
+                self._unseen_logged.add(task)
+            indices = [self._task_lookup.get(t, self.any_task_index) for t in tasks]
+            return torch.tensor(indices, device=device, dtype=torch.long)
         if TASK_INDEX_KEY in batch:
             index = torch.as_tensor(batch[TASK_INDEX_KEY], device=device).long().reshape(-1)
             if index.numel() and (index.min() < 0 or index.max() >= len(self.config.task_names)):
@@ -169,6 +181,10 @@ class MTDAggerPolicy(PreTrainedPolicy):
         """
         if task_index is None:
             task_index = self.task_indices(batch)
+        if self.training and self.any_task_index is not None:
+            # Task dropout: some samples learn the shared "any task" embedding instead of their own.
+            dropped = torch.rand(task_index.shape, device=task_index.device) < self.config.task_dropout
+            task_index = torch.where(dropped, torch.full_like(task_index, self.any_task_index), task_index)
         features = [self.task_embedding(task_index)]
         if self.state_encoder is not None:
             if len(self.vector_keys) == 1:
@@ -220,7 +236,8 @@ class MTDAggerPolicy(PreTrainedPolicy):
         indices = self.task_indices(batch)
         loss, prediction = self._imitation_terms(batch, indices)
         per_sample = ((prediction.detach() - batch[ACTION]) ** 2).mean(dim=1)  # (B,)
-        per_task, counts = per_task_means(per_sample, indices, len(self.config.task_names))
+        known = indices < len(self.config.task_names)  # unseen tasks (shared embedding) have no entry
+        per_task, counts = per_task_means(per_sample[known], indices[known], len(self.config.task_names))
         present = torch.nonzero(counts).flatten().tolist()
         names = self.config.task_names
         per_task_values = per_task.tolist()
