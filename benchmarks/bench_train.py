@@ -86,7 +86,7 @@ def make_policy(seed: int) -> MTDAggerPolicy:
 def bare_loop(data: NormalisedData, steps: int, warmup: int, seed: int) -> tuple[float, float]:
     """A plain PyTorch loop over the same modules; returns (steady ms/step, whole-run ms/step)."""
     policy = make_policy(seed)
-    embedding, encoder, head = policy.task_embedding, policy.state_encoder, policy.head
+    embedding, encoder, head = policy.task_embedding, policy.encoders["observation_state"], policy.head
     state, action, task = data.vector["observation.state"], data.vector["action"], data.task_index
     parameters = list(policy.parameters())
     optimizer = torch.optim.AdamW(

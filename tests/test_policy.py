@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import torch
@@ -64,15 +66,11 @@ def test_forward_backward_for_each_modality(modality):
     assert torch.isfinite(loss)
     assert set(info["per_task_loss"]) == {"reach-v3", "push-v3"}
 
-    # The modality builds exactly its encoders, and the loss trains every parameter of all of them.
-    encoders = {
-        "observation.state": "state_encoder",
-        "observation.image": "image_encoder",
-        "observation.pointcloud": "pointcloud_encoders",
-    }
-    expected_modules = {"task_embedding", "head"} | {encoders[key] for key in inputs}
+    # The modality builds exactly its encoders, one per input keyed by it, and the loss trains every
+    # parameter of all of them.
     parameters = dict(policy.named_parameters())
-    assert {name.split(".")[0] for name in parameters} == expected_modules
+    assert {name.split(".")[0] for name in parameters} == {"task_embedding", "head", "encoders"}
+    assert set(policy.encoders) == {key.replace(".", "_") for key in inputs}
     for name, parameter in parameters.items():
         grad = parameter.grad
         assert grad is not None, f"{name} gets no gradient"
@@ -247,3 +245,16 @@ def test_bad_feature_configs_are_clear_errors(kwargs, match):
 def test_bad_config_values_are_rejected(field, value, match):
     with pytest.raises(ValueError, match=match):
         MTDAggerConfig(device="cpu", **{field: value})
+
+
+LEGACY = Path(__file__).parent / "data" / "legacy-policy-v1"
+
+
+def test_a_checkpoint_written_before_encoders_were_keyed_by_input_still_loads():
+    """tests/data/legacy-policy-v1: state_encoder / image_encoder / pointcloud_encoders.0 weights."""
+    policy = MTDAggerPolicy.from_pretrained(LEGACY)
+    assert set(policy.encoders) == {"observation_state", "observation_image", "observation_pointcloud"}
+    expected = torch.load(LEGACY / "expected_actions.pt")
+    torch.testing.assert_close(
+        policy.select_action(dict(expected["batch"])), expected["actions"], rtol=0, atol=0
+    )

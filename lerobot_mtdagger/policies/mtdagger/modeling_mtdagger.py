@@ -11,6 +11,7 @@ import logging
 from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
 import torch
 from lerobot.policies.pretrained import PreTrainedPolicy
 from lerobot.utils.constants import ACTION
@@ -70,6 +71,27 @@ class PointNetEncoder(nn.Module):
         return self.projection(per_point.max(dim=1).values)
 
 
+def encoder_name(key: str) -> str:
+    """The ``encoders`` entry of an input feature (module names cannot hold dots)."""
+    return key.replace(".", "_")
+
+
+def build_encoder(key: str, config: MTDAggerConfig) -> tuple[nn.Module, int]:
+    """The encoder of one input feature and its output size (PointNet, CNN or MLP by feature kind)."""
+    if key in config.pointcloud_features:
+        channels = config.pointcloud_features[key].shape[1]
+        return PointNetEncoder(channels, config.pointnet_dims, config.pointcloud_embedding_dim), (
+            config.pointcloud_embedding_dim
+        )
+    if key in config.image_features:
+        channels = config.image_features[key].shape[0]
+        return ImageEncoder(
+            channels, config.image_channels, config.image_embedding_dim
+        ), config.image_embedding_dim
+    size = int(np.prod(config.vector_features[key].shape))
+    return mlp(size, config.state_hidden_dims, config.state_embedding_dim), config.state_embedding_dim
+
+
 class MTDAggerPolicy(PreTrainedPolicy):
     """Multitask policy conditioned on a learned task embedding (LeRobot policy type ``mtdagger``)."""
 
@@ -102,31 +124,48 @@ class MTDAggerPolicy(PreTrainedPolicy):
         self._unseen_logged: set[str] = set()
         fused = config.task_embedding_dim
 
+        # One encoder per input feature, keyed by it (as SB3's CombinedExtractor); their outputs are
+        # concatenated after the task embedding in this order: vectors, images, point clouds.
         self.vector_keys = sorted(config.vector_features)
-        self.state_encoder: nn.Module | None = None
-        if self.vector_keys:
-            state_dim = sum(config.vector_features[k].shape[0] for k in self.vector_keys)
-            self.state_encoder = mlp(state_dim, config.state_hidden_dims, config.state_embedding_dim)
-            fused += config.state_embedding_dim
-
         self.image_keys = sorted(config.image_features)
-        self.image_encoder: nn.Module | None = None
-        if self.image_keys:
-            in_channels = config.image_features[self.image_keys[0]].shape[0]
-            self.image_encoder = ImageEncoder(in_channels, config.image_channels, config.image_embedding_dim)
-            fused += config.image_embedding_dim * len(self.image_keys)
-
         self.pointcloud_keys = sorted(config.pointcloud_features)
-        self.pointcloud_encoders = nn.ModuleDict()
-        for index, key in enumerate(self.pointcloud_keys):
-            channels = config.pointcloud_features[key].shape[1]
-            self.pointcloud_encoders[str(index)] = PointNetEncoder(
-                channels, config.pointnet_dims, config.pointcloud_embedding_dim
-            )
-            fused += config.pointcloud_embedding_dim
+        self.encoders = nn.ModuleDict()
+        for key in [*self.vector_keys, *self.image_keys, *self.pointcloud_keys]:
+            encoder, size = build_encoder(key, config)
+            self.encoders[encoder_name(key)] = encoder
+            fused += size
+        self._register_load_state_dict_pre_hook(self._migrate_checkpoint)
 
         action_dim = config.output_features[ACTION].shape[0]
         self.head = mlp(fused, config.head_hidden_dims, action_dim, dropout=config.dropout)
+
+    def _migrate_checkpoint(self, state_dict: dict[str, Tensor], prefix: str, *args: Any) -> None:
+        """Renames the weights of a checkpoint written before encoders were keyed by input, in place.
+
+        Before: ``state_encoder`` (one MLP on the concatenated vector inputs), ``image_encoder`` (one
+        CNN shared by every image input) and ``pointcloud_encoders.<i>`` (the i-th point cloud in
+        sorted order). A checkpoint with several vector inputs cannot be mapped: one MLP read their
+        concatenation.
+
+        Raises:
+            ValueError: On such a checkpoint, naming the fix.
+        """
+        renames: dict[str, list[str]] = {}
+        if any(name.startswith(f"{prefix}state_encoder.") for name in state_dict):
+            if len(self.vector_keys) != 1:
+                raise ValueError(
+                    f"This checkpoint's state encoder read {self.vector_keys} concatenated; encoders are now "
+                    "one per input: retrain the policy (or load it with lerobot-mtdagger before 0.2)."
+                )
+            renames["state_encoder."] = [encoder_name(self.vector_keys[0])]
+        renames["image_encoder."] = [encoder_name(k) for k in self.image_keys]
+        for index, key in enumerate(self.pointcloud_keys):
+            renames[f"pointcloud_encoders.{index}."] = [encoder_name(key)]
+        for old, targets in renames.items():
+            for name in [n for n in state_dict if n.startswith(prefix + old)]:
+                tensor = state_dict.pop(name)
+                for target in targets:
+                    state_dict[f"{prefix}encoders.{target}.{name[len(prefix + old) :]}"] = tensor
 
     # ---------------------------------------------------------------------------------------------
     # Task conditioning
@@ -186,16 +225,10 @@ class MTDAggerPolicy(PreTrainedPolicy):
             dropped = torch.rand(task_index.shape, device=task_index.device) < self.config.task_dropout
             task_index = torch.where(dropped, torch.full_like(task_index, self.any_task_index), task_index)
         features = [self.task_embedding(task_index)]
-        if self.state_encoder is not None:
-            if len(self.vector_keys) == 1:
-                state = batch[self.vector_keys[0]].flatten(start_dim=1)
-            else:
-                state = torch.cat([batch[k].flatten(start_dim=1) for k in self.vector_keys], dim=1)
-            features.append(self.state_encoder(state))
-        if self.image_encoder is not None:
-            features += [self.image_encoder(batch[k]) for k in self.image_keys]
-        for index, key in enumerate(self.pointcloud_keys):
-            features.append(self.pointcloud_encoders[str(index)](batch[key]))
+        features += [self.encoders[encoder_name(k)](batch[k].flatten(start_dim=1)) for k in self.vector_keys]
+        features += [
+            self.encoders[encoder_name(k)](batch[k]) for k in (*self.image_keys, *self.pointcloud_keys)
+        ]
         batch_size = features[0].shape[0]
         for feature in features[1:]:
             if feature.shape[0] != batch_size:
