@@ -5,7 +5,7 @@ on every training drawer, asks the expert about every state it visits, and talli
 branch (``DrawerScriptedExpert.decide``), the learner's squared error to the label per branch, and
 the hand's misalignment to the grasp pose where the expert says "clear" (rise to a safe height).
 
-    .venv/bin/python docs/results/visual-collapse-dev/branches.py POLICY_FOLDER [EPISODES] [SEED]
+    .venv/bin/python docs/results/visual-collapse-dev/branches.py POLICY_FOLDER [EPISODES] [SEED] [DRAWER]
 
 Prints one table; the same seed gives the same episodes for every policy.
 """
@@ -35,12 +35,12 @@ def misalignment(state: np.ndarray) -> tuple[float, float, float]:
     return float(error @ lateral_axis), float(-(error @ axis)), float(error[2])
 
 
-def main(policy_path: str, episodes: int = 5, seed: int = 0) -> None:
+def main(policy_path: str, episodes: int = 5, seed: int = 0, drawer: str | None = None) -> None:
     """Prints the branch table of one policy (module docstring)."""
     runner = PolicyRunner.from_pretrained(policy_path)
     num_points = runner.policy.config.input_features["observation.pointcloud"].shape[0]
     suite = make_suite("drawers", obs_mode="pointcloud", num_points=num_points)
-    names = suite.task_names
+    names = suite.task_names if drawer is None else [drawer]
     counts: Counter[str] = Counter()
     errors: dict[str, list[float]] = defaultdict(list)
     clear_offsets: list[tuple[float, float, float]] = []
@@ -50,7 +50,8 @@ def main(policy_path: str, episodes: int = 5, seed: int = 0) -> None:
     for episode in range(episodes):
         observations, privileged, done = [], [], [False] * len(names)
         for task, env in enumerate(envs):
-            observation, info = env.reset(seed=episode_seed(seed, EVAL_STREAM, 0, task, episode))
+            index = suite.task_index(names[task])
+            observation, info = env.reset(seed=episode_seed(seed, EVAL_STREAM, 0, index, episode))
             observations.append(observation)
             privileged.append(info["privileged_state"])
         success, steps = [False] * len(names), [0] * len(names)
@@ -94,4 +95,4 @@ def main(policy_path: str, episodes: int = 5, seed: int = 0) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], *(int(a) for a in sys.argv[2:]))
+    main(sys.argv[1], *(int(a) for a in sys.argv[2:4]), *sys.argv[4:5])
