@@ -25,6 +25,7 @@ from lerobot_mtdagger.envs.drawers.variants import (
 )
 from lerobot_mtdagger.envs.lerobot_env import LeRobotSuiteEnv
 from lerobot_mtdagger.experts import make_expert, run_expert_episode
+from lerobot_mtdagger.experts.drawers import DrawerScriptedExpert
 
 ALL_DRAWERS = DRAWER_TASKS + HELDOUT_TASKS
 EXPERT_TARGET = 0.95
@@ -170,6 +171,48 @@ def test_expert_recovers_from_states_a_learner_left_behind():
     finally:
         env.close()
     assert np.mean(successes) >= 5 / 6
+
+
+def close_and_pull(suite, name: str, lateral: float, seed: int = 3) -> float:
+    """Opening (fraction of travel) after closing the gripper ``lateral`` metres off the grasp pose
+    across the pull axis (approached from above, as a learner does) and pulling for 40 steps."""
+    env = suite.make_env(name)
+    expert = DrawerScriptedExpert(VARIANTS[name])
+
+    def point(state, prefix):
+        return np.array([state[STATE_INDEX[f"{prefix}_{axis}"]] for axis in "xyz"])
+
+    try:
+        _, info = env.reset(seed=seed)
+        state = info["privileged_state"]
+        while expert.decide(state)[0] not in ("grip",):
+            state = env.step(expert.act(state))[4]["privileged_state"]
+        axis = point(state, "axis")
+        across = np.array([-axis[1], axis[0], 0.0])
+        # Up 5 cm, sideways above the handle, down to the grasp height: (sideways, height, steps).
+        for sideways, height, steps in ((0.0, 0.05, 10), (lateral, 0.05, 15), (lateral, 0.0, 20)):
+            for _ in range(steps):
+                target = point(state, "grasp") + sideways * across + np.array([0.0, 0.0, height])
+                move = np.clip(12.0 * (target - point(state, "hand")), -1, 1)
+                state = env.step(np.append(move, -1.0).astype(np.float32))[4]["privileged_state"]
+        for _ in range(15):
+            state = env.step(np.array([0, 0, 0, 1.0], dtype=np.float32))[4]["privileged_state"]
+        for _ in range(40):
+            pull = np.append(0.8 * point(state, "axis"), 1.0).astype(np.float32)
+            state = env.step(pull)[4]["privileged_state"]
+        return state[STATE_INDEX["opening"]] / state[STATE_INDEX["travel"]]
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("name", ["drawer-vbar-tall", "drawer-knob-large"])
+def test_the_expert_holds_where_closing_catches_the_handle(name):
+    """The expert's holding range across the pull axis is the physical one: a pull from just inside it
+    opens the drawer, one from beyond it does not (a centimetre out: the pad misses the handle)."""
+    suite = make_suite("drawers", tasks=[name])
+    reach = DrawerScriptedExpert.holding_half_width(VARIANTS[name])
+    assert close_and_pull(suite, name, reach - 0.003) >= SUCCESS_FRACTION
+    assert close_and_pull(suite, name, reach + 0.012) < 0.1
 
 
 @pytest.mark.parametrize("name", ALL_DRAWERS)

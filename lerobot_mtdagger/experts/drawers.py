@@ -4,12 +4,20 @@ It must label any state a learner reaches (DAgger asks it about the learner's st
 no memory: each action follows from the privileged state alone (``DRAWER_STATE_NAMES``).
 
 1. Gripper open: servo the hand towards a target above the grasp pose whose height grows with the
-   planar misalignment (``clearance``: 0 within ``ALIGN_TOLERANCE``, ``FUNNEL_SLOPE`` metres per
-   metre beyond it, at most ``SAFE_HEIGHT``): a funnel that ends at the grasp pose. A hand more than
-   ``RISE_FIRST`` below the funnel rises before it moves sideways (the fingers clear the handle).
-2. Aligned at the grasp pose: close the gripper (the rear pad pulls the handle into the grip).
+   planar misalignment (``clearance``: 0 within ``ALIGN_TOLERANCE`` along the pull axis and within
+   the closing range across it, ``FUNNEL_SLOPE`` metres per metre beyond, at most ``SAFE_HEIGHT``):
+   a funnel that ends at the grasp pose. A hand more than ``RISE_FIRST`` below the funnel rises
+   before it moves sideways (the fingers clear the handle). Across the pull axis the funnel is as
+   wide as the closing range (``closing_half_width``): there the rear pad descends into the gap
+   behind the handle without landing on it, so a hand at the handle's depth a centimetre off
+   sideways slides over rather than rising.
+2. At the grasp pose's depth and along-axis position, within the closing range across it: close
+   the gripper (the rear pad pulls the handle into the grip).
 3. Gripper closed on the handle: pull along the drawer's axis until it is open by
-   ``OPEN_TARGET`` of its travel, correcting sideways and vertical drift; then hold.
+   ``OPEN_TARGET`` of its travel, correcting sideways and vertical drift; then hold. "On the handle"
+   is where closing catches it (``hold_half_width``): the rear pad (``PAD_HALF_WIDTH`` either side of
+   the hand) overlaps the handle across the pull axis, the pull then opens the drawer (measured on
+   every handle type: a vertical bar is caught 2 cm off its axis and missed 2.5 cm off).
 4. Gripper closed anywhere else (a learner closed it, or the grip slipped): open it, rising to the
    funnel's height if below it, before approaching again.
 
@@ -19,6 +27,12 @@ centimetre, and an earlier version of this controller, which retreated to the sa
 the open hand was low and more than 8 mm off, gave its learner states labels that flipped from
 "descend" to "rise at full speed" within that centimetre (54% of the states its BC student visited;
 visual DAgger rounds then lowered success, ``docs/results/visual-collapse-dev/README.md``).
+
+An earlier version closed only within 8 mm of the grasp pose and held only within 1.5 cm across the
+axis for every handle, and its funnel rose for sideways misalignment too: its round-1 point-cloud
+students stopped at a vertical bar's depth 1.7 cm off sideways, where it said "rise" (52% of their
+steps) a few millimetres from states where it said "close", although the pads would have caught
+the bar there.
 
 The grasp pose comes from the env (``grasp_x/y/z``: the hand position that puts the open
 gripper's rear pad behind the handle); it moves with the drawer, so the controller also recovers
@@ -42,11 +56,15 @@ OPEN_GRIPPER = 0.9  # gripper reading (finger distance / 10 cm) above which the 
 CLOSED_GRIPPER = 0.75  # below which it holds something (or nothing) closed
 ALIGN_TOLERANCE = 0.008
 DEPTH_TOLERANCE = 0.012
+PAD_HALF_WIDTH = 0.015  # MetaWorld's finger pad: a box 3 cm wide across the pull axis
+HOLD_MARGIN = 0.003  # inside the catch range by this much before a closed gripper counts as holding
+CLOSE_MARGIN = 0.004  # inside the holding range by this much before the expert closes
+HOLD_ALONG = (-0.05, 0.015)  # hand behind (pulled) / in front of the grasp pose along the axis while holding
 FUNNEL_SLOPE = 4.0  # metres of height above the grasp pose per metre of planar misalignment
 RISE_FIRST = 0.02  # below the funnel by more than this, the hand rises before it moves sideways
-BRANCHES = ("align", "clear", "descend", "close", "grip", "pull", "release")
+BRANCHES = ("align", "clear", "descend", "grip", "pull", "release")
 """What ``decide`` reports: move over the grasp pose at a safe height, rise to clear the handle, descend
-onto the grasp pose, close on the handle, hold it closed, pull, open the gripper and back off."""
+onto the grasp pose, close on the handle (or hold it closed), pull, open the gripper and back off."""
 
 
 def _unpack(state: np.ndarray) -> dict[str, np.ndarray | float]:
@@ -67,8 +85,24 @@ class DrawerScriptedExpert:
     """Opens one drawer from any state (see the module docstring)."""
 
     def __init__(self, variant: DrawerVariant) -> None:
-        """Stores the drawer the expert opens (its geometry arrives through the privileged state)."""
+        """Stores the drawer the expert opens (its pose arrives through the privileged state)."""
         self.variant = variant
+        self.hold_half_width = self.holding_half_width(variant)
+        self.close_half_width = self.closing_half_width(variant)
+
+    @staticmethod
+    def holding_half_width(variant: DrawerVariant) -> float:
+        """How far across the pull axis a closed gripper still holds the handle (the pads overlap it)."""
+        return variant.handle_half_width() + PAD_HALF_WIDTH - HOLD_MARGIN
+
+    @classmethod
+    def closing_half_width(cls, variant: DrawerVariant) -> float:
+        """How far across the pull axis the expert closes (never less than ``ALIGN_TOLERANCE``).
+
+        Inside the holding range, with the pad inside the gap between a bar's standoffs.
+        """
+        free = variant.free_gap_half_width() - PAD_HALF_WIDTH
+        return max(ALIGN_TOLERANCE, min(cls.holding_half_width(variant), free) - CLOSE_MARGIN)
 
     def reset(self) -> None:
         """The expert is stateless."""
@@ -88,14 +122,14 @@ class DrawerScriptedExpert:
         along = float((hand - grasp) @ axis)
         depth = float(error[2])
         at_depth = abs(depth) < 2 * DEPTH_TOLERANCE
-        holding_zone = abs(lateral) < 0.015 and -0.05 < along < 0.015
-        aligned = abs(lateral) < ALIGN_TOLERANCE and abs(along) < ALIGN_TOLERANCE
+        holding_zone = abs(lateral) < self.hold_half_width and HOLD_ALONG[0] < along < HOLD_ALONG[1]
+        aligned = abs(lateral) < self.close_half_width and abs(along) < ALIGN_TOLERANCE
 
         if at_depth and holding_zone and (s["gripper"] < OPEN_GRIPPER or aligned):
             return self._grip_and_pull(s, lateral, lateral_axis, depth)
         if s["gripper"] < OPEN_GRIPPER:
             return "release", self._release(hand, grasp, lateral, along)
-        return self._approach(hand, grasp, lateral, along, depth)
+        return self._approach(hand, grasp, lateral, along)
 
     def _grip_and_pull(
         self, s: dict, lateral: float, lateral_axis: np.ndarray, depth: float
@@ -105,15 +139,16 @@ class DrawerScriptedExpert:
             return "pull", self._action(correction + PULL_SPEED * s["axis"], grip=1.0)
         return "grip", self._action(correction, grip=1.0)
 
-    @staticmethod
-    def clearance(lateral: float, along: float) -> float:
+    def clearance(self, lateral: float, along: float) -> float:
         """Height above the grasp pose the hand keeps at a planar misalignment (the approach funnel).
 
-        0 within ``ALIGN_TOLERANCE``, rising by ``FUNNEL_SLOPE`` metres per metre of misalignment
-        beyond it, at most ``SAFE_HEIGHT``: continuous, so a centimetre of misalignment asks for a few
-        centimetres of height, not for a retreat to the safe height.
+        0 within ``ALIGN_TOLERANCE`` along the pull axis and the closing range across it, rising by
+        ``FUNNEL_SLOPE`` metres per metre of misalignment beyond, at most ``SAFE_HEIGHT``:
+        continuous, so a centimetre of misalignment asks for a few centimetres of height, not for a
+        retreat to the safe height.
         """
-        planar = math.hypot(lateral, along)
+        across = max(0.0, abs(lateral) - self.close_half_width)
+        planar = math.hypot(across, along)
         return min(SAFE_HEIGHT, FUNNEL_SLOPE * max(0.0, planar - ALIGN_TOLERANCE))
 
     def _release(self, hand: np.ndarray, grasp: np.ndarray, lateral: float, along: float) -> np.ndarray:
@@ -121,11 +156,9 @@ class DrawerScriptedExpert:
         return self._action(np.array([0.0, 0.0, max(0.0, GAIN * (target_z - hand[2]))]), grip=-1.0)
 
     def _approach(
-        self, hand: np.ndarray, grasp: np.ndarray, lateral: float, along: float, depth: float
+        self, hand: np.ndarray, grasp: np.ndarray, lateral: float, along: float
     ) -> tuple[str, np.ndarray]:
         clearance = self.clearance(lateral, along)
-        if clearance == 0.0 and abs(depth) < DEPTH_TOLERANCE:
-            return "close", self._action(GAIN * (grasp - hand), grip=1.0)
         target = grasp + np.array([0.0, 0.0, clearance])
         below = target[2] - hand[2]
         # Further below the funnel than RISE_FIRST: rise only (the fingers clear the handle first);

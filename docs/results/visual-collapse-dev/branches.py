@@ -3,7 +3,8 @@
 Rolls out a policy (the learner acts at every step, as in a beta = 0 DAgger round or an evaluation)
 on every training drawer, asks the expert about every state it visits, and tallies the expert's
 branch (``DrawerScriptedExpert.decide``), the learner's squared error to the label per branch, and
-the hand's misalignment to the grasp pose where the expert says "clear" (rise to a safe height).
+where the hand is per branch: its median offset from the grasp pose across the pull axis (absolute),
+along it (signed: > 0 towards the robot) and vertically (signed: > 0 above), and the gripper reading.
 
     .venv/bin/python docs/results/visual-collapse-dev/branches.py POLICY_FOLDER [EPISODES] [SEED] [DRAWER]
 
@@ -26,7 +27,7 @@ from lerobot_mtdagger.experts.drawers import BRANCHES
 
 
 def misalignment(state: np.ndarray) -> tuple[float, float, float]:
-    """Lateral, along-axis and vertical offset of the hand from the grasp pose, metres."""
+    """Lateral, along-axis and vertical offset of the grasp pose from the hand, metres."""
     hand = np.array([state[STATE_INDEX[f"hand_{a}"]] for a in "xyz"])
     grasp = np.array([state[STATE_INDEX[f"grasp_{a}"]] for a in "xyz"])
     axis = np.array([state[STATE_INDEX[f"axis_{a}"]] for a in "xyz"])
@@ -43,7 +44,7 @@ def main(policy_path: str, episodes: int = 5, seed: int = 0, drawer: str | None 
     names = suite.task_names if drawer is None else [drawer]
     counts: Counter[str] = Counter()
     errors: dict[str, list[float]] = defaultdict(list)
-    clear_offsets: list[tuple[float, float, float]] = []
+    offsets: dict[str, list[tuple[float, ...]]] = defaultdict(list)
     successes, lengths = [], []
     envs = [suite.make_env(name) for name in names]
     experts = [make_expert(suite, name) for name in names]
@@ -62,8 +63,9 @@ def main(policy_path: str, episodes: int = 5, seed: int = 0, drawer: str | None 
                 branch, label = experts[task].expert.decide(privileged[task])
                 counts[branch] += 1
                 errors[branch].append(float(((action - label) ** 2).mean()))
-                if branch == "clear":
-                    clear_offsets.append(misalignment(privileged[task]))
+                lateral, along, vertical = misalignment(privileged[task])
+                gripper = privileged[task][STATE_INDEX["gripper"]]
+                offsets[branch].append((abs(lateral), along, -vertical, gripper))
                 observations[task], _, _, truncated, info = envs[task].step(action)
                 privileged[task] = info["privileged_state"]
                 steps[task] += 1
@@ -77,19 +79,18 @@ def main(policy_path: str, episodes: int = 5, seed: int = 0, drawer: str | None 
         f"policy {policy_path}: success {np.mean(successes):.3f} over {len(successes)} episodes, "
         f"{total} learner steps (mean episode {np.mean(lengths):.0f})"
     )
-    print("| branch | share of steps | learner MSE to label |")
-    print("|---|---:|---:|")
+    print(
+        "| branch | share of steps | learner MSE to label | median abs lateral cm | median along cm "
+        "| median vertical cm | median gripper |"
+    )
+    print("|---|---:|---:|---:|---:|---:|---:|")
     for branch in BRANCHES:
         if counts[branch]:
-            print(f"| {branch} | {counts[branch] / total:.3f} | {np.mean(errors[branch]):.3f} |")
-    if clear_offsets:
-        offsets = np.abs(np.array(clear_offsets)) * 100
-        planar = np.maximum(offsets[:, 0], offsets[:, 1])
-        print(
-            f"'clear' states: median |lateral| {np.median(offsets[:, 0]):.1f} cm, |along| "
-            f"{np.median(offsets[:, 1]):.1f} cm, |vertical| {np.median(offsets[:, 2]):.1f} cm; "
-            f"share within 2 cm in the plane {np.mean(planar < 2):.2f}"
-        )
+            lateral, along, vertical, gripper = np.median(np.array(offsets[branch]), axis=0)
+            print(
+                f"| {branch} | {counts[branch] / total:.3f} | {np.mean(errors[branch]):.3f} | "
+                f"{100 * lateral:.1f} | {100 * along:+.1f} | {100 * vertical:+.1f} | {gripper:.2f} |"
+            )
     for env in envs:
         env.close()
 

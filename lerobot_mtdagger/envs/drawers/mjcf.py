@@ -14,9 +14,11 @@ from collections.abc import Sequence
 import numpy as np
 
 from lerobot_mtdagger.envs.drawers.variants import (
+    BAR_POST_INSET,
     BAR_RADIUS,
     FINGER_MARGIN,
     LIP_TAB_HEIGHT,
+    STANDOFF_RADIUS,
     VBAR_OVERHANG,
     DrawerVariant,
 )
@@ -29,7 +31,6 @@ PAD_HALF_HEIGHT = 0.045
 _WALL = 0.01  # case wall thickness
 _FRONT = 0.015  # front panel thickness
 _GAP = 0.004  # clearance between drawer box and case
-_STANDOFF_RADIUS = 0.005
 _KNOB_STEM_RADIUS = 0.005
 _KNOB_CAP_THICKNESS = 0.012
 _LIP_THICKNESS = 0.004
@@ -102,11 +103,11 @@ def _handle_geoms(v: DrawerVariant) -> tuple[list[str], np.ndarray, np.ndarray]:
     if v.handle == "bar":
         y = front - c - BAR_RADIUS
         half = v.handle_size / 2
-        post_x = half - 0.012
+        post_x = half - BAR_POST_INSET
         geoms = [
             _capsule("handle_bar", (-half, y, z), (half, y, z), BAR_RADIUS, rgba),
-            _cylinder("handle_post_left", (-post_x, front, z), (-post_x, y, z), _STANDOFF_RADIUS, rgba),
-            _cylinder("handle_post_right", (post_x, front, z), (post_x, y, z), _STANDOFF_RADIUS, rgba),
+            _cylinder("handle_post_left", (-post_x, front, z), (-post_x, y, z), STANDOFF_RADIUS, rgba),
+            _cylinder("handle_post_right", (post_x, front, z), (post_x, y, z), STANDOFF_RADIUS, rgba),
         ]
         hook = np.array([0.0, front - c / 2, z + 0.02])
         return geoms, np.array([0.0, y, z]), hook
@@ -116,12 +117,12 @@ def _handle_geoms(v: DrawerVariant) -> tuple[list[str], np.ndarray, np.ndarray]:
         post_z = half - VBAR_OVERHANG
         geoms = [
             _capsule("handle_bar", (0, y, z - half), (0, y, z + half), BAR_RADIUS, rgba),
-            _cylinder("handle_post_top", (0, front, z + post_z), (0, y, z + post_z), _STANDOFF_RADIUS, rgba),
+            _cylinder("handle_post_top", (0, front, z + post_z), (0, y, z + post_z), STANDOFF_RADIUS, rgba),
             _cylinder(
-                "handle_post_bottom", (0, front, z - post_z), (0, y, z - post_z), _STANDOFF_RADIUS, rgba
+                "handle_post_bottom", (0, front, z - post_z), (0, y, z - post_z), STANDOFF_RADIUS, rgba
             ),
         ]
-        pad_bottom = z + post_z + _STANDOFF_RADIUS + FINGER_MARGIN
+        pad_bottom = z + post_z + STANDOFF_RADIUS + FINGER_MARGIN
         hook = np.array([0.0, front - c / 2, pad_bottom + PAD_HALF_HEIGHT])
         return geoms, np.array([0.0, y, z]), hook
     if v.handle == "knob":

@@ -28,6 +28,8 @@ BAR_RADIUS = 0.007
 VBAR_OVERHANG = 0.03
 LIP_TAB_HEIGHT = 0.035
 FINGER_MARGIN = 0.005
+STANDOFF_RADIUS = 0.005
+BAR_POST_INSET = 0.012  # a bar's standoffs stand this far in from its ends
 
 DRAWER_STATE_NAMES: list[str] = [
     "hand_x",
@@ -222,6 +224,25 @@ class DrawerVariant:
             "vbar": self.handle_size / 2 + BAR_RADIUS,
         }[self.handle]
         return center - half, center + half
+
+    def handle_half_width(self) -> float:
+        """Half the handle's extent across the pull axis (horizontal, in the drawer's front plane)."""
+        return {
+            "bar": self.handle_size / 2,
+            "knob": self.handle_size,
+            "lip": self.handle_size / 2,
+            "vbar": BAR_RADIUS,
+        }[self.handle]
+
+    def free_gap_half_width(self) -> float:
+        """Half-width across the pull axis of the finger gap behind the handle free of standoffs.
+
+        A bar's two standoffs cross that gap at the handle's height (a finger pad must not descend
+        onto them); a vertical bar's standoffs, a knob's stem and a lip stand below the pads (``inf``).
+        """
+        if self.handle == "bar":
+            return self.handle_size / 2 - BAR_POST_INSET - STANDOFF_RADIUS
+        return math.inf
 
     def parameter_vector(self) -> np.ndarray:
         """Numeric description (handle one-hot, then every geometric and physical parameter)."""
