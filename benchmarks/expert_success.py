@@ -20,8 +20,9 @@ def main() -> None:
     parser.add_argument("--suite", default="metaworld-mt10")
     parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--first-seed", type=int, default=1000)
+    parser.add_argument("--placement", default=None, help="drawers only: kitchen (default) or narrow")
     args = parser.parse_args()
-    suite = make_suite(args.suite)
+    suite = make_suite(args.suite, placement=args.placement)
     seeds = range(args.first_seed, args.first_seed + args.episodes)
     heldout = suite.heldout_task_names
     print("| task | success | mean steps (successful) |\n|---|---:|---:|")

@@ -210,6 +210,8 @@ class EvalConfig:
         seed: Seed of the evaluation episodes.
         num_points: Points per cloud.
         image_size: Image side.
+        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when
+            None, or ``narrow``).
         output: Optional JSON file for the results.
         workers: Env worker processes (None: one per core; 0: in this process).
         trust_checkpoint: Let the policy's processor configs name Python classes, which LeRobot's
@@ -224,6 +226,7 @@ class EvalConfig:
     seed: int = 0
     num_points: int = 1024
     image_size: int = 84
+    placement: str | None = None
     output: Path | None = None
     workers: int | None = None
     trust_checkpoint: bool = False

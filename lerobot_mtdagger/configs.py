@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from lerobot_mtdagger.envs.drawers.variants import DEFAULT_PLACEMENT, LEGACY_PLACEMENT, PLACEMENTS
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
 
 
@@ -193,6 +194,9 @@ class RunConfig:
         steps_after_success: Steps recorded after the first success before an episode ends.
         num_points: Points per cloud (pointcloud mode).
         image_size: Image side (rgb mode).
+        placement: ``drawers`` suite only: how resets move and recolour the drawers (``kitchen``
+            when None, stored as such; ``narrow``: the suite's first ranges, which runs made before
+            this option existed used). Refused for other suites.
         policy: Policy and optimiser options (``policy.lr`` and ``policy.batch_size`` from the preset
             when unset).
         output_dir: Experiment directory (refused if it exists, unless ``resume``); default
@@ -236,6 +240,7 @@ class RunConfig:
     steps_after_success: int = 10
     num_points: int = 1024
     image_size: int = 84
+    placement: str | None = None
     policy: PolicyOptions = field(default_factory=PolicyOptions)
     output_dir: Path | None = None
     seed: int = 0
@@ -254,6 +259,8 @@ class RunConfig:
                 setattr(owner, name, value)
         if self.output_dir is None:
             self.output_dir = Path("outputs") / "mtdagger" / f"{self.preset}-{self.method}-seed{self.seed}"
+        if self.suite == "drawers" and self.placement is None:
+            self.placement = DEFAULT_PLACEMENT
         self._check()
 
     def _field_owner(self, path: str) -> tuple[Any, str]:
@@ -310,6 +317,12 @@ class RunConfig:
                 f"got {self.policy.batch_size}, {self.policy.lr}."
             )
         check_device(self.policy.device)
+        if self.placement is not None and self.suite != "drawers":
+            raise ValueError(f"placement applies to the drawers suite only; drop it for {self.suite!r}.")
+        if self.placement is not None and self.placement not in PLACEMENTS:
+            raise ValueError(
+                f"Unknown drawer placement {self.placement!r}; choose one of {sorted(PLACEMENTS)}."
+            )
 
     @property
     def is_bc(self) -> bool:
@@ -349,8 +362,13 @@ class RunConfig:
 
     @classmethod
     def option_defaults(cls) -> dict[str, Any]:
-        """The top-level options with a plain default value, by name (e.g. ``plateau_every: 200``)."""
-        return {f.name: f.default for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
+        """What each top-level option was before it existed, by name (e.g. ``plateau_every: 200``).
+
+        Its plain default, except ``placement``: drawer runs made before it existed used ``narrow``.
+        """
+        fields = dataclasses.fields(cls)
+        defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
+        return defaults | {"placement": LEGACY_PLACEMENT}
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (stored in every round's record)."""

@@ -236,12 +236,14 @@ class ExperimentDir:
         differing = sorted(key for key in set(stored) | set(given) if stored.get(key) != given.get(key))
         if differing:
             details = ", ".join(f"{k}: {stored.get(k)!r} -> {given.get(k)!r}" for k in differing)
-            hint = (
-                " (--rounds may only grow, and only for a DAgger run: BC's one round holds the demos "
-                "of every round)"
-                if "rounds" in differing
-                else ""
-            )
+            hint = ""
+            if "rounds" in differing:
+                hint = (
+                    " (--rounds may only grow, and only for a DAgger run: BC's one round holds the "
+                    "demos of every round)"
+                )
+            elif "placement" in differing and "placement" not in stored:
+                hint = " (drawer runs made before --placement existed used --placement=narrow)"
             raise UserError(
                 f"Cannot resume {self.root} with a different config ({details}){hint}: resume with "
                 "the stored values, or start a new --output_dir."

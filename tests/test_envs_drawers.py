@@ -19,9 +19,11 @@ from lerobot_mtdagger.envs.drawers.pictures import render_drawer_picture
 from lerobot_mtdagger.envs.drawers.scene import DrawerSceneEnv
 from lerobot_mtdagger.envs.drawers.variants import (
     DRAWER_STATE_NAMES,
-    PLACEMENT_RANGE,
+    PLACEMENTS,
     STATE_INDEX,
     SUCCESS_FRACTION,
+    TABLE_X_LIMIT,
+    TABLE_Y_RANGE,
 )
 from lerobot_mtdagger.envs.lerobot_env import LeRobotSuiteEnv
 from lerobot_mtdagger.experts import make_expert, run_expert_episode
@@ -79,25 +81,71 @@ def test_every_drawer_builds_and_starts_closed(name):
         env.close()
 
 
-def test_seeded_resets_place_the_case_reproducibly_within_the_range():
-    suite = make_suite("drawers", tasks=["drawer-bar-wide"])
+@pytest.mark.parametrize("placement", sorted(PLACEMENTS))
+def test_seeded_resets_place_the_case_reproducibly_within_the_range(placement):
+    suite = make_suite("drawers", tasks=["drawer-bar-wide"], placement=placement)
     env = suite.make_env("drawer-bar-wide")
-    variant = VARIANTS["drawer-bar-wide"]
+    variant, ranges = VARIANTS["drawer-bar-wide"], PLACEMENTS[placement]
     try:
         first = env.reset(seed=3)[1]["privileged_state"]
         other = env.reset(seed=4)[1]["privileged_state"]
         again = env.reset(seed=3)[1]["privileged_state"]
         np.testing.assert_array_equal(first, again)
         assert not np.allclose(first, other)
-        positions = []
+        poses, colours = [], []
+        model = env._env.model
         for seed in range(20):
             env.reset(seed=seed)
-            positions.append(env._env.model.body("drawer_case").pos.copy())
-        offsets = np.array(positions)[:, :2] - np.array([variant.x, variant.y])
-        assert np.all(np.abs(offsets) <= np.array(PLACEMENT_RANGE[:2]) + 1e-9)
-        assert offsets.std(axis=0).min() > 0.005
+            yaw = 2 * np.degrees(
+                np.arctan2(model.body("drawer_case").quat[3], model.body("drawer_case").quat[0])
+            )
+            poses.append([*model.body("drawer_case").pos, yaw])
+            colours.append(
+                model.geom_rgba[[model.geom(n).id for n in ("case_top", "drawer_front", "handle_bar")]]
+            )
+        offsets = np.array(poses) - np.array([variant.x, variant.y, variant.elevation, variant.yaw])
+        limits = np.array([ranges.x, ranges.y, ranges.lift, ranges.yaw])
+        assert np.all(np.abs(offsets) <= limits + 1e-6) and np.all(offsets[:, 2] >= 0)
+        assert offsets[:, [0, 1, 3]].std(axis=0).min() > ranges.y / 6
+        colours = np.array(colours)
+        shifts = colours - np.array([variant.case_rgba, variant.front_rgba, variant.handle_rgba])
+        assert np.all(np.abs(shifts) <= ranges.colour + 1e-6)
+        if placement == "narrow":
+            assert np.all(offsets[:, 2] == 0) and np.abs(shifts).max() < 1e-6  # float32 colours
+        else:
+            assert offsets[:, 2].std() > 0.01 and shifts[..., :3].std() > 0.05
     finally:
         env.close()
+
+
+def test_the_kitchen_placement_keeps_every_drawer_on_the_table():
+    """Shifts that would push a deep case through the back wall move it towards the robot instead."""
+    suite = make_suite("drawers", tasks=ALL_DRAWERS, placement="kitchen")
+    for name in ALL_DRAWERS:
+        env = suite.make_env(name)
+        try:
+            for seed in range(10):
+                env.reset(seed=seed)
+                scene = env._env
+                case = scene.data.body("drawer_case")
+                rotation = case.xmat.reshape(3, 3)[:2, :2]
+                variant = VARIANTS[name]
+                half = variant.width / 2
+                local = np.array([[-half, 0.0], [half, 0.0], [-half, variant.depth], [half, variant.depth]])
+                corners = local @ rotation.T + case.xpos[:2]
+                assert np.all(np.abs(corners[:, 0]) <= TABLE_X_LIMIT + 1e-9), name
+                assert np.all(
+                    (corners[:, 1] >= TABLE_Y_RANGE[0] - 1e-9) & (corners[:, 1] <= TABLE_Y_RANGE[1] + 1e-9)
+                )
+        finally:
+            env.close()
+
+
+def test_an_unknown_placement_is_a_clear_error():
+    with pytest.raises(ValueError, match="choose one of .*kitchen.*narrow"):
+        make_suite("drawers", placement="office")
+    with pytest.raises(ValueError, match="drawers suite only"):
+        make_suite("toy", placement="narrow")
 
 
 @pytest.mark.parametrize("name", ["drawer-knob-small", "drawer-lip-heavy"])

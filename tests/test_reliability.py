@@ -17,6 +17,7 @@ from lerobot_mtdagger import dagger as dagger_module
 from lerobot_mtdagger import rounds as rounds_module
 from lerobot_mtdagger.checkpoints import UntrustedCheckpointError
 from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.errors import CorruptExperimentError, UserError
 from lerobot_mtdagger.evaluate import PolicyRunner
@@ -239,6 +240,20 @@ def test_a_run_made_before_an_option_existed_resumes_with_its_default(finished, 
     assert run(toy_config(copy, "--rounds=1", "--resume=true")), "resumed: nothing to do"
     with pytest.raises(UserError, match=r"different config \(plateau_every: None -> 7\)"):
         run(toy_config(copy, "--rounds=1", "--resume=true", "--plateau_every=7"))
+
+
+def test_a_drawer_run_made_before_placements_existed_resumes_only_with_the_narrow_one(finished, tmp_path):
+    """Those runs used today's ``narrow`` ranges; resuming them with the new default would mix settings."""
+    copy = tmp_path / "older-drawers"
+    shutil.copytree(finished, copy)
+    stored = json.loads((copy / "config.json").read_text())
+    older = {k: v for k, v in stored.items() if k != "placement"} | {"suite": "drawers"}
+    (copy / "config.json").write_text(json.dumps(older))
+    experiment = ExperimentDir(copy)
+    defaults = RunConfig.option_defaults()
+    experiment.check_resumable({**older, "placement": "narrow"}, added_defaults=defaults)
+    with pytest.raises(UserError, match=r"placement: None -> 'kitchen'\) \(drawer runs made before"):
+        experiment.check_resumable({**older, "placement": "kitchen"}, added_defaults=defaults)
 
 
 def test_resume_refuses_a_round_changed_after_commit_before_running(finished, tmp_path):

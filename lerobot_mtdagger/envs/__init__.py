@@ -81,6 +81,7 @@ def make_suite(
     crop: CropBox | None = None,
     include_goal: bool = True,
     max_episode_steps: int | None = None,
+    placement: str | None = None,
 ) -> TaskSuite:
     """Builds a task suite.
 
@@ -97,6 +98,8 @@ def make_suite(
         crop: Crop box of the cloud (suite default when None).
         include_goal: Append the goal position to the proprioceptive state in rgb/pointcloud modes.
         max_episode_steps: Truncation length (the task's max path length when None).
+        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen``, the
+            default, or ``narrow``; see ``lerobot_mtdagger.envs.drawers.PLACEMENTS``).
 
     Returns:
         The suite.
@@ -118,10 +121,14 @@ def make_suite(
     if name not in SUITE_NAMES:
         raise UserError(f"Unknown suite {name!r}; available suites: {list(SUITE_NAMES)}.")
     if name == "drawers":
-        from lerobot_mtdagger.envs.drawers import DRAWER_TASKS, DrawerSuite
+        from lerobot_mtdagger.envs.drawers import DRAWER_TASKS, PLACEMENTS, DrawerSuite
 
+        if placement is not None and placement not in PLACEMENTS:
+            raise UserError(f"Unknown drawer placement {placement!r}; choose one of {sorted(PLACEMENTS)}.")
         task_names = list(tasks) if tasks else list(DRAWER_TASKS)
-        return DrawerSuite(task_names, observation, max_episode_steps=max_episode_steps)
+        return DrawerSuite(task_names, observation, max_episode_steps=max_episode_steps, placement=placement)
+    if placement is not None:
+        raise UserError(f"placement={placement!r} applies to the drawers suite only; drop it for {name!r}.")
     if name == "toy":
         from lerobot_mtdagger.envs.toy import TOY_TASKS, ToySuite
 
@@ -153,7 +160,10 @@ class SuiteOptions(Protocol):
 
 
 def suite_from_config(config: SuiteOptions, **overrides: Any) -> TaskSuite:
-    """The suite a config names; ``max_episode_steps`` comes from ``config.episode_length`` if it has one.
+    """The suite a config names.
+
+    ``max_episode_steps`` comes from ``config.episode_length`` and ``placement`` from
+    ``config.placement`` where the config has them.
 
     Args:
         config: Any object with the ``SuiteOptions`` attributes.
@@ -171,5 +181,6 @@ def suite_from_config(config: SuiteOptions, **overrides: Any) -> TaskSuite:
         "image_size": config.image_size,
         "num_points": config.num_points,
         "max_episode_steps": getattr(config, "episode_length", None),
+        "placement": getattr(config, "placement", None),
     }
     return make_suite(config.suite, **(options | overrides))

@@ -54,6 +54,7 @@ class LeRobotSuiteEnv(gym.Env):
         num_points: int = 1024,
         episode_length: int | None = None,
         render_mode: str | None = "rgb_array",
+        placement: str | None = None,
     ) -> None:
         """Builds the suite env of ``task``."""
         config = MTDAggerSuiteEnvConfig(
@@ -63,6 +64,7 @@ class LeRobotSuiteEnv(gym.Env):
             image_size=image_size,
             num_points=num_points,
             episode_length=episode_length,
+            placement=placement,
         )
         self._suite = suite_from_config(config)
         self._env = self._suite.make_env(task)
@@ -117,6 +119,8 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
         image_size: RGB side in pixels.
         num_points: Points per cloud.
         episode_length: Truncation length (the task's default when None).
+        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when
+            None, or ``narrow``).
     """
 
     suite: str = "metaworld-mt10"
@@ -125,6 +129,7 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
     image_size: int = 84
     num_points: int = 1024
     episode_length: int | None = None
+    placement: str | None = None
     fps: int = 80
     features: dict[str, PolicyFeature] = field(default_factory=dict)
     features_map: dict[str, str] = field(default_factory=dict)
@@ -170,4 +175,5 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
             "image_size": self.image_size,
             "num_points": self.num_points,
             "episode_length": self.episode_length,
+            "placement": self.placement,
         }

@@ -27,8 +27,11 @@ carries ``progress`` (0-3, the paper's real-robot score, kept as the best of the
 1 for touching the handle with the fingers, 1 for pulling it open by ``PULL_FRACTION`` (0.1) of
 the travel, 1 for success. ``info["opening"]`` is the opening in metres.
 
-Each reset shifts the case by up to ``PLACEMENT_RANGE`` (3 cm in x and y, 5 degrees of yaw) from
-the variant's pose, drawn from the env's seeded generator; the drawer starts closed.
+Each reset places the case around the variant's pose by the suite's ``placement`` setting
+(``PLACEMENTS``), drawn from the env's seeded generator; the drawer starts closed. ``kitchen`` (the
+default): up to 10 cm across the table, 5 cm in depth, 12 degrees of yaw, 6 cm higher, and case,
+front and handle colours shifted by up to 0.2 per RGB channel; ``narrow`` (the suite's first
+setting): 3 cm in x and y, 5 degrees, fixed colours.
 
 The privileged state (``DRAWER_STATE_NAMES``, what the scripted expert acts on and what
 ``observation.state`` is in ``state`` mode) holds the hand position and gripper opening, the
@@ -75,6 +78,8 @@ _EXPORTS: dict[str, str] = {
             "DRAWER_STATE_NAMES",
             "HANDLE_TYPES",
             "MAX_EPISODE_STEPS",
+            "DEFAULT_PLACEMENT",
+            "PLACEMENTS",
             "PLACEMENT_RANGE",
             "PULL_FRACTION",
             "STATE_INDEX",
@@ -82,6 +87,8 @@ _EXPORTS: dict[str, str] = {
             "TABLE_X_LIMIT",
             "TABLE_Y_RANGE",
             "DrawerVariant",
+            "Placement",
+            "placement_named",
         ),
         "variants",
     ),
@@ -105,19 +112,24 @@ if TYPE_CHECKING:
         drawer_state_names,
     )
     from lerobot_mtdagger.envs.drawers.variants import (
+        DEFAULT_PLACEMENT,
         DRAWER_STATE_NAMES,
         HANDLE_TYPES,
         MAX_EPISODE_STEPS,
         PLACEMENT_RANGE,
+        PLACEMENTS,
         PULL_FRACTION,
         STATE_INDEX,
         SUCCESS_FRACTION,
         TABLE_X_LIMIT,
         TABLE_Y_RANGE,
         DrawerVariant,
+        Placement,
+        placement_named,
     )
 
 __all__ = [
+    "DEFAULT_PLACEMENT",
     "DRAWER_CROP",
     "DRAWER_STATE_NAMES",
     "DRAWER_TASKS",
@@ -127,6 +139,7 @@ __all__ = [
     "MAX_EPISODE_STEPS",
     "PAD_HALF_HEIGHT",
     "PAD_OFFSET_Y",
+    "PLACEMENTS",
     "PLACEMENT_RANGE",
     "PULL_FRACTION",
     "STATE_INDEX",
@@ -139,9 +152,11 @@ __all__ = [
     "DrawerSuite",
     "DrawerTaskEnv",
     "DrawerVariant",
+    "Placement",
     "drawer_body_xml",
     "drawer_mjcf",
     "drawer_state_names",
+    "placement_named",
     "render_drawer_picture",
 ]
 

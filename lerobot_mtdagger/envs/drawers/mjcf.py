@@ -59,7 +59,8 @@ _capsule = functools.partial(_round_geom, "capsule")
 _cylinder = functools.partial(_round_geom, "cylinder")
 
 
-def _case_geoms(v: DrawerVariant) -> list[str]:
+def _case_geoms(v: DrawerVariant, lift: float = 0.0) -> list[str]:
+    """The case; its plinth reaches ``lift`` further down (below the table until a reset lifts it)."""
     w, h, d, t = v.width, v.height, v.depth, _WALL
     rgba = v.case_rgba
     geoms = [
@@ -69,9 +70,10 @@ def _case_geoms(v: DrawerVariant) -> list[str]:
         _box("case_right", (w / 2 - t / 2, d / 2, h / 2), (t / 2, d / 2, h / 2), rgba),
         _box("case_back", (0, d - t / 2, h / 2), (w / 2 - t, t / 2, h / 2 - t), rgba),
     ]
-    if v.elevation > 0:
-        plinth = (w / 2 - 0.01, d / 2 - 0.01, v.elevation / 2)
-        geoms.append(_box("case_plinth", (0, d / 2 + 0.01, -v.elevation / 2), plinth, rgba))
+    plinth_height = v.elevation + lift
+    if plinth_height > 0:
+        plinth = (w / 2 - 0.01, d / 2 - 0.01, plinth_height / 2)
+        geoms.append(_box("case_plinth", (0, d / 2 + 0.01, -plinth_height / 2), plinth, rgba))
     return geoms
 
 
@@ -154,8 +156,11 @@ def _handle_geoms(v: DrawerVariant) -> tuple[list[str], np.ndarray, np.ndarray]:
     return geoms, np.array([0.0, tab_y, z]), hook
 
 
-def drawer_body_xml(v: DrawerVariant) -> str:
-    """The ``<body>`` of the case, the drawer, its joint, handle and sites (MJCF fragment)."""
+def drawer_body_xml(v: DrawerVariant, lift: float = 0.0) -> str:
+    """The ``<body>`` of the case, the drawer, its joint, handle and sites (MJCF fragment).
+
+    ``lift`` is the most a reset raises the case (``Placement.lift``): the plinth is that much longer.
+    """
     handle_geoms, handle_center, hook = _handle_geoms(v)
     # MetaWorld's compiler takes inertia from geom groups 4-5 only: the drawer gets explicit inertia,
     # about 0.8 kg for a 30 x 20 cm drawer, scaled with its footprint.
@@ -164,7 +169,7 @@ def drawer_body_xml(v: DrawerVariant) -> str:
     inertia = mass / 12.0 * (extent[[1, 0, 0]] ** 2 + extent[[2, 2, 1]] ** 2)
     yaw = math.radians(v.yaw)
     quat = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
-    case = "\n        ".join(_case_geoms(v))
+    case = "\n        ".join(_case_geoms(v, lift))
     drawer = "\n            ".join(_drawer_geoms(v) + handle_geoms)
     return f"""
     <body name="drawer_case" childclass="drawer_part" pos="{_vec((v.x, v.y, v.elevation))}"
@@ -182,11 +187,12 @@ def drawer_body_xml(v: DrawerVariant) -> str:
     </body>"""
 
 
-def drawer_mjcf(v: DrawerVariant) -> str:
+def drawer_mjcf(v: DrawerVariant, lift: float = 0.0) -> str:
     """The complete MJCF of MetaWorld's arena with the drawer of ``v``.
 
     Includes MetaWorld's scene, arm and gripper (``../scene``, ``../objects`` relative to the file,
-    which ``DrawerSceneEnv`` writes next to links to MetaWorld's asset folders).
+    which ``DrawerSceneEnv`` writes next to links to MetaWorld's asset folders). ``lift`` as in
+    ``drawer_body_xml``.
     """
     return f"""<mujoco model="{v.name}">
     <include file="../scene/basic_scene.xml"/>
@@ -198,7 +204,7 @@ def drawer_mjcf(v: DrawerVariant) -> str:
     </default>
     <worldbody>
         <include file="../objects/assets/xyz_base.xml"/>
-        {drawer_body_xml(v)}
+        {drawer_body_xml(v, lift)}
         <site name="goal" pos="0 0.6 0.2" size="0.01" rgba="0 0 0 0" group="5"/>
     </worldbody>
     <contact>

@@ -24,11 +24,17 @@ from lerobot_mtdagger.envs.drawers.mjcf import PAD_OFFSET_Y, drawer_mjcf
 from lerobot_mtdagger.envs.drawers.variants import (
     DRAWER_STATE_NAMES,
     MAX_EPISODE_STEPS,
-    PLACEMENT_RANGE,
     PULL_FRACTION,
     SUCCESS_FRACTION,
+    TABLE_X_LIMIT,
+    TABLE_Y_RANGE,
     DrawerVariant,
+    Placement,
+    placement_named,
 )
+
+# Name prefixes of the geoms recoloured per reset (``Placement.colour``): case, drawer, handle.
+_COLOURED_PARTS = ("case", "drawer", "handle")
 
 
 def _metaworld_assets() -> Path:
@@ -46,8 +52,9 @@ class DrawerSceneEnv(SawyerXYZEnv):
 
     max_path_length = MAX_EPISODE_STEPS
 
-    def __init__(self, variant: DrawerVariant) -> None:
-        """Builds the model of ``variant``."""
+    def __init__(self, variant: DrawerVariant, placement: Placement | None = None) -> None:
+        """Builds the model of ``variant``; resets place it by ``placement`` (default setting if None)."""
+        self.placement = placement_named(None) if placement is None else placement
         self.variant = variant
         self._tmp = tempfile.TemporaryDirectory(prefix="mtdagger-drawer-")
         root = Path(self._tmp.name)
@@ -56,7 +63,7 @@ class DrawerSceneEnv(SawyerXYZEnv):
             os.symlink(assets / folder, root / folder)
         (root / "sawyer_xyz").mkdir()
         self._model_path = str(root / "sawyer_xyz" / f"{variant.name}.xml")
-        Path(self._model_path).write_text(drawer_mjcf(variant))
+        Path(self._model_path).write_text(drawer_mjcf(variant, lift=self.placement.lift))
         try:
             super().__init__(hand_low=(-0.5, 0.36, 0.05), hand_high=(0.5, 1.0, 0.5))
         finally:
@@ -67,9 +74,7 @@ class DrawerSceneEnv(SawyerXYZEnv):
         self._set_task_called = True
         self.hand_init_pos = np.array([0.0, 0.55, 0.25])
         self.init_tcp = self.tcp_center
-        self._random_reset_space = gym.spaces.Box(
-            -np.asarray(PLACEMENT_RANGE), np.asarray(PLACEMENT_RANGE), dtype=np.float64
-        )
+        self._random_reset_space = gym.spaces.Box(*self.placement.reset_bounds, dtype=np.float64)
         self.goal_space = gym.spaces.Box(np.full(3, -np.inf), np.full(3, np.inf), dtype=np.float64)
         self._joint_qpos = self.model.jnt_qposadr[self.model.joint("drawer_slide").id]
         self._pad_geoms = {self.model.geom(n).id for n in ("leftpad_geom", "rightpad_geom")}
@@ -79,6 +84,7 @@ class DrawerSceneEnv(SawyerXYZEnv):
         }
         self._progress = 0
         self._target_pos = np.zeros(3)
+        self._coloured_geoms = self._geoms_by_part()
 
     @property
     def model_name(self) -> str:
@@ -179,9 +185,13 @@ class DrawerSceneEnv(SawyerXYZEnv):
         """Places the case (seeded offsets around the variant's pose), closes the drawer, homes the hand."""
         offset = self._get_state_rand_vec()
         v = self.variant
-        self.model.body("drawer_case").pos = (v.x + offset[0], v.y + offset[1], v.elevation)
         yaw = math.radians(v.yaw + offset[2])
+        lift = offset[3] if len(offset) > 3 else 0.0
+        x, y = self._on_the_table(v.x + offset[0], v.y + offset[1], yaw)
+        self.model.body("drawer_case").pos = (x, y, v.elevation + lift)
         self.model.body("drawer_case").quat = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+        if len(offset) > 3:
+            self._recolour(np.asarray(offset[4:13]).reshape(3, 3))
         self.data.qpos[self._joint_qpos] = 0.0
         self.data.qvel[self.model.jnt_dofadr[self.model.joint("drawer_slide").id]] = 0.0
         mujoco.mj_forward(self.model, self.data)
@@ -189,6 +199,41 @@ class DrawerSceneEnv(SawyerXYZEnv):
         self._progress = 0
         self._target_pos = self.goal_position()
         return self._get_obs()
+
+    def _on_the_table(self, x: float, y: float, yaw: float) -> tuple[float, float]:
+        """The case front's (x, y), moved the least that keeps the turned case on the table.
+
+        A shift the placement draws may push a deep case through MetaWorld's back wall or over the
+        table's side; the case then stands as close to that limit as it fits (the ``narrow``
+        setting never needs it: every variant is validated with room for it).
+        """
+        v = self.variant
+        half = v.width / 2
+        local = np.array([[-half, 0.0], [half, 0.0], [-half, v.depth], [half, v.depth]])
+        rotation = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+        corners = local @ rotation.T + np.array([x, y])
+        x -= max(0.0, corners[:, 0].max() - TABLE_X_LIMIT) - max(0.0, -TABLE_X_LIMIT - corners[:, 0].min())
+        y -= max(0.0, corners[:, 1].max() - TABLE_Y_RANGE[1]) - max(
+            0.0, TABLE_Y_RANGE[0] - corners[:, 1].min()
+        )
+        return x, y
+
+    def _geoms_by_part(self) -> dict[str, tuple[list[int], np.ndarray]]:
+        """Geom ids of the case, the drawer (front and box) and the handle, with their model colours."""
+        parts: dict[str, tuple[list[int], np.ndarray]] = {}
+        names = [self.model.geom(i).name or "" for i in range(self.model.ngeom)]
+        for prefix in _COLOURED_PARTS:
+            ids = [i for i, name in enumerate(names) if name.startswith(prefix + "_")]
+            parts[prefix] = (ids, self.model.geom_rgba[ids].copy())
+        return parts
+
+    def _recolour(self, shifts: np.ndarray) -> None:
+        """Shifts the RGB of the case, the drawer and the handle by one row of ``shifts`` each."""
+        for prefix, shift in zip(_COLOURED_PARTS, shifts, strict=True):
+            ids, base = self._coloured_geoms[prefix]
+            colours = base.copy()
+            colours[:, :3] = np.clip(base[:, :3] + shift, 0.0, 1.0)
+            self.model.geom_rgba[ids] = colours
 
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None

@@ -16,7 +16,13 @@ import numpy as np
 from lerobot_mtdagger.envs.base import ObservationConfig, TaskSuite, observation_features
 from lerobot_mtdagger.envs.drawers.catalogue import HELDOUT_TASKS, VARIANTS
 from lerobot_mtdagger.envs.drawers.scene import DrawerSceneEnv
-from lerobot_mtdagger.envs.drawers.variants import DRAWER_STATE_NAMES, STATE_INDEX, DrawerVariant
+from lerobot_mtdagger.envs.drawers.variants import (
+    DRAWER_STATE_NAMES,
+    STATE_INDEX,
+    DrawerVariant,
+    Placement,
+    placement_named,
+)
 from lerobot_mtdagger.envs.metaworld import ACTION_DIM, ACTION_NAMES, PROPRIO_NAMES, MetaWorldTaskEnv
 from lerobot_mtdagger.envs.rendering import CropBox
 
@@ -39,13 +45,15 @@ class DrawerTaskEnv(MetaWorldTaskEnv):
         observation: ObservationConfig,
         seed: int | None = None,
         max_episode_steps: int | None = None,
+        placement: Placement | None = None,
     ) -> None:
-        """Builds the drawer's model and env."""
+        """Builds the drawer's model and env (placed per reset by ``placement``, default if None)."""
         self.variant = variant
+        self.placement = placement_named(None) if placement is None else placement
         super().__init__(variant.name, observation, seed=seed, max_episode_steps=max_episode_steps)
 
     def _build_raw_env(self) -> DrawerSceneEnv:
-        return DrawerSceneEnv(self.variant)
+        return DrawerSceneEnv(self.variant, self.placement)
 
     def state_names(self) -> list[str]:
         """Privileged state names in ``state`` mode, hand xyz + gripper otherwise."""
@@ -74,6 +82,7 @@ class DrawerSuite(TaskSuite):
         observation: ObservationConfig,
         max_episode_steps: int | None = None,
         variants: Sequence[DrawerVariant] | None = None,
+        placement: str | Placement | None = None,
     ) -> None:
         """Selects the drawers of the suite.
 
@@ -83,10 +92,13 @@ class DrawerSuite(TaskSuite):
             observation: What the envs show the policy.
             max_episode_steps: Truncation length (``MAX_EPISODE_STEPS`` when None).
             variants: Extra drawer variants (user-defined) that task names may refer to.
+            placement: How resets move and recolour the drawers: a ``PLACEMENTS`` name or a
+                ``Placement`` (``DEFAULT_PLACEMENT`` when None).
 
         Raises:
-            ValueError: On an unknown drawer.
+            ValueError: On an unknown drawer or placement.
         """
+        self.placement = placement if isinstance(placement, Placement) else placement_named(placement)
         self.variants = dict(VARIANTS)
         for variant in variants or ():
             self.variants[variant.name] = variant
@@ -103,7 +115,11 @@ class DrawerSuite(TaskSuite):
         if not self.heldout_task_names:
             return None
         return DrawerSuite(
-            self.heldout_task_names, self.observation, self.max_episode_steps, variants=self._user_variants
+            self.heldout_task_names,
+            self.observation,
+            self.max_episode_steps,
+            variants=self._user_variants,
+            placement=self.placement,
         )
 
     @property
@@ -115,7 +131,13 @@ class DrawerSuite(TaskSuite):
         """Builds the env of a training or held-out drawer."""
         self.check_buildable(task_name)
         variant = self.variants[task_name]
-        return DrawerTaskEnv(variant, self.observation, seed=seed, max_episode_steps=self.max_episode_steps)
+        return DrawerTaskEnv(
+            variant,
+            self.observation,
+            seed=seed,
+            max_episode_steps=self.max_episode_steps,
+            placement=self.placement,
+        )
 
     @property
     def features(self) -> dict[str, dict[str, Any]]:

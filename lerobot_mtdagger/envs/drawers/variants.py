@@ -16,7 +16,7 @@ import numpy as np
 HANDLE_TYPES: tuple[str, ...] = ("bar", "knob", "lip", "vbar")
 SUCCESS_FRACTION = 0.8
 PULL_FRACTION = 0.1
-PLACEMENT_RANGE = (0.03, 0.03, 5.0)  # +- x (m), +- y (m), +- yaw (degrees) per reset
+PLACEMENT_RANGE = (0.03, 0.03, 5.0)  # the "narrow" setting's +- x (m), +- y (m), +- yaw (degrees)
 MAX_EPISODE_STEPS = 300
 
 # The table top is z = 0, x in [-0.7, 0.7]; MetaWorld's retaining walls stand at y = 0.21 and 0.99.
@@ -30,6 +30,75 @@ LIP_TAB_HEIGHT = 0.035
 FINGER_MARGIN = 0.005
 STANDOFF_RADIUS = 0.005
 BAR_POST_INSET = 0.012  # a bar's standoffs stand this far in from its ends
+
+
+@dataclass(frozen=True)
+class Placement:
+    """How far each reset moves and recolours a drawer around its variant's nominal pose.
+
+    Attributes:
+        name: The setting's name (``PLACEMENTS``).
+        x: Shift across the table, +- metres.
+        y: Shift towards or away from the robot, +- metres (then moved towards the robot as far as
+            needed to keep the case in front of MetaWorld's back wall).
+        yaw: Turn about the vertical, +- degrees.
+        lift: The case stands up to this many metres higher (on a taller plinth).
+        colour: Shift of each RGB channel of the case, the front and the handle, +-.
+    """
+
+    name: str
+    x: float
+    y: float
+    yaw: float
+    lift: float = 0.0
+    colour: float = 0.0
+
+    def __post_init__(self) -> None:
+        for field_name in ("x", "y", "yaw", "lift", "colour"):
+            value = getattr(self, field_name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"Placement {self.name!r}: {field_name} must be >= 0, got {value}.")
+
+    @property
+    def reset_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Low and high of the per-reset offset vector.
+
+        x, y, yaw, then lift and 9 colour shifts (case, front, handle RGB) unless the setting has
+        neither: the ``narrow`` setting's 3 values are drawn exactly as before other settings existed.
+        """
+        low, high = [-self.x, -self.y, -self.yaw], [self.x, self.y, self.yaw]
+        if self.lift or self.colour:
+            low += [0.0] + [-self.colour] * 9
+            high += [self.lift] + [self.colour] * 9
+        return np.array(low), np.array(high)
+
+
+PLACEMENTS: dict[str, Placement] = {
+    placement.name: placement
+    for placement in (
+        # The suite's first ranges: a drawer nearly where its variant puts it, always the same colours.
+        Placement("narrow", x=PLACEMENT_RANGE[0], y=PLACEMENT_RANGE[1], yaw=PLACEMENT_RANGE[2]),
+        # What a row of kitchen drawers shows a robot whose base is not square to the counter:
+        # positions along the counter, counter depths, cabinet heights, the robot's angle to it,
+        # and paint / wood / metal finishes.
+        Placement("kitchen", x=0.10, y=0.05, yaw=12.0, lift=0.06, colour=0.2),
+    )
+}
+DEFAULT_PLACEMENT = "kitchen"
+LEGACY_PLACEMENT = "narrow"  # what drawer runs and envs made before placement settings existed used
+
+
+def placement_named(name: str | None) -> Placement:
+    """The placement setting ``name`` (``DEFAULT_PLACEMENT`` when None).
+
+    Raises:
+        ValueError: On an unknown name, listing the settings.
+    """
+    name = DEFAULT_PLACEMENT if name is None else name
+    if name not in PLACEMENTS:
+        raise ValueError(f"Unknown drawer placement {name!r}; choose one of {sorted(PLACEMENTS)}.")
+    return PLACEMENTS[name]
+
 
 DRAWER_STATE_NAMES: list[str] = [
     "hand_x",
