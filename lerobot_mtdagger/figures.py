@@ -441,6 +441,9 @@ def task_gap_lines(rows: Sequence[Row], hardest: Sequence[int]) -> list[str]:
         "| method | baseline | demos per task | hardest tasks | other tasks |",
         "|---|---|---:|---|---|",
     ]
+    task_count = len(rows[0]["eval_success"]) if rows else 0
+    if task_count <= len(hardest):
+        return lines[:2] + [f"Not shown: with {task_count} task(s), no task is left besides the hardest.", ""]
     grouped = runs_by_method(rows)
     for method, baseline in comparison_pairs(rows):
         if method not in grouped or baseline not in grouped:

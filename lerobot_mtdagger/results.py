@@ -32,9 +32,18 @@ from lerobot_mtdagger.rounds import ExperimentDir
 
 RESULTS_FILE = "results.json"
 META_FILE = "results_meta.json"
-REQUIRED_COLUMNS = ("method", "seed", "round", "demos_per_task_mean", "eval_success_mean", "eval_success")
-"""The columns every saved row must have to be reported (``read_results`` checks them)."""
 PHASE_TIMINGS = ("collect_s", "write_s", "load_s", "train_s", "eval_s")
+REQUIRED_COLUMNS = (
+    "method",
+    "seed",
+    "round",
+    "demos_per_task_mean",
+    "expert_frames_per_task_mean",
+    "eval_success_mean",
+    "eval_success",
+    *PHASE_TIMINGS,
+)
+"""The columns every saved row must have to be reported (``read_results`` checks them)."""
 LIST_COLUMNS = (
     "demos_per_task",
     "expert_frames_per_task",

@@ -498,3 +498,57 @@ def test_reach_table_gives_demos_and_frames_at_the_first_crossing():
     # seed 0 crosses 0.5 at 2.5 demos (250 frames), seed 1 at 4.0 (400): mean 3.25 and 325.
     assert "| need | 50% | 3.2" in table and "| 325 [" in table and "| 2/2 |" in table
     assert "| need | 95% | never | never | 0/2 |" in table
+
+
+def hand_built_table(folder: Path, need: dict, bc: dict, tasks: int = 2) -> Path:
+    """A saved results table of known per-seed success (every task alike): ``need`` gives per seed the
+    success after rounds 0, 1, ... (1, 2, ... demos per task), ``bc`` per seed its success at 1, 2, ..."""
+    rows = []
+
+    def row(method: str, seed: int, round_index: int, demos: int, success: float) -> dict:
+        return {
+            "experiment": f"runs/{method}-seed{seed}", "method": method, "bc": method == "bc", "seed": seed,
+            "round": round_index, "preset": "small", "demos_per_task_mean": float(demos),
+            "demos_per_task": [demos] * tasks, "expert_frames_per_task_mean": 100.0 * demos,
+            "expert_frames_per_task": [100 * demos] * tasks, "eval_success_mean": success,
+            "eval_success": [success] * tasks, "eval_episodes_per_task": 20, "metric": None, "kalman_p": None,
+            "raw_success": None, "gain": None, "collect_s": 1.0, "write_s": 0.1, "load_s": 0.1,
+            "train_s": 2.0, "eval_s": 1.0,
+        }  # fmt: skip
+
+    for seed, values in need.items():
+        rows += [row("need", seed, index, index + 1, value) for index, value in enumerate(values)]
+    for seed, values in bc.items():
+        rows += [row("bc", seed, 0, index + 1, value) for index, value in enumerate(values)]
+    folder.mkdir(parents=True)
+    (folder / "results.json").write_text(json.dumps(rows))
+    names = [f"task-{i}" for i in range(tasks)]
+    (folder / "results_meta.json").write_text(json.dumps({"task_names": names, "unfinished": []}))
+    return folder
+
+
+def test_the_report_s_paired_differences_and_reach_ratios_are_the_hand_computed_ones(tmp_path, capsys):
+    """Differences are method - baseline per seed, then a 95% t interval (t = 4.303 for 3 seeds)."""
+    table = hand_built_table(
+        tmp_path / "table",
+        need={0: [0.5, 0.9], 1: [0.4, 0.8], 2: [0.3, 0.7]},
+        bc={0: [0.5, 0.6], 1: [0.4, 0.6], 2: [0.3, 0.6]},
+    )
+    assert main(["report", f"--results=[{table}]", f"--output_dir={tmp_path / 'report'}"]) == 0
+    summary = (tmp_path / "report" / "report.md").read_text()
+    # At 2 demos: need - bc = 0.3, 0.2, 0.1 -> mean 0.2, sd 0.1, half-width 4.303 * 0.1 / sqrt(3) = 0.248.
+    assert "| need | bc | 2.0 | +0.200 [-0.048, +0.448] |" in summary
+    assert "| need | bc | 1.0 | +0.000 [+0.000, +0.000] |" in summary
+    # 60%: need crosses it at 1.25, 1.5, 1.75 demos, BC at 2, 2, 2 -> ratios 0.625, 0.75, 0.875.
+    assert "| need | bc | 60% | 0.75 | 3/3 |" in summary
+    assert "Not shown: with 2 task(s), no task is left besides the hardest." in summary
+
+
+def test_a_saved_table_without_phase_timings_is_refused_naming_the_column(tmp_path, capsys):
+    table = hand_built_table(tmp_path / "table", need={0: [0.5, 0.9]}, bc={0: [0.5, 0.6]})
+    rows = json.loads((table / "results.json").read_text())
+    (table / "results.json").write_text(
+        json.dumps([{k: v for k, v in r.items() if k != "train_s"} for r in rows])
+    )
+    assert main(["report", f"--results=[{table}]", f"--output_dir={tmp_path / 'report'}"]) == 2
+    assert "lack the column(s) ['train_s']" in capsys.readouterr().err
