@@ -12,6 +12,8 @@ import sys
 from pathlib import Path
 
 import pytest
+from safetensors import safe_open
+from safetensors.torch import load_file, save_file
 
 from lerobot_mtdagger import dagger as dagger_module
 from lerobot_mtdagger import rounds as rounds_module
@@ -123,7 +125,20 @@ def garble(path: Path) -> None:
     path.write_bytes(bytes(data))
 
 
+def nudge_weights(root: Path) -> None:
+    """Changes one weight of a committed policy by 1e-3: the file still loads, only its checksum differs."""
+    path = ExperimentDir(root).policy_root(1) / "model.safetensors"
+    with safe_open(str(path), framework="pt") as handle:
+        metadata = handle.metadata()
+    tensors = load_file(path)
+    name = sorted(tensors)[0]
+    tensors[name] = tensors[name] + 1e-3
+    save_file(tensors, str(path), metadata=metadata)
+    assert set(load_file(path)) == set(tensors)
+
+
 DAMAGES = {
+    "changed weights that still load": nudge_weights,
     "truncated parquet": lambda root: truncate(round_parquet(root)),
     "garbled parquet": lambda root: garble(round_parquet(root)),
     "deleted parquet": lambda root: round_parquet(root).unlink(),
@@ -254,6 +269,12 @@ def test_a_drawer_run_made_before_placements_existed_resumes_only_with_the_narro
     experiment.check_resumable({**older, "placement": "narrow"}, added_defaults=defaults)
     with pytest.raises(UserError, match=r"placement: None -> 'kitchen'\) \(drawer runs made before"):
         experiment.check_resumable({**older, "placement": "kitchen"}, added_defaults=defaults)
+
+
+def test_resume_refuses_a_policy_changed_after_commit_that_still_loads(finished, tmp_path):
+    copy = damaged_copy(finished, tmp_path, nudge_weights)
+    with pytest.raises(CorruptExperimentError, match=r"policies/round-001.*model.safetensors"):
+        run(toy_config(copy, "--rounds=1", "--resume=true"))
 
 
 def test_resume_refuses_a_round_changed_after_commit_before_running(finished, tmp_path):
