@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import os
 
 import numpy as np
 import pytest
@@ -368,12 +369,17 @@ def test_vector_env_steps_drawers_in_worker_processes():
     suite = make_suite("drawers", tasks=["drawer-bar-wide", "drawer-knob-small"])
     envs = suite.make_vector_env(suite.task_names, seeds=[0, 1])
     try:
+        workers = [process.pid for process in envs.processes if process.is_alive()]
+        assert len(set(workers)) == 2 and os.getpid() not in workers
         _, infos = envs.reset()
         _, _, _, _, infos = envs.step(np.zeros((2, 4), dtype=np.float32))
         assert infos["privileged_state"].shape == (2, len(DRAWER_STATE_NAMES))
         assert list(infos["progress"]) == [0, 0]
+        travel = infos["privileged_state"][:, STATE_INDEX["travel"]]
+        assert list(travel) == pytest.approx([0.15, 0.10])  # each worker holds its own drawer
     finally:
         envs.close()
+    assert not any(process.is_alive() for process in envs.processes)
 
 
 def test_lerobot_env_plugin_builds_a_drawer():
