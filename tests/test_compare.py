@@ -78,12 +78,20 @@ def test_the_table_holds_every_method_seed_and_round_and_bc_at_every_budget(comp
         assert len(list(csv.DictReader(handle))) == len(rows)
 
 
-def test_a_second_compare_skips_finished_runs(compared):
+def test_a_second_compare_skips_finished_runs(compared, monkeypatch):
+    """No run process starts at all (resuming a finished run would leave every file as it was)."""
     folder, args = compared
+    started, popen = [], subprocess.Popen
+
+    def spy(command, *rest, **options):
+        started.append(command)
+        return popen(command, *rest, **options)
+
+    monkeypatch.setattr(subprocess, "Popen", spy)
     before = {p.name: p.stat().st_mtime_ns for p in (folder / "runs").glob("*/policies/round-*")}
     assert main([*args, "--jobs=1", *TINY]) == 0
     after = {p.name: p.stat().st_mtime_ns for p in (folder / "runs").glob("*/policies/round-*")}
-    assert before == after
+    assert before == after and started == []
 
 
 def _compare_in_its_first_run(folder: Path, seeds: str) -> tuple[subprocess.Popen, list[str], list[int]]:
