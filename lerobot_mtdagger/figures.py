@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.report import is_bc
 from lerobot_mtdagger.results import PHASE_TIMINGS
 from lerobot_mtdagger.stats import Interval, correlation, demos_to_reach, mean_interval, paired_difference
 
@@ -36,11 +37,6 @@ Row = dict[str, Any]
 # -------------------------------------------------------------------------------------------------
 # Curves from rows
 # -------------------------------------------------------------------------------------------------
-
-
-def is_bc(row: Row) -> bool:
-    """Whether a row comes from a one-round BC run (under any label)."""
-    return bool(row.get("bc", row["method"] == "bc"))
 
 
 def bc_methods(rows: Sequence[Row]) -> list[str]:

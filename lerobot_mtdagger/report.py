@@ -14,6 +14,7 @@ from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -132,14 +133,17 @@ def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = N
     return average_runs([experiment_curve(Path(root), labels.get(Path(root))) for root in roots])
 
 
+def is_bc(row: Mapping[str, Any]) -> bool:
+    """Whether a results row comes from a one-round BC run (under any label)."""
+    return bool(row.get("bc", row["method"] == "bc"))
+
+
 def curves_from_rows(rows: Sequence[Mapping]) -> list[CurvePoint]:
     """The learning curves of a saved results table (``results.read_results``), as ``learning_curves``.
 
     Raises:
         ValueError: As ``average_runs``.
     """
-    from lerobot_mtdagger.figures import is_bc
-
     runs: dict[tuple[str, int], list[tuple[int, float, float]]] = defaultdict(list)
     for row in rows:
         name = _curve_name(row["method"], is_bc(row), float(row["demos_per_task_mean"]))

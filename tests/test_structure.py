@@ -45,10 +45,15 @@ def module_path(name: str) -> Path:
 
 def module_level_imports(name: str) -> set[str]:
     """Our modules imported at module level by ``name`` (function bodies are not module level)."""
+    return imports_of(name, everywhere=False)
+
+
+def imports_of(name: str, everywhere: bool = True) -> set[str]:
+    """Our modules imported by ``name``: anywhere in it, or at module level only."""
     tree = ast.parse(module_path(name).read_text())
     imported: set[str] = set()
     is_package = module_path(name).name == "__init__.py"
-    for node in tree.body:  # module level only; nested imports run on call
+    for node in ast.walk(tree) if everywhere else tree.body:
         targets = []
         if isinstance(node, ast.Import):
             targets = [alias.name for alias in node.names]
@@ -64,8 +69,10 @@ def module_level_imports(name: str) -> set[str]:
     return {t for t in imported if t in modules and t != name}
 
 
-def test_module_level_imports_have_no_cycle():
-    graph = {name: module_level_imports(name) for name in package_modules()}
+@pytest.mark.parametrize("everywhere", [False, True], ids=["module-level", "function-level-too"])
+def test_imports_have_no_cycle(everywhere):
+    """Not even through an import inside a function: such a cycle still couples the modules."""
+    graph = {name: imports_of(name, everywhere) for name in package_modules()}
     # A package's __init__ imported by its own submodules is not a cycle we can avoid: Python imports
     # the parent package first; cycles between distinct modules are what break.
     for name, targets in graph.items():
