@@ -8,7 +8,8 @@ import os
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, make_suite
+from lerobot_mtdagger.cli import EvalConfig
+from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, make_suite, suite_from_config
 from lerobot_mtdagger.envs.drawers.catalogue import (
     DRAWER_TASKS,
     HELDOUT_DRAWERS,
@@ -26,7 +27,7 @@ from lerobot_mtdagger.envs.drawers.variants import (
     TABLE_X_LIMIT,
     TABLE_Y_RANGE,
 )
-from lerobot_mtdagger.envs.lerobot_env import LeRobotSuiteEnv
+from lerobot_mtdagger.envs.lerobot_env import LeRobotSuiteEnv, MTDAggerSuiteEnvConfig
 from lerobot_mtdagger.experts import make_expert, run_expert_episode
 from lerobot_mtdagger.experts.drawers import DrawerScriptedExpert
 
@@ -390,6 +391,20 @@ def test_lerobot_env_plugin_builds_a_drawer():
         assert env.task_description == "drawer-kitchen"
     finally:
         env.close()
+
+
+@pytest.mark.parametrize("placement", [None, "narrow"])
+def test_the_lerobot_env_plugin_and_eval_take_the_placement(placement):
+    """``--env.placement`` (lerobot-eval) and ``eval --placement`` reach the drawers; default kitchen."""
+    config = MTDAggerSuiteEnvConfig(suite="drawers", task="drawer-kitchen", placement=placement)
+    assert config.gym_kwargs["placement"] == placement
+    env = LeRobotSuiteEnv(**config.gym_kwargs)
+    try:
+        assert env._suite.placement.name == (placement or "kitchen")
+    finally:
+        env.close()
+    eval_config = EvalConfig(policy_path="unused", suite="drawers", placement=placement)
+    assert suite_from_config(eval_config).placement.name == (placement or "kitchen")
 
 
 def test_pictures_show_the_drawer():
