@@ -346,6 +346,26 @@ def bad_inputs(finished: Path, tmp_path: Path) -> dict[str, tuple[list[str], str
             ["compare", "--rounds=-1", f"--output_dir={tmp_path / 'cmp'}"],
             "rounds must be >= 0",
         ),
+        "run of an unknown drawer": (
+            ["run", "--suite=drawers", "--tasks=[drawer-nope]", f"--output_dir={tmp_path / 'r1'}"],
+            "Unknown drawer(s) ['drawer-nope']",
+        ),
+        "run with an unknown observation mode": (
+            ["run", "--obs_mode=depth", f"--output_dir={tmp_path / 'r2'}"],
+            "Unknown obs_mode 'depth'",
+        ),
+        "run of the toy suite on point clouds": (
+            ["run", "--suite=toy", "--obs_mode=pointcloud", f"--output_dir={tmp_path / 'r3'}"],
+            "The toy suite has state observations only",
+        ),
+        "run with a placement outside the drawers": (
+            ["run", "--suite=toy", "--placement=kitchen", f"--output_dir={tmp_path / 'r4'}"],
+            "placement applies to the drawers suite only",
+        ),
+        "run with an unknown placement": (
+            ["run", "--suite=drawers", "--placement=office", f"--output_dir={tmp_path / 'r5'}"],
+            "Unknown drawer placement 'office'",
+        ),
         "merge of a non-experiment": (
             ["merge", f"--experiment_dir={tmp_path}", f"--output={tmp_path / 'm'}"],
             "is not a lerobot-mtdagger experiment",
@@ -362,6 +382,7 @@ def test_every_bad_input_is_one_error_line_and_exit_2(finished, tmp_path, capsys
         assert err[0].startswith(f"lerobot-mtdagger {argv[0]}: error: ") and expected in err[0], (name, err)
         assert "Traceback" not in captured.out + captured.err
     assert not (tmp_path / "cmp").exists(), "compare wrote before checking its options"
+    assert not any((tmp_path / f"r{i}").exists() for i in range(1, 6)), "run wrote before checking its suite"
 
 
 def test_debug_shows_the_traceback_of_a_user_error(tmp_path):

@@ -170,7 +170,7 @@ def suite_from_config(config: SuiteOptions, **overrides: Any) -> TaskSuite:
         **overrides: ``make_suite`` keyword arguments that replace the config's.
 
     Raises:
-        ValueError: On an unknown suite, task or observation setting.
+        UserError: On an unknown suite, task or observation setting (one line, naming the option).
     """
     tasks = config.tasks
     if isinstance(tasks, str):
@@ -183,4 +183,9 @@ def suite_from_config(config: SuiteOptions, **overrides: Any) -> TaskSuite:
         "max_episode_steps": getattr(config, "episode_length", None),
         "placement": getattr(config, "placement", None),
     }
-    return make_suite(config.suite, **(options | overrides))
+    try:
+        return make_suite(config.suite, **(options | overrides))
+    except UserError:
+        raise
+    except ValueError as error:  # a bad suite, task or observation option: the user's to fix
+        raise UserError(str(error)) from None
