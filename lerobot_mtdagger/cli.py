@@ -27,13 +27,14 @@ Commands:
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -205,11 +206,11 @@ class EvalConfig:
         suite: Task suite.
         tasks: Tasks to evaluate (all the suite's when empty; ``heldout``: the suite's unseen tasks,
             which a policy trained with ``task_dropout > 0`` acts on with its shared embedding).
-        obs_mode: Observation mode the policy was trained on.
+        obs_mode: Observation mode the policy was trained on (None: read from the policy's inputs).
         episodes: Episodes per task.
         seed: Seed of the evaluation episodes.
-        num_points: Points per cloud.
-        image_size: Image side.
+        num_points: Points per cloud (None: the policy's).
+        image_size: Image side (None: the policy's).
         placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when
             None, or ``narrow``).
         output: Optional JSON file for the results.
@@ -221,11 +222,11 @@ class EvalConfig:
     policy_path: str | None = None
     suite: str = "metaworld-mt10"
     tasks: list[str] = field(default_factory=list)
-    obs_mode: str = "state"
+    obs_mode: str | None = None
     episodes: int = 10
     seed: int = 0
-    num_points: int = 1024
-    image_size: int = 84
+    num_points: int | None = None
+    image_size: int | None = None
     placement: str | None = None
     output: Path | None = None
     workers: int | None = None
@@ -249,6 +250,8 @@ def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.evaluate import PolicyRunner
 
+    runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
+    config = dataclasses.replace(config, **observation_options(runner, config))
     if list(config.tasks) == [HELDOUT_TASKS]:
         suite = suite_from_config(config, tasks=None).heldout_suite()
         if suite is None:
@@ -257,9 +260,31 @@ def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
             )
     else:
         suite = suite_from_config(config)
-    runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
     runner.check_inputs(suite.features, config.obs_mode)
     return suite, runner
+
+
+DEFAULT_NUM_POINTS = 1024
+DEFAULT_IMAGE_SIZE = 84
+
+
+def observation_options(runner: PolicyRunner, config: EvalConfig) -> dict[str, Any]:
+    """``obs_mode``, ``num_points`` and ``image_size``: the config's, else what the policy was trained on.
+
+    A policy with a point-cloud input was trained on clouds of its input's point count, one with an
+    image input on images of its side, any other on state.
+    """
+    from lerobot_mtdagger.policies.mtdagger.configuration_mtdagger import is_pointcloud_feature
+
+    features = runner.policy.config.input_features
+    clouds = [f for key, f in features.items() if is_pointcloud_feature(key, f)]
+    images = [f for key, f in features.items() if key.startswith("observation.image")]
+    trained = "pointcloud" if clouds else "rgb" if images else "state"
+    return {
+        "obs_mode": config.obs_mode or trained,
+        "num_points": config.num_points or (clouds[0].shape[0] if clouds else DEFAULT_NUM_POINTS),
+        "image_size": config.image_size or (images[0].shape[-1] if images else DEFAULT_IMAGE_SIZE),
+    }
 
 
 def eval_command(config: EvalConfig) -> dict:

@@ -94,3 +94,29 @@ def test_dataset_card_template_ships_with_the_package(tmp_path):
         assert "lerobot_mtdagger/datasets_cards/mtdagger_card.md" in cards, f"cards in the wheel: {cards}"
         card = archive.read("lerobot_mtdagger/datasets_cards/mtdagger_card.md").decode("utf-8")
     assert "{{ allocation_table }}" in card
+
+
+@pytest.mark.parametrize(
+    ("inputs", "given", "expected"),
+    [
+        ({"observation.state": (4,), "observation.pointcloud": (512, 3)}, {}, ("pointcloud", 512, 84)),
+        ({"observation.state": (7,), "observation.image": (3, 64, 64)}, {}, ("rgb", 1024, 64)),
+        ({"observation.state": (39,)}, {}, ("state", 1024, 84)),
+        ({"observation.pointcloud": (512, 3)}, {"num_points": 256}, ("pointcloud", 256, 84)),
+    ],
+)
+def test_eval_takes_the_observation_options_the_policy_was_trained_with(inputs, given, expected):
+    """A point-cloud policy evaluates without --obs_mode / --num_points; what is given still wins."""
+    from types import SimpleNamespace
+
+    from lerobot.configs.types import FeatureType, PolicyFeature
+
+    from lerobot_mtdagger.cli import EvalConfig, observation_options
+
+    features = {
+        key: PolicyFeature(FeatureType.VISUAL if "image" in key else FeatureType.STATE, shape)
+        for key, shape in inputs.items()
+    }
+    runner = SimpleNamespace(policy=SimpleNamespace(config=SimpleNamespace(input_features=features)))
+    options = observation_options(runner, EvalConfig(policy_path="p", **given))
+    assert (options["obs_mode"], options["num_points"], options["image_size"]) == expected

@@ -267,10 +267,9 @@ def test_drawer_suite_runs_with_point_clouds_and_evaluates_the_unseen_drawers(tm
     from lerobot_mtdagger.cli import EvalConfig, eval_command
 
     policy = experiment.policy_root(1)
-    args = [f"--policy_path={policy}", "--suite=drawers", "--tasks=[heldout]", "--obs_mode=pointcloud"]
-    result = eval_command(
-        draccus.parse(EvalConfig, args=[*args, "--num_points=128", "--episodes=1", "--workers=0"])
-    )
+    # No --obs_mode / --num_points: eval reads them from the policy's inputs (a 128-point cloud).
+    args = [f"--policy_path={policy}", "--suite=drawers", "--tasks=[heldout]", "--placement=kitchen"]
+    result = eval_command(draccus.parse(EvalConfig, args=[*args, "--episodes=1", "--workers=0"]))
     assert result["task_names"] == list(HELDOUT_TASKS) and len(result["progress"]) == len(HELDOUT_TASKS)
 
     # report carries them: the in-domain / unseen table and the unseen-success figure.

@@ -403,7 +403,14 @@ def test_the_lerobot_env_plugin_and_eval_take_the_placement(placement):
         assert env._suite.placement.name == (placement or "kitchen")
     finally:
         env.close()
-    eval_config = EvalConfig(policy_path="unused", suite="drawers", placement=placement)
+    eval_config = EvalConfig(
+        policy_path="unused",
+        suite="drawers",
+        obs_mode="state",
+        num_points=512,
+        image_size=84,
+        placement=placement,
+    )
     assert suite_from_config(eval_config).placement.name == (placement or "kitchen")
 
 
