@@ -4,7 +4,8 @@
 
 Per round: episodes, frames, the share of episodes (and of frames) from episodes that ran the full
 300-step horizon, the share of frames labelled "open the gripper" (gripper command < 0), the mean
-|z| command, and each phase's evaluation success and final training loss.
+|z| command, and each phase's evaluation success and final training loss. Then per phase the success
+of every training drawer and, where the run evaluated them, of every unseen drawer.
 """
 
 from __future__ import annotations
@@ -62,6 +63,20 @@ def main(folders: list[str]) -> None:
                 f"| {n['long_frames']:.2f} "
                 f"| {n['open_labels']:.2f} | {n['mean_abs_z']:.2f} | {success} | {loss} |"
             )
+        print_per_drawer(folder)
+
+
+def print_per_drawer(folder: Path) -> None:
+    """Success per drawer (and per unseen drawer) after each phase of one run."""
+    phases = [json.loads(p.read_text()) for p in sorted(folder.glob("policies/round-*/training.json"))]
+    for key, title in (("eval", "training drawers"), ("heldout_eval", "unseen drawers")):
+        evaluated = [phase[key] for phase in phases if phase.get(key)]
+        if not evaluated:
+            continue
+        print(f"\nsuccess per phase, {title}: " + ", ".join(f"phase {i}" for i in range(len(evaluated))))
+        for index, name in enumerate(evaluated[0]["task_names"]):
+            cells = " ".join(f"{result['success'][index]:.1f}" for result in evaluated)
+            print(f"  {name:20s} {cells}")
 
 
 if __name__ == "__main__":
