@@ -114,6 +114,8 @@ def test_seeded_resets_place_the_case_reproducibly_within_the_range(placement):
         assert np.all(np.abs(shifts) <= ranges.colour + 1e-6)
         if placement == "narrow":
             assert np.all(offsets[:, 2] == 0) and np.abs(shifts).max() < 1e-6  # float32 colours
+            # The first setting's exact offsets: a deep case is not moved back from the back wall.
+            assert offsets[:, 1].max() > 0.01
         else:
             assert offsets[:, 2].std() > 0.01 and shifts[..., :3].std() > 0.05
     finally:

@@ -187,7 +187,9 @@ class DrawerSceneEnv(SawyerXYZEnv):
         v = self.variant
         yaw = math.radians(v.yaw + offset[2])
         lift = offset[3] if len(offset) > 3 else 0.0
-        x, y = self._on_the_table(v.x + offset[0], v.y + offset[1], yaw)
+        x, y = v.x + offset[0], v.y + offset[1]
+        if self.placement.keep_on_table:
+            x, y = self._on_the_table(x, y, yaw)
         self.model.body("drawer_case").pos = (x, y, v.elevation + lift)
         self.model.body("drawer_case").quat = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
         if len(offset) > 3:
@@ -204,8 +206,7 @@ class DrawerSceneEnv(SawyerXYZEnv):
         """The case front's (x, y), moved the least that keeps the turned case on the table.
 
         A shift the placement draws may push a deep case through MetaWorld's back wall or over the
-        table's side; the case then stands as close to that limit as it fits (the ``narrow``
-        setting never needs it: every variant is validated with room for it).
+        table's side; the case then stands as close to that limit as it fits.
         """
         v = self.variant
         half = v.width / 2

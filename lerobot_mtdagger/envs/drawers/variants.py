@@ -44,6 +44,10 @@ class Placement:
         yaw: Turn about the vertical, +- degrees.
         lift: The case stands up to this many metres higher (on a taller plinth).
         colour: Shift of each RGB channel of the case, the front and the handle, +-.
+        keep_on_table: Move a case that a shift pushes over the table's edge or into MetaWorld's
+            back wall back just far enough. ``narrow`` does not (its first version let deep cases
+            reach up to 4 cm into the back wall, static geoms that never touch) so that it replays
+            exactly.
     """
 
     name: str
@@ -52,6 +56,7 @@ class Placement:
     yaw: float
     lift: float = 0.0
     colour: float = 0.0
+    keep_on_table: bool = True
 
     def __post_init__(self) -> None:
         for field_name in ("x", "y", "yaw", "lift", "colour"):
@@ -77,7 +82,9 @@ PLACEMENTS: dict[str, Placement] = {
     placement.name: placement
     for placement in (
         # The suite's first ranges: a drawer nearly where its variant puts it, always the same colours.
-        Placement("narrow", x=PLACEMENT_RANGE[0], y=PLACEMENT_RANGE[1], yaw=PLACEMENT_RANGE[2]),
+        Placement(
+            "narrow", x=PLACEMENT_RANGE[0], y=PLACEMENT_RANGE[1], yaw=PLACEMENT_RANGE[2], keep_on_table=False
+        ),
         # What a row of kitchen drawers shows a robot whose base is not square to the counter:
         # positions along the counter, counter depths, cabinet heights, the robot's angle to it,
         # and paint / wood / metal finishes.
