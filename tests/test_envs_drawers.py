@@ -132,11 +132,8 @@ def test_the_kitchen_placement_keeps_every_drawer_on_the_table():
                 env.reset(seed=seed)
                 scene = env._env
                 case = scene.data.body("drawer_case")
-                rotation = case.xmat.reshape(3, 3)[:2, :2]
-                variant = VARIANTS[name]
-                half = variant.width / 2
-                local = np.array([[-half, 0.0], [half, 0.0], [-half, variant.depth], [half, variant.depth]])
-                corners = local @ rotation.T + case.xpos[:2]
+                yaw = np.arctan2(case.xmat[3], case.xmat[0])
+                corners = VARIANTS[name].case_corners_xy(case.xpos[0], case.xpos[1], yaw)
                 assert np.all(np.abs(corners[:, 0]) <= TABLE_X_LIMIT + 1e-9), name
                 assert np.all(
                     (corners[:, 1] >= TABLE_Y_RANGE[0] - 1e-9) & (corners[:, 1] <= TABLE_Y_RANGE[1] + 1e-9)

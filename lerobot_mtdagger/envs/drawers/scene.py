@@ -208,11 +208,7 @@ class DrawerSceneEnv(SawyerXYZEnv):
         A shift the placement draws may push a deep case through MetaWorld's back wall or over the
         table's side; the case then stands as close to that limit as it fits.
         """
-        v = self.variant
-        half = v.width / 2
-        local = np.array([[-half, 0.0], [half, 0.0], [-half, v.depth], [half, v.depth]])
-        rotation = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
-        corners = local @ rotation.T + np.array([x, y])
+        corners = self.variant.case_corners_xy(x, y, yaw)
         x -= max(0.0, corners[:, 0].max() - TABLE_X_LIMIT) - max(0.0, -TABLE_X_LIMIT - corners[:, 0].min())
         y -= max(0.0, corners[:, 1].max() - TABLE_Y_RANGE[1]) - max(
             0.0, TABLE_Y_RANGE[0] - corners[:, 1].min()

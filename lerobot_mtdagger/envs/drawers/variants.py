@@ -276,13 +276,19 @@ class DrawerVariant:
             f"{TABLE_Y_RANGE} (MetaWorld's back wall stands at 0.99); move y or make the case shallower.",
         )
 
-    def case_corners_xy(self) -> np.ndarray:
-        """World (x, y) of the four footprint corners of the case at the variant's nominal pose, (4, 2)."""
+    def case_corners_xy(
+        self, x: float | None = None, y: float | None = None, yaw: float | None = None
+    ) -> np.ndarray:
+        """World (x, y) of the four footprint corners of the case, (4, 2).
+
+        At the variant's nominal pose, or with the case front's centre at ``x``, ``y`` and turned by
+        ``yaw`` radians where given.
+        """
         half = self.width / 2
         local = np.array([[-half, 0.0], [half, 0.0], [-half, self.depth], [half, self.depth]])
-        yaw = math.radians(self.yaw)
+        yaw = math.radians(self.yaw) if yaw is None else yaw
         rotation = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
-        return local @ rotation.T + np.array([self.x, self.y])
+        return local @ rotation.T + np.array([self.x if x is None else x, self.y if y is None else y])
 
     def handle_center_z(self) -> float:
         """Height of the handle centre above the case bottom (case frame, without elevation)."""
