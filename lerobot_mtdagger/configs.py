@@ -43,6 +43,9 @@ class PolicyOptions:
         state_hidden_dims: Hidden sizes of the state MLP.
         head_hidden_dims: Hidden sizes of the action head.
         pointnet_dims: PointNet per-point MLP sizes.
+        pointnet_layer_norm: LayerNorm after every PointNet layer and its projection (DP3's encoder;
+            with ``pointcloud_embedding_dim=64`` and 512 points, DP3's size).
+        pointcloud_embedding_dim: Output size of the point-cloud encoder.
         task_embedding_dim: Task embedding size.
         task_dropout: Probability of training a sample on the shared "any task" embedding instead of
             its own (``MTDAggerConfig.task_dropout``: what lets the policy act on unseen tasks). None:
@@ -55,6 +58,8 @@ class PolicyOptions:
     state_hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
     head_hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
     pointnet_dims: list[int] = field(default_factory=lambda: [64, 128, 256])
+    pointnet_layer_norm: bool = False
+    pointcloud_embedding_dim: int = 256
     task_embedding_dim: int = 32
     task_dropout: float | None = None
     device: str = "cpu"
@@ -364,11 +369,17 @@ class RunConfig:
     def option_defaults(cls) -> dict[str, Any]:
         """What each top-level option was before it existed, by name (e.g. ``plateau_every: 200``).
 
-        Its plain default, except ``placement``: drawer runs made before it existed used ``narrow``.
+        Its plain default, except ``placement``: drawer runs made before it existed used ``narrow``;
+        ``policy`` maps the policy options alike.
         """
         fields = dataclasses.fields(cls)
         defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
-        return defaults | {"placement": LEGACY_PLACEMENT}
+        policy = {
+            f.name: f.default
+            for f in dataclasses.fields(PolicyOptions)
+            if f.default is not dataclasses.MISSING
+        }
+        return defaults | {"placement": LEGACY_PLACEMENT, "policy": policy}
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (stored in every round's record)."""

@@ -120,6 +120,21 @@ def result_options(config: Mapping[str, Any], ignore: Sequence[str]) -> dict[str
     return options
 
 
+def fill_added_options(stored: dict[str, Any], given: Mapping[str, Any], added: Mapping[str, Any]) -> None:
+    """Gives ``stored`` each option of ``added`` it lacks where ``given`` holds that default.
+
+    ``added`` maps an option to what it was before it existed; a nested mapping (``policy``) is
+    filled option by option.
+    """
+    for key, default in added.items():
+        if isinstance(default, Mapping):
+            if isinstance(stored.get(key), Mapping) and isinstance(given.get(key), Mapping):
+                stored[key] = dict(stored[key])
+                fill_added_options(stored[key], given[key], default)
+        elif key in given and key not in stored and given[key] == default:
+            stored[key] = default
+
+
 def adds_dagger_rounds(stored: Mapping[str, Any], given: Mapping[str, Any]) -> bool:
     """Whether ``given`` asks a stored DAgger run for more rounds (and maybe nothing else)."""
     rounds = stored.get("rounds"), given.get("rounds")
@@ -216,7 +231,8 @@ class ExperimentDir:
         depends on how many follow it, so the run is extended (``extend_rounds``) and its rounds so
         far are those of a run started with the larger number. An option the stored config lacks (added
         to the toolkit after the run started) matches when ``config`` gives it its default in
-        ``added_defaults``: a new option's default keeps the behaviour the run was made with.
+        ``added_defaults`` (a nested mapping for ``policy``): a new option's default keeps the behaviour
+        the run was made with.
 
         Raises:
             NotAnExperimentError: If there is no experiment to resume.
@@ -228,9 +244,7 @@ class ExperimentDir:
             )
         stored = result_options(self.read_config(), ignore)
         given = result_options(config, ignore)
-        for key, default in (added_defaults or {}).items():
-            if key in given and key not in stored and given[key] == default:
-                stored[key] = default
+        fill_added_options(stored, given, added_defaults or {})
         if adds_dagger_rounds(stored, given):
             stored["rounds"] = given["rounds"]
         differing = sorted(key for key in set(stored) | set(given) if stored.get(key) != given.get(key))

@@ -228,6 +228,8 @@ def policy_config(
         state_hidden_dims=tuple(options.state_hidden_dims),
         head_hidden_dims=tuple(options.head_hidden_dims),
         pointnet_dims=tuple(options.pointnet_dims),
+        pointnet_layer_norm=options.pointnet_layer_norm,
+        pointcloud_embedding_dim=options.pointcloud_embedding_dim,
         task_embedding_dim=options.task_embedding_dim,
         task_dropout=task_dropout,
         push_to_hub=False,

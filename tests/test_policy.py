@@ -11,7 +11,7 @@ from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.policies.factory import get_policy_class, make_policy_config
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
-from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
+from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import max_pool_of_winners, per_task_means
 from lerobot_mtdagger.policies.mtdagger.processor_mtdagger import pool_pointcloud_stats
 
 TASKS = ["reach-v3", "push-v3", "door-open-v3"]
@@ -82,6 +82,67 @@ def test_forward_backward_for_each_modality(modality):
     assert policy.training
     assert policy.select_action(batch).shape == (6, 4)
     assert not any(module.training for module in policy.modules()), "select_action leaves eval mode on"
+
+
+@pytest.mark.parametrize("layer_norm", [False, True])
+def test_max_pool_of_winners_gives_the_dense_max_pool_and_its_gradient(layer_norm):
+    torch.manual_seed(0)
+    norm = [torch.nn.LayerNorm(16)] if layer_norm else []
+    per_point = torch.nn.Sequential(torch.nn.Linear(3, 16), *norm, torch.nn.ReLU(), torch.nn.Linear(16, 32))
+    points = torch.randn(5, 40, 3)
+    points[:, 20:] = points[:, :20]  # duplicated points: ties go to one winner, as with max
+    points.requires_grad_(True)
+    weights = torch.randn(32)
+
+    def gradients(pool):
+        pooled = pool()
+        return pooled.detach(), torch.autograd.grad(
+            (pooled * weights).sum(), [points, *per_point.parameters()]
+        )
+
+    dense, dense_grads = gradients(lambda: per_point(points).max(dim=1).values)
+    sparse, sparse_grads = gradients(lambda: max_pool_of_winners(per_point, points))
+    torch.testing.assert_close(sparse, dense)
+    for got, expected in zip(sparse_grads, dense_grads, strict=True):
+        torch.testing.assert_close(got, expected, rtol=1e-5, atol=1e-6)
+    assert bool(dense_grads[0][:, 20:].eq(0).all()), "a tie's gradient goes to its first point only"
+
+
+def test_the_dp3_encoder_has_dp3s_size_and_round_trips(tmp_path):
+    cloud = PolicyFeature(type=FeatureType.STATE, shape=(512, 3))
+    inputs = {"observation.state": STATE, "observation.pointcloud": cloud}
+    dp3 = {"pointnet_dims": (64, 128, 256), "pointcloud_embedding_dim": 64, "pointnet_layer_norm": True}
+    policy = MTDAggerPolicy(make_config(inputs, **dp3))
+    encoder = policy.encoders["observation_pointcloud"]
+    assert sum(p.numel() for p in encoder.parameters()) == 59_072  # DP3's PointNet with LayerNorm
+    assert sum(isinstance(m, torch.nn.LayerNorm) for m in encoder.modules()) == 4
+    batch = make_batch(inputs, batch_size=4)
+    loss, _ = policy.forward(batch)
+    loss.backward()
+    policy.save_pretrained(tmp_path)
+    loaded = MTDAggerPolicy.from_pretrained(tmp_path).eval()
+    with torch.no_grad():
+        expected = policy.eval().predict(batch, task_index=batch["task_index"])
+        torch.testing.assert_close(loaded.predict(batch, task_index=batch["task_index"]), expected)
+
+
+def test_pointnet_trains_through_the_winners_and_infers_densely(monkeypatch):
+    from lerobot_mtdagger.policies.mtdagger import modeling_mtdagger
+
+    calls = []
+    original = modeling_mtdagger.max_pool_of_winners
+    monkeypatch.setattr(
+        modeling_mtdagger, "max_pool_of_winners", lambda *args: calls.append(1) or original(*args)
+    )
+    inputs = MODALITIES["state+pointcloud"]
+    policy = MTDAggerPolicy(make_config(inputs))
+    batch = make_batch(inputs)
+    loss, _ = policy.forward(batch)
+    loss.backward()
+    assert calls == [1]
+    with torch.no_grad():
+        policy.predict(batch, task_index=batch["task_index"])
+    assert calls == [1]
 
 
 def test_per_task_loss_equals_hand_computed_means():

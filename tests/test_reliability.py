@@ -251,10 +251,13 @@ def test_a_run_made_before_an_option_existed_resumes_with_its_default(finished, 
     shutil.copytree(finished, copy)
     stored = json.loads((copy / "config.json").read_text())
     older = {k: v for k, v in stored.items() if not k.startswith("plateau_")}  # options added later
+    older["policy"] = {k: v for k, v in stored["policy"].items() if not k.startswith("pointnet_layer")}
     (copy / "config.json").write_text(json.dumps(older))
     assert run(toy_config(copy, "--rounds=1", "--resume=true")), "resumed: nothing to do"
     with pytest.raises(UserError, match=r"different config \(plateau_every: None -> 7\)"):
         run(toy_config(copy, "--rounds=1", "--resume=true", "--plateau_every=7"))
+    with pytest.raises(UserError, match=r"different config \(policy: .*'pointnet_layer_norm': True"):
+        run(toy_config(copy, "--rounds=1", "--resume=true", "--policy.pointnet_layer_norm=true"))
 
 
 def test_a_drawer_run_made_before_placements_existed_resumes_only_with_the_narrow_one(finished, tmp_path):

@@ -43,6 +43,9 @@ class MTDAggerConfig(PreTrainedConfig):
         image_embedding_dim: Output size of the image encoder.
         pointnet_dims: Sizes of PointNet's shared per-point MLP; the last is the max-pooled feature size.
         pointcloud_embedding_dim: Output size of the point-cloud encoder (after the max-pool projection).
+        pointnet_layer_norm: LayerNorm after every per-point layer and after the projection, as DP3's
+            encoder (``pointnet_dims=(64, 128, 256)``, ``pointcloud_embedding_dim=64``: about 59 k
+            parameters); without it, ReLU between the layers and before the projection.
         head_hidden_dims: Hidden layer sizes of the action head.
         dropout: Dropout in the action head.
         task_dropout: Probability, per training sample, of replacing its task embedding by one shared
@@ -67,6 +70,7 @@ class MTDAggerConfig(PreTrainedConfig):
     image_embedding_dim: int = 128
     pointnet_dims: tuple[int, ...] = (64, 128, 256)
     pointcloud_embedding_dim: int = 256
+    pointnet_layer_norm: bool = False
     head_hidden_dims: tuple[int, ...] = (256, 256)
     dropout: float = 0.0
     task_dropout: float = 0.0
