@@ -30,13 +30,14 @@ import time
 
 import numpy as np
 
-from lerobot_mtdagger.collect import COLLECT_STREAM, run_episodes
+from lerobot_mtdagger.collect import run_episodes
 from lerobot_mtdagger.configs import PolicyOptions
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.metaworld import _make_raw_env
 from lerobot_mtdagger.evaluate import PolicyRunner, evaluate
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.records import EXECUTED_ACTION
+from lerobot_mtdagger.seeds import COLLECT_STREAM
 from lerobot_mtdagger.train import build_processors, policy_config
 from lerobot_mtdagger.workers import EnvWorkers
 

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lerobot_mtdagger.seeds import BETA_STREAM, EVAL_STREAM, stream_seed
 from lerobot_mtdagger.workers import (
-    BETA_STREAM,
     EnvWorkers,
     Episode,
     EpisodeSpec,
@@ -40,8 +40,6 @@ from lerobot_mtdagger.workers import (
 
 logger = logging.getLogger(__name__)
 
-COLLECT_STREAM = 0
-EVAL_STREAM = 1
 LANE_GROUPS = 2
 
 PolicyFn = Callable[[list[dict[str, np.ndarray]], list[str]], np.ndarray]
@@ -50,7 +48,7 @@ PolicyFn = Callable[[list[dict[str, np.ndarray]], list[str]], np.ndarray]
 
 def episode_seed(seed: int, stream: int, round_index: int, task_index: int, episode: int) -> int:
     """Reset seed of one episode; collection and evaluation seeds lie in disjoint ranges."""
-    value = int(np.random.SeedSequence([seed, stream, round_index, task_index, episode]).generate_state(1)[0])
+    value = stream_seed(seed, stream, round_index, task_index, episode)
     value %= 2**31
     return value + (2**31 if stream == EVAL_STREAM else 0)
 

@@ -50,7 +50,6 @@ import torch
 from tqdm import tqdm
 
 from lerobot_mtdagger.collect import (
-    COLLECT_STREAM,
     Episode,
     learner_success_by_task,
     run_episodes,
@@ -66,6 +65,7 @@ from lerobot_mtdagger.quiet import quiet_third_party
 from lerobot_mtdagger.records import PhaseRecord, RoundRecord, round_features
 from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
+from lerobot_mtdagger.seeds import COLLECT_STREAM, TRAINING_STREAM, stream_seed
 from lerobot_mtdagger.train import (
     EPISODE_ID_STRIDE,
     FrameSplit,
@@ -304,7 +304,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     input_keys = list(policy_cfg.input_features)
     image_keys = [k for k in input_keys if k.startswith(IMAGE_KEY)]
     data = rounds_in_memory(ctx, round_index, input_keys)
-    phase_seed = int(np.random.SeedSequence([config.seed, 3, round_index]).generate_state(1)[0])
+    phase_seed = stream_seed(config.seed, TRAINING_STREAM, round_index)
     split = split_frames(
         data, config.gain_split, config.heldout_fraction, config.seed, hold_out=config.steps_rule == "plateau"
     )

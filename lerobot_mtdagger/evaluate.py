@@ -17,10 +17,11 @@ import torch
 from lerobot.policies.factory import make_pre_post_processors
 
 from lerobot_mtdagger.checkpoints import check_hub_policy, check_policy_folder, check_policy_path
-from lerobot_mtdagger.collect import EVAL_STREAM, PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.collect import PolicyFn, run_episodes, success_by_task
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.quiet import quiet_third_party
+from lerobot_mtdagger.seeds import EVAL_STREAM
 from lerobot_mtdagger.workers import EnvWorkers, Episode
 
 

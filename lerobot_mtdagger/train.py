@@ -36,6 +36,7 @@ from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
 from lerobot_mtdagger.sampling import systematic_picks
+from lerobot_mtdagger.seeds import HELDOUT_STREAM
 
 logger = logging.getLogger(__name__)
 
@@ -49,9 +50,6 @@ FINAL_LOSSES = 10
 
 EPISODE_ID_STRIDE = 1_000_000
 """``episode_id = episode_index + round_position * EPISODE_ID_STRIDE``."""
-
-HELDOUT_STREAM = 7
-"""Seed stream of the held-out episode choice (``heldout_episodes``)."""
 
 
 @dataclass

@@ -43,8 +43,6 @@ from lerobot_mtdagger.sampling import systematic_picks
 
 logger = logging.getLogger(__name__)
 
-BETA_STREAM = 2
-
 
 @contextlib.contextmanager
 def limited_torch_threads(threads: int | None) -> Iterator[None]:

@@ -21,13 +21,14 @@ import numpy as np
 import pytest
 import torch
 
-from lerobot_mtdagger.collect import COLLECT_STREAM, learner_success_by_task, run_episodes, success_by_task
+from lerobot_mtdagger.collect import learner_success_by_task, run_episodes, success_by_task
 from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.evaluate import PolicyRunner
 from lerobot_mtdagger.rounds import ExperimentDir
+from lerobot_mtdagger.seeds import BETA_STREAM, COLLECT_STREAM
 from lerobot_mtdagger.train import (
     EPISODE_ID_STRIDE,
     NormalisedData,
@@ -41,7 +42,7 @@ from lerobot_mtdagger.train import (
     performance_gain,
     split_frames,
 )
-from lerobot_mtdagger.workers import BETA_STREAM, EnvWorkers, expert_episode_coin
+from lerobot_mtdagger.workers import EnvWorkers, expert_episode_coin
 from tests.test_toy import TOY_RUN
 from tests.test_train import normalised, small_policy, synthetic_data
 

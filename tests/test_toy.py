@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import torch
 
-from lerobot_mtdagger.collect import COLLECT_STREAM, EVAL_STREAM, episode_seed, run_episodes, success_by_task
+from lerobot_mtdagger.collect import episode_seed, run_episodes, success_by_task
 from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.envs import make_suite
@@ -20,6 +20,7 @@ from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.records import DAGGER_ROUND, EXECUTED_ACTION, LEARNER_ACTED, RoundRecord, round_features
 from lerobot_mtdagger.rounds import STAGING_DIR, ExperimentDir
 from lerobot_mtdagger.scheduler import scheduling_methods
+from lerobot_mtdagger.seeds import COLLECT_STREAM, EVAL_STREAM
 from lerobot_mtdagger.train import LOSS_SAMPLES_PER_TASK, TrainingData, split_frames
 from lerobot_mtdagger.verify import verify_experiment
 from lerobot_mtdagger.workers import EnvWorkers

@@ -15,10 +15,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.collect import COLLECT_STREAM, run_episodes
+from lerobot_mtdagger.collect import run_episodes
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.records import EXECUTED_ACTION, LEARNER_ACTED
+from lerobot_mtdagger.seeds import COLLECT_STREAM
 from lerobot_mtdagger.workers import EnvWorkers
 
 DRAWERS = ["drawer-bar-wide", "drawer-knob-small", "drawer-lip-shallow"]

@@ -10,13 +10,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lerobot_mtdagger.collect import COLLECT_STREAM, run_episodes
+from lerobot_mtdagger.collect import run_episodes
 from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.evaluate import evaluate
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.rounds import ExperimentDir
+from lerobot_mtdagger.seeds import COLLECT_STREAM
 from lerobot_mtdagger.workers import EnvWorkers, RemoteWorkerError, WorkerDiedError
 
 from .test_toy import TOY_RUN

@@ -1,0 +1,32 @@
+"""Every random stream of a run, named in one place.
+
+A run has one seed (``--seed``). Each kind of random choice draws from its own stream, derived with
+numpy's ``SeedSequence`` from ``(seed, stream, *keys)``, so drawing more from one stream (more
+rounds, tasks or episodes) never shifts another.
+
+Streams (number; the keys after it; what it decides):
+
+- ``COLLECT_STREAM`` (0; round, task, episode): the env reset of a collected episode (``episode_seed``).
+- ``EVAL_STREAM`` (1; round, task, episode): the env reset of an evaluation episode (offset by 2**31).
+- ``BETA_STREAM`` (2; round, task, episode): who acts in an episode of a mixed DAgger round.
+- ``TRAINING_STREAM`` (3; round): a phase's initial weights and batch order.
+- ``HELDOUT_STREAM`` (7; task): which episodes a run holds out of training.
+
+The frames each phase measures its per-task loss on are drawn from ``np.random.default_rng(seed)``
+itself (``train.split_frames``), as every run since the first did.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+COLLECT_STREAM = 0
+EVAL_STREAM = 1
+BETA_STREAM = 2
+TRAINING_STREAM = 3
+HELDOUT_STREAM = 7
+
+
+def stream_seed(seed: int, stream: int, *keys: int) -> int:
+    """A 32-bit seed of ``stream`` for ``keys`` (e.g. a round index), derived from the run's seed."""
+    return int(np.random.SeedSequence([seed, stream, *keys]).generate_state(1)[0])
