@@ -18,8 +18,7 @@ from collections import Counter, defaultdict
 
 import numpy as np
 
-from lerobot_mtdagger.collect import episode_seed
-from lerobot_mtdagger.seeds import EVAL_STREAM
+from lerobot_mtdagger.collect import EVAL_STREAM, episode_seed
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.drawers import STATE_INDEX
 from lerobot_mtdagger.evaluate import PolicyRunner
