@@ -41,6 +41,7 @@ from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
 from lerobot_mtdagger.train import (
     LOG_INTERVAL,
     NormalisedData,
+    StepOptions,
     TrainingData,
     build_processors,
     compute_stats,
@@ -122,10 +123,7 @@ def ours(data: NormalisedData, steps: int, seed: int) -> tuple[float, float]:
         data,
         train_index,
         loss_index,
-        steps=steps,
-        batch_size=BATCH_SIZE,
-        lr=LR,
-        seed=seed,
+        StepOptions(steps=steps, batch_size=BATCH_SIZE, lr=LR, seed=seed),
         on_step=lambda done, loss: marks.append((done, time.perf_counter())),
     )
     end = time.perf_counter()

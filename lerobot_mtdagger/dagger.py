@@ -46,7 +46,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import torch
 from tqdm import tqdm
 
 from lerobot_mtdagger.collect import (
@@ -56,33 +55,16 @@ from lerobot_mtdagger.collect import (
     success_by_task,
 )
 from lerobot_mtdagger.configs import RunConfig
-from lerobot_mtdagger.envs import IMAGE_KEY, suite_from_config
+from lerobot_mtdagger.envs import suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.evaluate import EvalResult, PolicyRunner, evaluate
-from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.quiet import quiet_third_party
-from lerobot_mtdagger.records import PhaseRecord, RoundRecord, round_features
+from lerobot_mtdagger.records import RoundRecord, round_features
 from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
-from lerobot_mtdagger.seeds import COLLECT_STREAM, TRAINING_STREAM, stream_seed
-from lerobot_mtdagger.train import (
-    EPISODE_ID_STRIDE,
-    FrameSplit,
-    NormalisedData,
-    PlateauStop,
-    TrainingData,
-    build_processors,
-    compute_stats,
-    heldout_mask,
-    load_round,
-    per_task_loss_of,
-    performance_gain,
-    policy_config,
-    save_policy,
-    split_frames,
-    train_phase,
-)
+from lerobot_mtdagger.seeds import COLLECT_STREAM
+from lerobot_mtdagger.train import RoundCache, check_heldout, student_config, train_on_rounds
 from lerobot_mtdagger.workers import EnvWorkers
 
 logger = logging.getLogger(__name__)
@@ -99,7 +81,7 @@ class RunContext:
     show_progress: bool
     heldout_suite: TaskSuite | None = None
     timings: dict[int, dict[str, float]] = field(default_factory=dict)
-    rounds_in_memory: list[TrainingData] = field(default_factory=list)
+    rounds: RoundCache = field(default_factory=RoundCache)
 
     @property
     def task_names(self) -> list[str]:
@@ -294,109 +276,41 @@ def round_record(
 
 
 def train_round(ctx: RunContext, round_index: int) -> None:
-    """Trains on D(round_index), evaluates and commits the phase."""
-    config = ctx.config
+    """Trains on D(round_index), evaluates the student on the training and the unseen tasks, commits."""
     start = time.perf_counter()
-    task_dropout = config.policy.resolved_task_dropout(bool(ctx.suite.heldout_task_names))
-    policy_cfg = policy_config(
-        ctx.suite.features, ctx.task_names, config.policy, config.policy.device, task_dropout
-    )
-    input_keys = list(policy_cfg.input_features)
-    image_keys = [k for k in input_keys if k.startswith(IMAGE_KEY)]
-    data = rounds_in_memory(ctx, round_index, input_keys)
-    phase_seed = stream_seed(config.seed, TRAINING_STREAM, round_index)
-    split = split_frames(
-        data, config.gain_split, config.heldout_fraction, config.seed, hold_out=config.steps_rule == "plateau"
-    )
-    stats = compute_stats(data.subset(normalisation_frames(config, data, split.train)), image_keys)
-    torch.manual_seed(phase_seed)
-    policy = MTDAggerPolicy(policy_cfg)
-    previous = None
-    if round_index > 0:
-        with quiet_third_party():  # LeRobot prints "Loading weights from local directory"
-            previous = PolicyRunner.from_pretrained(
-                ctx.experiment.policy_root(round_index - 1), config.policy.device
-            )
-        if config.warm_start:
-            policy.load_state_dict(previous.policy.state_dict())
-    preprocessor, postprocessor = build_processors(policy_cfg, stats)
-    normalised = NormalisedData(data, preprocessor, image_keys, ctx.task_names)
-    loss_previous = None
-    if previous is not None:
-        loss_previous = per_task_loss_of(previous.predict, normalised, split.loss, len(ctx.task_names))
-    steps = config.phase_steps(len(split.train))
+    unseen = bool(ctx.suite.heldout_task_names)
+    policy_cfg = student_config(ctx.config, ctx.suite.features, ctx.task_names, unseen)
+    roots = [ctx.experiment.round_root(k) for k in range(round_index + 1)]
+    data = ctx.rounds.load(roots, list(policy_cfg.input_features))
+    previous = ctx.experiment.policy_root(round_index - 1) if round_index > 0 else None
     loaded = time.perf_counter()
-    with tqdm(
-        total=steps, desc=f"round {round_index} train", leave=False, disable=not ctx.show_progress
-    ) as bar:
-        result = train_phase(
-            policy,
-            normalised,
-            split.train,
-            split.loss,
-            steps=steps,
-            batch_size=config.policy.batch_size,
-            lr=config.policy.lr,
-            seed=phase_seed,
-            on_step=lambda done, loss: bar.update(done - bar.n),
-            sampling=config.sampling,
-            plateau=plateau_stop(config, split),
-        )
-    trained = time.perf_counter()
+    trained = train_on_rounds(ctx.config, policy_cfg, data, round_index, previous, ctx.show_progress)
+    trained_at = time.perf_counter()
     staging = ctx.experiment.staging_policy_root(round_index)
-    save_policy(policy, preprocessor, postprocessor, staging)
-    runner = PolicyRunner(policy, preprocessor, postprocessor)
-    eval_result = evaluate_phase(ctx, runner, ctx.workers)
-    heldout_result = None
-    if ctx.heldout_suite is not None:
-        # Workers of their own, only while they evaluate: each holds its drawers' envs and renderers.
-        with EnvWorkers(ctx.heldout_suite, ctx.config.worker_count) as heldout_workers:
-            heldout_result = evaluate_phase(ctx, runner, heldout_workers)
-    evaluated = time.perf_counter()
-    demos = ctx.experiment.read_round_record(round_index).demos_so_far
-    timing = {"load_s": loaded - start, "train_s": trained - loaded, "eval_s": evaluated - trained}
-    ctx.timings.setdefault(round_index, {}).update(timing)
-    record = PhaseRecord(
-        round=round_index,
-        trained_on_rounds=list(range(round_index + 1)),
-        frames=len(data),
-        steps=result.steps,
-        gain_split=config.gain_split,
-        loss_start=result.loss_start,
-        loss_end=result.loss_end,
-        gain=None if loss_previous is None else performance_gain(loss_previous, result.loss_end),
-        loss_previous=loss_previous,
-        loss_samples=result.loss_samples,
-        final_train_loss=result.train_loss,
-        eval=None if eval_result is None else eval_result.to_dict(),
-        heldout_eval=None if heldout_result is None else heldout_result.to_dict(),
-        demos_per_task=demos,
-        timings=ctx.timings[round_index],
-        best_step=result.best_step,
-        heldout_loss=result.heldout_loss,
+    trained.save(staging)
+    evaluations = evaluate_student(
+        ctx, PolicyRunner(trained.policy, trained.preprocessor, trained.postprocessor)
     )
+    timing = {
+        "load_s": loaded - start + trained.prepare_s,
+        "train_s": trained.train_s,
+        "eval_s": time.perf_counter() - trained_at,
+    }
+    ctx.timings.setdefault(round_index, {}).update(timing)
+    demos = ctx.experiment.read_round_record(round_index).demos_so_far
+    record = trained.record(round_index, ctx.config.gain_split, demos, ctx.timings[round_index])
+    record.eval, record.heldout_eval = evaluations
     ctx.experiment.commit_phase(round_index, staging, record)
 
 
-def plateau_stop(config: RunConfig, split: FrameSplit) -> PlateauStop | None:
-    """The phase's plateau stop on the held-out frames (``steps_rule=plateau``), or None."""
-    if config.steps_rule != "plateau":
-        return None
-    return PlateauStop(index=split.heldout, every=config.plateau_every, patience=config.plateau_patience)
-
-
-def normalisation_frames(config: RunConfig, data: TrainingData, train_index: torch.Tensor) -> torch.Tensor:
-    """The training frames the normalisation statistics come from: round 0's (``fixed``) or all."""
-    if config.normalisation == "recompute":
-        return train_index
-    return train_index[data.episode_id[train_index] < EPISODE_ID_STRIDE]
-
-
-def rounds_in_memory(ctx: RunContext, round_index: int, input_keys: list[str]) -> TrainingData:
-    """D(round_index) in memory: rounds loaded earlier in this run are kept, only new ones are read."""
-    for k in range(len(ctx.rounds_in_memory), round_index + 1):
-        ctx.rounds_in_memory.append(load_round(ctx.experiment.round_root(k), k, input_keys))
-    return TrainingData.concat(ctx.rounds_in_memory[: round_index + 1])
+def evaluate_student(ctx: RunContext, runner: PolicyRunner) -> tuple[dict | None, dict | None]:
+    """``EvalResult.to_dict()`` on the training tasks and on the unseen ones (None: not evaluated)."""
+    results = [evaluate_phase(ctx, runner, ctx.workers), None]
+    if ctx.heldout_suite is not None:
+        # Workers of their own, only while they evaluate: each holds its drawers' envs and renderers.
+        with EnvWorkers(ctx.heldout_suite, ctx.config.worker_count) as heldout_workers:
+            results[1] = evaluate_phase(ctx, runner, heldout_workers)
+    return tuple(None if result is None else result.to_dict() for result in results)
 
 
 def evaluate_phase(ctx: RunContext, runner: PolicyRunner, workers: EnvWorkers) -> EvalResult | None:
@@ -451,24 +365,6 @@ def check_budget(config: RunConfig, num_tasks: int) -> None:
         raise UserError(
             f"budget={budget} is smaller than n_min * num_tasks = {n_min} * {num_tasks} = "
             f"{n_min * num_tasks}: raise --budget to at least {n_min * num_tasks} or lower --scheduler.n_min."
-        )
-
-
-def check_heldout(config: RunConfig, num_tasks: int) -> None:
-    """Refuses ``steps_rule=plateau`` when round 0 would hold no episode out, before anything runs.
-
-    Raises:
-        UserError: With the numbers and the fix.
-    """
-    if config.steps_rule != "plateau":
-        return
-    fraction, demos = config.heldout_fraction, config.initial_demos
-    if not any(heldout_mask(demos, fraction, config.seed, task).any() for task in range(num_tasks)):
-        raise UserError(
-            f"--steps_rule=plateau needs held-out episodes, and round 0 would hold none out: a task's "
-            f"first episode is always trained on, and --heldout_fraction={config.heldout_fraction} of the "
-            f"other {config.initial_demos - 1} per task gives none. Raise --heldout_fraction or "
-            "--initial_demos, or choose --steps_rule=fixed or epochs."
         )
 
 

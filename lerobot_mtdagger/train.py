@@ -20,6 +20,7 @@ import io
 import json
 import logging
 import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,12 +32,16 @@ import pyarrow.parquet as pq
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.datasets.utils import dataset_to_policy_features
+from tqdm import tqdm
 
+from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.evaluate import PolicyRunner
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
+from lerobot_mtdagger.records import PhaseRecord
 from lerobot_mtdagger.sampling import systematic_picks
-from lerobot_mtdagger.seeds import HELDOUT_STREAM
+from lerobot_mtdagger.seeds import HELDOUT_STREAM, TRAINING_STREAM, stream_seed
 
 logger = logging.getLogger(__name__)
 
@@ -525,22 +530,39 @@ class _LossWindow:
             self.on_step(steps_done, float(losses.double().mean()))
 
 
+@dataclass(frozen=True)
+class StepOptions:
+    """How a training phase steps.
+
+    Attributes:
+        steps: Optimiser steps (the cap, with ``plateau``).
+        batch_size: Frames per step (capped at the number of training frames).
+        lr: AdamW learning rate.
+        seed: Seed of the batch sampling.
+        sampling: ``uniform`` over frames or ``balanced`` over tasks.
+        plateau: End the phase when the held-out loss stops improving and keep the weights of its
+            minimum (None: train all ``steps``).
+        log_interval: Steps between two reads of the loss.
+    """
+
+    steps: int
+    batch_size: int
+    lr: float
+    seed: int
+    sampling: str = "uniform"
+    plateau: PlateauStop | None = None
+    log_interval: int = LOG_INTERVAL
+
+
 def train_phase(
     policy: MTDAggerPolicy,
     data: NormalisedData,
     train_index: torch.Tensor,
     loss_index: torch.Tensor,
-    *,
-    steps: int,
-    batch_size: int,
-    lr: float,
-    seed: int,
+    options: StepOptions,
     on_step: Callable[[int, float], None] | None = None,
-    log_interval: int = LOG_INTERVAL,
-    sampling: str = "uniform",
-    plateau: PlateauStop | None = None,
 ) -> PhaseResult:
-    """Trains ``policy`` for ``steps`` AdamW steps (or until a plateau) and measures the per-task loss drop.
+    """Trains ``policy`` for ``options.steps`` steps (or until a plateau); measures the per-task loss drop.
 
     Each step samples ``batch_size`` frames of ``train_index`` with replacement (uniformly, or with
     ``sampling="balanced"`` a task uniformly and then one of its frames uniformly) and takes
@@ -556,17 +578,10 @@ def train_phase(
         data: The normalised frames.
         train_index: Frames to train on.
         loss_index: Frames the per-task loss is measured on, before and after.
-        steps: Optimiser steps (the cap, with ``plateau``).
-        batch_size: Frames per step (capped at ``len(train_index)``).
-        lr: AdamW learning rate.
-        seed: Seed of the batch sampling.
+        options: Steps, batch size, learning rate, sampling seed and rule, plateau stop.
         on_step: Progress callback, called every ``log_interval`` steps and after the last step as
             ``on_step(steps_done, mean_loss)``: the number of steps completed so far (1..steps) and the
             mean training loss over the steps since the previous call.
-        log_interval: Steps between two reads of the loss.
-        sampling: ``uniform`` over frames or ``balanced`` over tasks.
-        plateau: End the phase when the held-out loss stops improving and keep the weights of its
-            minimum (None: train all ``steps``).
 
     Returns:
         The per-task losses at the start and at the end, the gain, the last FINAL_LOSSES step
@@ -577,15 +592,16 @@ def train_phase(
             ``sampling`` is unknown or ``plateau`` has no held-out frame.
         FloatingPointError: If the loss becomes NaN or infinite (nothing is committed then).
     """
+    steps, log_interval, plateau = options.steps, options.log_interval, options.plateau
     _check_phase_inputs(policy, data, log_interval, plateau)
     num_tasks = len(data.task_names)
     loss_start, _ = per_task_loss(policy, data, loss_index, num_tasks)
-    generator = torch.Generator().manual_seed(seed)
-    draw = batch_sampler(train_index, data.data.task_index, sampling, generator)
-    optimizer = make_optimizer(policy, lr)
+    generator = torch.Generator().manual_seed(options.seed)
+    draw = batch_sampler(train_index, data.data.task_index, options.sampling, generator)
+    optimizer = make_optimizer(policy, options.lr)
     parameters = [p for p in policy.parameters() if p.requires_grad]
     clip_norm = policy.config.optimizer_grad_clip_norm
-    size = min(batch_size, len(train_index))
+    size = min(options.batch_size, len(train_index))
     tracker = None if plateau is None else _PlateauTracker(plateau, policy, data)
     stopped = tracker is not None and tracker.measure(0)
     policy.train()
@@ -706,3 +722,194 @@ def save_policy(policy: MTDAggerPolicy, preprocessor: Any, postprocessor: Any, f
 def build_processors(config: MTDAggerConfig, stats: dict[str, dict[str, np.ndarray]]) -> tuple[Any, Any]:
     """The policy's LeRobot pre- and post-processors for ``stats``."""
     return make_mtdagger_pre_post_processors(config, dataset_stats=stats)
+
+
+# -------------------------------------------------------------------------------------------------
+# A run's training phase: D(k) in, a trained student and its per-task losses out
+# -------------------------------------------------------------------------------------------------
+
+
+class RoundCache:
+    """Committed rounds read once per run and kept in memory (committed rounds never change)."""
+
+    def __init__(self) -> None:
+        self.rounds: list[TrainingData] = []
+
+    def load(self, roots: Sequence[Path], input_keys: Sequence[str]) -> TrainingData:
+        """D(k) for the round folders ``roots`` (rounds 0..k in order); only new rounds are read."""
+        for position in range(len(self.rounds), len(roots)):
+            self.rounds.append(load_round(roots[position], position, input_keys))
+        return TrainingData.concat(self.rounds[: len(roots)])
+
+
+def student_config(
+    config: RunConfig, features: dict[str, Any], task_names: Sequence[str], unseen: bool
+) -> MTDAggerConfig:
+    """The student's policy config for a run on a suite's ``features`` (``unseen``: it has held-out tasks)."""
+    task_dropout = config.policy.resolved_task_dropout(unseen)
+    return policy_config(features, task_names, config.policy, config.policy.device, task_dropout)
+
+
+@dataclass
+class TrainedPhase:
+    """A trained student with its processors and what its phase measured.
+
+    Attributes:
+        policy: The trained policy (its weights are the phase's result).
+        preprocessor: Its LeRobot pre-processor (normalisation statistics of the phase's frames).
+        postprocessor: Its post-processor.
+        result: The per-task losses and steps of the phase.
+        loss_previous: The previous phase's policy's per-task loss on this phase's loss frames (None
+            in round 0): the loss performance gain is measured from.
+        frames: Frames of D(k).
+        prepare_s: Seconds spent before the first step (statistics, previous policy, its losses).
+        train_s: Seconds spent training.
+    """
+
+    policy: MTDAggerPolicy
+    preprocessor: Any
+    postprocessor: Any
+    result: PhaseResult
+    loss_previous: list[float | None] | None
+    frames: int
+    prepare_s: float
+    train_s: float
+
+    @property
+    def gain(self) -> list[float] | None:
+        """Performance gain per task against the previous phase's policy (None in round 0)."""
+        if self.loss_previous is None:
+            return None
+        return performance_gain(self.loss_previous, self.result.loss_end)
+
+    def save(self, folder: Path) -> None:
+        """Writes the LeRobot pretrained model folder."""
+        save_policy(self.policy, self.preprocessor, self.postprocessor, folder)
+
+    def record(
+        self, round_index: int, gain_split: str, demos: list[int], timings: dict[str, float]
+    ) -> PhaseRecord:
+        """The phase's record without its evaluations (``eval`` and ``heldout_eval`` are None)."""
+        result = self.result
+        return PhaseRecord(
+            round=round_index,
+            trained_on_rounds=list(range(round_index + 1)),
+            frames=self.frames,
+            steps=result.steps,
+            gain_split=gain_split,
+            loss_start=result.loss_start,
+            loss_end=result.loss_end,
+            gain=self.gain,
+            loss_previous=self.loss_previous,
+            loss_samples=result.loss_samples,
+            final_train_loss=result.train_loss,
+            eval=None,
+            heldout_eval=None,
+            demos_per_task=demos,
+            timings=timings,
+            best_step=result.best_step,
+            heldout_loss=result.heldout_loss,
+        )
+
+
+def train_on_rounds(
+    config: RunConfig,
+    policy_cfg: MTDAggerConfig,
+    data: TrainingData,
+    round_index: int,
+    previous: Path | None,
+    show_progress: bool = False,
+) -> TrainedPhase:
+    """Algorithm 1's "Train Policy" for round ``round_index`` of a run: trains a student on D(k).
+
+    Splits the frames (``split_frames``), normalises them with statistics of the run's rule, builds
+    the student (warm-started from ``previous`` when the run says so), measures the previous
+    policy's per-task loss for performance gain and trains for the run's steps.
+
+    Args:
+        config: The run's config (training options, seed, split and step rules).
+        policy_cfg: The student's config (``student_config``).
+        data: D(k), the frames of rounds 0..k.
+        round_index: k.
+        previous: The folder of round k-1's policy (None in round 0).
+        show_progress: Show a progress bar over the steps.
+    """
+    start = time.perf_counter()
+    image_keys = list(policy_cfg.image_features)
+    phase_seed = stream_seed(config.seed, TRAINING_STREAM, round_index)
+    split = split_frames(
+        data, config.gain_split, config.heldout_fraction, config.seed, hold_out=config.steps_rule == "plateau"
+    )
+    stats = compute_stats(data.subset(normalisation_frames(config, data, split.train)), image_keys)
+    torch.manual_seed(phase_seed)
+    policy = MTDAggerPolicy(policy_cfg)
+    runner = None if previous is None else PolicyRunner.from_pretrained(previous, config.policy.device)
+    if runner is not None and config.warm_start:
+        policy.load_state_dict(runner.policy.state_dict())
+    preprocessor, postprocessor = build_processors(policy_cfg, stats)
+    normalised = NormalisedData(data, preprocessor, image_keys, list(policy_cfg.task_names))
+    loss_previous = None
+    if runner is not None:
+        loss_previous = per_task_loss_of(runner.predict, normalised, split.loss, len(policy_cfg.task_names))
+    options = StepOptions(
+        steps=config.phase_steps(len(split.train)),
+        batch_size=config.policy.batch_size,
+        lr=config.policy.lr,
+        seed=phase_seed,
+        sampling=config.sampling,
+        plateau=plateau_stop(config, split),
+    )
+    prepared = time.perf_counter()
+    with tqdm(
+        total=options.steps, desc=f"round {round_index} train", leave=False, disable=not show_progress
+    ) as bar:
+        result = train_phase(
+            policy,
+            normalised,
+            split.train,
+            split.loss,
+            options,
+            on_step=lambda done, _: bar.update(done - bar.n),
+        )
+    return TrainedPhase(
+        policy=policy,
+        preprocessor=preprocessor,
+        postprocessor=postprocessor,
+        result=result,
+        loss_previous=loss_previous,
+        frames=len(data),
+        prepare_s=prepared - start,
+        train_s=time.perf_counter() - prepared,
+    )
+
+
+def plateau_stop(config: RunConfig, split: FrameSplit) -> PlateauStop | None:
+    """The phase's plateau stop on the held-out frames (``steps_rule=plateau``), or None."""
+    if config.steps_rule != "plateau":
+        return None
+    return PlateauStop(index=split.heldout, every=config.plateau_every, patience=config.plateau_patience)
+
+
+def normalisation_frames(config: RunConfig, data: TrainingData, train_index: torch.Tensor) -> torch.Tensor:
+    """The training frames the normalisation statistics come from: round 0's (``fixed``) or all."""
+    if config.normalisation == "recompute":
+        return train_index
+    return train_index[data.episode_id[train_index] < EPISODE_ID_STRIDE]
+
+
+def check_heldout(config: RunConfig, num_tasks: int) -> None:
+    """Refuses ``steps_rule=plateau`` when round 0 would hold no episode out, before anything runs.
+
+    Raises:
+        UserError: With the numbers and the fix.
+    """
+    if config.steps_rule != "plateau":
+        return
+    fraction, demos = config.heldout_fraction, config.initial_demos
+    if not any(heldout_mask(demos, fraction, config.seed, task).any() for task in range(num_tasks)):
+        raise UserError(
+            f"--steps_rule=plateau needs held-out episodes, and round 0 would hold none out: a task's "
+            f"first episode is always trained on, and --heldout_fraction={config.heldout_fraction} of the "
+            f"other {config.initial_demos - 1} per task gives none. Raise --heldout_fraction or "
+            "--initial_demos, or choose --steps_rule=fixed or epochs."
+        )

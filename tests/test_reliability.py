@@ -228,7 +228,7 @@ def test_a_start_that_fails_after_creation_leaves_a_resumable_folder(tmp_path, m
     def diverge(*args, **kwargs):
         raise FloatingPointError("Training loss became nan at step 3; nothing was committed.")
 
-    monkeypatch.setattr(dagger_module, "train_phase", diverge)
+    monkeypatch.setattr(dagger_module, "train_on_rounds", diverge)
     with pytest.raises(FloatingPointError):
         run(toy_config(output, "--rounds=1"))
     assert (output / "config.json").is_file() and ExperimentDir(output).committed_phases() == []

@@ -149,3 +149,44 @@ def test_every_module_imports_alone_in_a_fresh_process():
         result.stdout + result.stderr
     )
     assert {"lerobot_mtdagger.envs.drawers.variants", "lerobot_mtdagger.experts.drawers"} <= set(modules)
+
+
+WIDE_FUNCTIONS = {"collect.run_episodes", "envs.make_suite"}
+"""Functions still taking more than MAX_PARAMETERS (the composed-config work folds them); none may join."""
+
+MAX_PARAMETERS = 8
+
+
+def parameter_counts() -> dict[str, int]:
+    """Parameters of every function of the package (``self``/``cls`` not counted), by ``module.name``."""
+    counts = {}
+    for name in package_modules():
+        short = name.removeprefix("lerobot_mtdagger").lstrip(".") or "__init__"
+        for node in ast.walk(ast.parse(module_path(name).read_text())):
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                args = node.args
+                named = [*args.posonlyargs, *args.args, *args.kwonlyargs]
+                count = len(named) + (args.vararg is not None) + (args.kwarg is not None)
+                if named and named[0].arg in ("self", "cls"):
+                    count -= 1
+                counts[f"{short}.{node.name}"] = max(count, counts.get(f"{short}.{node.name}", 0))
+    return counts
+
+
+def test_no_function_takes_more_than_eight_parameters():
+    wide = {name for name, count in parameter_counts().items() if count > MAX_PARAMETERS}
+    assert wide == WIDE_FUNCTIONS, "fold options into a dataclass; update WIDE_FUNCTIONS when one is fixed"
+
+
+def test_the_dagger_loop_hands_each_training_phase_to_train():
+    """``dagger.train_round`` is short and takes at most four names from ``train``."""
+    tree = ast.parse(module_path("lerobot_mtdagger.dagger").read_text())
+    from_train = [
+        alias.name
+        for node in tree.body
+        if isinstance(node, ast.ImportFrom) and node.module == "lerobot_mtdagger.train"
+        for alias in node.names
+    ]
+    assert len(from_train) <= 4, from_train
+    (train_round,) = [n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == "train_round"]
+    assert train_round.end_lineno - train_round.lineno + 1 <= 30

@@ -16,6 +16,7 @@ from lerobot_mtdagger.train import (
     EPISODE_ID_STRIDE,
     NormalisedData,
     PlateauStop,
+    StepOptions,
     TrainingData,
     build_processors,
     compute_stats,
@@ -76,12 +77,8 @@ def train(seed: int = 0, steps: int = 40, log_interval: int = 100, on_step=None)
         normalised(data, policy),
         torch.arange(len(data)),
         torch.arange(0, len(data), 3),
-        steps=steps,
-        batch_size=64,
-        lr=1e-3,
-        seed=seed,
+        StepOptions(steps=steps, batch_size=64, lr=1e-3, seed=seed, log_interval=log_interval),
         on_step=on_step,
-        log_interval=log_interval,
     )
     return policy, result
 
@@ -308,12 +305,14 @@ def plateau_train(held_out_sign: float, steps: int, log_interval: int = 100, hel
         prepared,
         torch.arange(450),
         torch.arange(0, 450, 3),
-        steps=steps,
-        batch_size=64,
-        lr=1e-3,
-        seed=0,
-        log_interval=log_interval,
-        plateau=PlateauStop(index=held_out, every=20, patience=3),
+        StepOptions(
+            steps=steps,
+            batch_size=64,
+            lr=1e-3,
+            seed=0,
+            log_interval=log_interval,
+            plateau=PlateauStop(index=held_out, every=20, patience=3),
+        ),
     )
     return policy, prepared, result
 
@@ -356,8 +355,5 @@ def test_a_policy_with_another_task_vocabulary_is_refused():
             normalised_data,
             torch.arange(10),
             torch.arange(10),
-            steps=1,
-            batch_size=4,
-            lr=1e-3,
-            seed=0,
+            StepOptions(steps=1, batch_size=4, lr=1e-3, seed=0),
         )
