@@ -9,6 +9,8 @@ actions (``np.random.default_rng(0).uniform(-1, 1, (n, 4))``, float32):
 - ``rgb``: our env in ``rgb`` mode, 84 x 84 pixels;
 - ``pointcloud``: our env in ``pointcloud`` mode, 1024 points from the two default depth cameras;
 - ``pointcloud-1cam`` (reference line): the same with ``pointcloud_cameras=("corner",)``.
+- ``rgb-simple`` and ``pointcloud-simple`` (reference lines): ``rgb`` and ``pointcloud`` rendered with
+  ``mesh_detail=0.2`` (the arm's visual meshes simplified to a fifth of their faces).
 
 Only the step calls are timed (env construction and resets are not). The machine may be noisy, so
 the modes are interleaved: for each task, every mode is measured back to back, and the whole sweep
@@ -20,6 +22,9 @@ Targets checked (PASS/FAIL printed at the end):
 
 - state mode within 10% of raw MetaWorld: paired ratio to raw >= 0.9;
 - point-cloud mode (1024 points, 2 cameras) >= 50 steps/s per core.
+- (the visual-speed issue) point-cloud steps/s at least 0.25x and RGB at least 0.1x the state
+  mode's, per core; printed for the exact and the simplified render.
+
 """
 
 from __future__ import annotations
@@ -40,8 +45,11 @@ DEFAULT_TASKS = {
     "metaworld-mt10": ["reach-v3", "push-v3", "door-open-v3", "drawer-open-v3"],
     "drawers": ["drawer-bar-wide", "drawer-knob-large", "drawer-lip-wide", "drawer-kitchen"],
 }
-MODES = ["raw", "state", "rgb", "pointcloud", "pointcloud-1cam"]
-RENDER_MODES = {"rgb", "pointcloud", "pointcloud-1cam"}
+MESH_DETAIL = 0.2
+MODES = ["raw", "state", "rgb", "pointcloud", "pointcloud-1cam", "rgb-simple", "pointcloud-simple"]
+RENDER_MODES = {"rgb", "pointcloud", "pointcloud-1cam", "rgb-simple", "pointcloud-simple"}
+STEP_TARGETS = {"pointcloud": 0.25, "rgb": 0.1}
+"""The visual-speed issue's targets: steps/s of a mode over the state mode's, per core."""
 STATE_TARGET_RATIO = 0.9
 POINTCLOUD_TARGET_RATE = 50.0
 
@@ -70,14 +78,20 @@ def time_raw(suite: str, task: str, actions: np.ndarray) -> float:
 
 
 def make_env(suite_name: str, task: str, mode: str, num_points: int, image_size: int):
-    """Our env of ``task`` in ``mode`` (``pointcloud-1cam`` is point-cloud mode with one camera)."""
+    """Our env of ``task`` in ``mode``.
+
+    ``pointcloud-1cam`` is point-cloud mode with one camera; ``-simple`` modes render with
+    ``mesh_detail=MESH_DETAIL`` (the arm's meshes simplified).
+    """
     obs_mode, cameras = ("pointcloud", ("corner",)) if mode == "pointcloud-1cam" else (mode, None)
+    detail = MESH_DETAIL if mode.endswith("-simple") else 1.0
     suite = make_suite(
         suite_name,
-        obs_mode=obs_mode,
+        obs_mode=obs_mode.removesuffix("-simple"),
         num_points=num_points,
         image_size=image_size,
         pointcloud_cameras=cameras,
+        mesh_detail=detail,
     )
     return suite.make_env(task, seed=0)
 
@@ -144,6 +158,12 @@ def print_table(summary, num_points: int, image_size: int) -> None:
         f"Reference: pointcloud {num_points} pts, 1 cam (corner): {rate:.1f} steps/s per core "
         f"(ratio to raw {ratio:.3f}, {steps} steps)"
     )
+    for mode in ("rgb-simple", "pointcloud-simple"):
+        steps, rate, ratio = summary[mode]
+        print(
+            f"Reference: {mode.removesuffix('-simple')} with mesh_detail={MESH_DETAIL}: {rate:.1f} steps/s "
+            f"per core (ratio to raw {ratio:.3f}, {steps} steps)"
+        )
 
 
 def print_targets(summary) -> bool:
@@ -159,6 +179,12 @@ def print_targets(summary) -> bool:
         f"{'PASS' if cloud_ok else 'FAIL'}: pointcloud mode {cloud_rate:.1f} steps/s per core "
         f">= {POINTCLOUD_TARGET_RATE:.0f}"
     )
+    state_rate = summary["state"][1]
+    for mode, target in STEP_TARGETS.items():
+        for variant in (mode, f"{mode}-simple"):
+            share = summary[variant][1] / state_rate
+            verdict = "PASS" if share >= target else "FAIL"
+            print(f"{verdict}: {variant} steps/s / state steps/s = {share:.3f} (target >= {target})")
     return state_ok and cloud_ok
 
 

@@ -199,6 +199,9 @@ class RunConfig:
         steps_after_success: Steps recorded after the first success before an episode ends.
         num_points: Points per cloud (pointcloud mode).
         image_size: Image side (rgb mode).
+        mesh_detail: Share of the faces of the arm's meshes the observation renderer keeps, in (0, 1]
+            (rgb and pointcloud modes; 1: the exact model). 0.2 renders about twice as fast on a CPU
+            and changes only the arm's silhouette by millimetres (``docs/benchmarks.md``).
         placement: ``drawers`` suite only: how resets move and recolour the drawers (``kitchen``
             when None, stored as such; ``narrow``: the suite's first ranges, which runs made before
             this option existed used). Refused for other suites.
@@ -245,6 +248,7 @@ class RunConfig:
     steps_after_success: int = 10
     num_points: int = 1024
     image_size: int = 84
+    mesh_detail: float = 1.0
     placement: str | None = None
     policy: PolicyOptions = field(default_factory=PolicyOptions)
     output_dir: Path | None = None

@@ -153,6 +153,56 @@ def test_point_cloud_follows_the_arm():
     env.close()
 
 
+def test_a_simplified_render_model_differs_only_on_the_meshes_it_simplified():
+    """``mesh_detail`` renders the arm with fewer faces: every other pixel's depth stays exact."""
+    import mujoco
+
+    from lerobot_mtdagger.envs.rendering import MIN_FACES_TO_SIMPLIFY, simplified_model
+
+    env = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=64).make_env("push-v3", seed=0)
+    env.reset()
+    for _ in range(10):
+        env.step(np.array([0.5, 0.5, -0.5, 0.0]))
+    model, data = env.unwrapped._env.model, env.unwrapped._env.data
+    faces = model.mesh_facenum.sum()
+    simple = simplified_model(model, 0.2)
+    assert model.mesh_facenum.sum() == faces, "the physics model is not modified"
+    assert simple.mesh_facenum.sum() < 0.3 * faces
+    big = [i for i in range(model.nmesh) if model.mesh_facenum[i] >= MIN_FACES_TO_SIMPLIFY]
+    simplified_geoms = [g for g in range(model.ngeom) if model.geom_dataid[g] in big]
+
+    def frames(render_model):
+        renderer = mujoco.Renderer(render_model, 84, 84)
+        renderer.update_scene(data, camera="corner")
+        renderer.enable_depth_rendering()
+        depth = renderer.render().copy()
+        renderer.disable_depth_rendering()
+        renderer.enable_segmentation_rendering()
+        geoms = renderer.render()[..., 0].copy()
+        renderer.close()
+        return depth, geoms
+
+    (depth, geoms), (simple_depth, simple_geoms) = frames(model), frames(simple)
+    changed = np.abs(depth - simple_depth) > 1e-4
+    on_simplified = np.isin(geoms, simplified_geoms) | np.isin(simple_geoms, simplified_geoms)
+    assert changed.any() and np.isin(geoms, simplified_geoms).mean() > 0.05, "the arm is in view"
+    assert not (changed & ~on_simplified).any()
+    env.close()
+
+
+def test_mesh_detail_gives_clouds_of_the_same_scene():
+    clouds = []
+    for detail in (1.0, 0.2):
+        suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=512, mesh_detail=detail)
+        env = suite.make_env("push-v3", seed=3)
+        observation, _ = env.reset()
+        clouds.append(observation[POINTCLOUD_KEY])
+        env.close()
+    assert np.all(METAWORLD_CROP.contains(clouds[1].astype(np.float64)))
+    nearest = np.linalg.norm(clouds[1][:, None] - clouds[0][None], axis=2).min(axis=1)
+    assert np.median(nearest) < 0.01, "the simplified scene's points lie on the exact scene"
+
+
 def test_same_seed_gives_the_same_cloud():
     suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=300)
     clouds = []
@@ -343,6 +393,10 @@ def test_features_create_a_lerobot_dataset(tmp_path, obs_mode):
         ({"name": "metaworld-mt10", "obs_mode": "depth"}, r"Unknown obs_mode 'depth'; choose one of"),
         ({"name": "metaworld-mt10", "obs_mode": "pointcloud", "num_points": 0}, "num_points must be > 0"),
         ({"name": "metaworld-mt10", "tasks": ["reach-v3", "reach-v3"]}, "unique"),
+        (
+            {"name": "metaworld-mt10", "obs_mode": "rgb", "mesh_detail": 0.0},
+            r"mesh_detail must be in \(0, 1\]",
+        ),
     ],
 )
 def test_make_suite_rejects_bad_input(kwargs, match):

@@ -365,6 +365,19 @@ def bad_inputs(finished: Path, tmp_path: Path) -> dict[str, tuple[list[str], str
             ["run", "--suite=toy", "--placement=kitchen", f"--output_dir={tmp_path / 'r4'}"],
             "placement applies to the drawers suite only",
         ),
+        "run with no mesh left to render": (
+            ["run", "--obs_mode=rgb", "--mesh_detail=0", f"--output_dir={tmp_path / 'r6'}"],
+            "mesh_detail must be in (0, 1]",
+        ),
+        "eval with too much mesh detail": (
+            [
+                "eval",
+                f"--policy_path={finished / 'policies' / 'round-001'}",
+                "--suite=toy",
+                "--mesh_detail=2",
+            ],
+            "mesh_detail must be in (0, 1]",
+        ),
         "run with an unknown placement": (
             ["run", "--suite=drawers", "--placement=office", f"--output_dir={tmp_path / 'r5'}"],
             "Unknown drawer placement 'office'",

@@ -82,6 +82,7 @@ def make_suite(
     include_goal: bool = True,
     max_episode_steps: int | None = None,
     placement: str | None = None,
+    mesh_detail: float = 1.0,
 ) -> TaskSuite:
     """Builds a task suite.
 
@@ -100,6 +101,7 @@ def make_suite(
         max_episode_steps: Truncation length (the task's max path length when None).
         placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen``, the
             default, or ``narrow``; see ``lerobot_mtdagger.envs.drawers.PLACEMENTS``).
+        mesh_detail: Share of the faces of each large mesh the observation renderer keeps (1: all).
 
     Returns:
         The suite.
@@ -114,6 +116,7 @@ def make_suite(
         num_points=num_points,
         pointcloud_cameras=None if pointcloud_cameras is None else tuple(pointcloud_cameras),
         depth_size=depth_size,
+        mesh_detail=mesh_detail,
         pointcloud_color=pointcloud_color,
         crop=crop,
         include_goal=include_goal,
@@ -162,8 +165,8 @@ class SuiteOptions(Protocol):
 def suite_from_config(config: SuiteOptions, **overrides: Any) -> TaskSuite:
     """The suite a config names.
 
-    ``max_episode_steps`` comes from ``config.episode_length`` and ``placement`` from
-    ``config.placement`` where the config has them.
+    ``max_episode_steps`` comes from ``config.episode_length``, ``placement`` from
+    ``config.placement`` and ``mesh_detail`` from ``config.mesh_detail`` where the config has them.
 
     Args:
         config: Any object with the ``SuiteOptions`` attributes.
@@ -182,6 +185,7 @@ def suite_from_config(config: SuiteOptions, **overrides: Any) -> TaskSuite:
         "num_points": config.num_points,
         "max_episode_steps": getattr(config, "episode_length", None),
         "placement": getattr(config, "placement", None),
+        "mesh_detail": getattr(config, "mesh_detail", 1.0),
     }
     try:
         return make_suite(config.suite, **(options | overrides))

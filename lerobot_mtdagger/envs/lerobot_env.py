@@ -55,6 +55,7 @@ class LeRobotSuiteEnv(gym.Env):
         episode_length: int | None = None,
         render_mode: str | None = "rgb_array",
         placement: str | None = None,
+        mesh_detail: float = 1.0,
     ) -> None:
         """Builds the suite env of ``task``."""
         config = MTDAggerSuiteEnvConfig(
@@ -65,6 +66,7 @@ class LeRobotSuiteEnv(gym.Env):
             num_points=num_points,
             episode_length=episode_length,
             placement=placement,
+            mesh_detail=mesh_detail,
         )
         self._suite = suite_from_config(config)
         self._env = self._suite.make_env(task)
@@ -121,6 +123,7 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
         episode_length: Truncation length (the task's default when None).
         placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when
             None, or ``narrow``).
+        mesh_detail: Share of the faces of the arm's meshes the observation renderer keeps (1: all).
     """
 
     suite: str = "metaworld-mt10"
@@ -130,6 +133,7 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
     num_points: int = 1024
     episode_length: int | None = None
     placement: str | None = None
+    mesh_detail: float = 1.0
     fps: int = 80
     features: dict[str, PolicyFeature] = field(default_factory=dict)
     features_map: dict[str, str] = field(default_factory=dict)
@@ -176,4 +180,5 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
             "num_points": self.num_points,
             "episode_length": self.episode_length,
             "placement": self.placement,
+            "mesh_detail": self.mesh_detail,
         }

@@ -37,7 +37,13 @@ from lerobot_mtdagger.envs.base import (
     TaskSuite,
     observation_features,
 )
-from lerobot_mtdagger.envs.rendering import CropBox, PointCloudCamera, SceneRenderer, camera_rays
+from lerobot_mtdagger.envs.rendering import (
+    CropBox,
+    PointCloudCamera,
+    SceneRenderer,
+    camera_rays,
+    simplified_model,
+)
 from lerobot_mtdagger.errors import UserError
 
 logger = logging.getLogger(__name__)
@@ -166,6 +172,8 @@ class MetaWorldTaskEnv(gym.Env):
     def _setup_rendering(self) -> None:
         config = self.observation_config
         model = self._env.model
+        if config.obs_mode != "state" and config.mesh_detail < 1.0:
+            model = simplified_model(model, config.mesh_detail)
         if config.obs_mode == "rgb":
             self._renderer = SceneRenderer(model, config.image_size, config.image_size)
             self._camera = config.camera or self.default_camera

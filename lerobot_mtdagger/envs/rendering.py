@@ -123,6 +123,68 @@ class SceneRenderer:
         _OPEN_RENDERERS.discard(self)
 
 
+MIN_FACES_TO_SIMPLIFY = 1000
+"""Meshes with fewer faces are rendered as they are (the drawers' and the objects' meshes)."""
+
+
+def simplified_model(model: mujoco.MjModel, detail: float) -> mujoco.MjModel:
+    """A copy of ``model`` for rendering only, its large untextured meshes simplified.
+
+    Each mesh of at least MIN_FACES_TO_SIMPLIFY faces without texture coordinates (the Sawyer arm's
+    visual meshes: 66 859 of the drawer scene's faces) keeps about ``detail`` of its faces
+    (quadric-error decimation, ``fast_simplification``), written into the mesh's own slots of the
+    copy, with smooth vertex normals recomputed. Geoms, bodies, cameras and lights are untouched, so
+    the copy renders the physics model's ``MjData``: MuJoCo places every geom from the data, and a
+    mesh's vertices stay in the frame its geom was compiled with. At 84 pixels a CPU depth frame of
+    the drawer scene costs 2.6x less at ``detail=0.2`` and the frames differ on the arm's
+    silhouette only (``docs/benchmarks.md``).
+
+    Args:
+        model: The physics model (not modified).
+        detail: Share of faces kept, in (0, 1]; 1 returns ``model`` itself.
+
+    Raises:
+        ValueError: If ``detail`` is outside (0, 1].
+    """
+    if not 0.0 < detail <= 1.0:
+        raise ValueError(f"detail must be in (0, 1], got {detail}.")
+    if detail == 1.0:
+        return model
+    import fast_simplification
+
+    copy = mujoco.MjModel.__copy__(model)
+    for mesh in range(copy.nmesh):
+        if copy.mesh_facenum[mesh] < MIN_FACES_TO_SIMPLIFY or copy.mesh_texcoordadr[mesh] >= 0:
+            continue
+        vert, face = copy.mesh_vertadr[mesh], copy.mesh_faceadr[mesh]
+        vertices = copy.mesh_vert[vert : vert + copy.mesh_vertnum[mesh]]
+        faces = copy.mesh_face[face : face + copy.mesh_facenum[mesh]]
+        kept_vertices, kept_faces = fast_simplification.simplify(
+            vertices.astype(np.float32), faces.astype(np.int64), target_reduction=1.0 - detail
+        )
+        if len(kept_vertices) <= copy.mesh_normalnum[mesh]:  # the normals fit the mesh's slots
+            _write_mesh(copy, mesh, kept_vertices, kept_faces.astype(np.int32))
+    return copy
+
+
+def _write_mesh(model: mujoco.MjModel, mesh: int, vertices: np.ndarray, faces: np.ndarray) -> None:
+    """Puts a smaller mesh into the slots of ``mesh`` (its normals one per vertex, area-weighted)."""
+    vert, face, normal = model.mesh_vertadr[mesh], model.mesh_faceadr[mesh], model.mesh_normaladr[mesh]
+    model.mesh_vert[vert : vert + len(vertices)] = vertices
+    model.mesh_vertnum[mesh] = len(vertices)
+    model.mesh_face[face : face + len(faces)] = faces
+    model.mesh_facenum[mesh] = len(faces)
+    corners = vertices[faces]  # (F, 3, 3)
+    face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normals = np.zeros_like(vertices, dtype=np.float64)
+    for corner in range(3):
+        np.add.at(normals, faces[:, corner], face_normals)
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+    model.mesh_normal[normal : normal + len(vertices)] = normals
+    model.mesh_normalnum[mesh] = len(vertices)
+    model.mesh_facenormal[face : face + len(faces)] = faces
+
+
 def camera_rays(model: mujoco.MjModel, camera: str, height: int, width: int) -> np.ndarray:
     """Per-pixel ray directions in the camera frame, scaled so that a depth d gives the point.
 
