@@ -28,12 +28,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lerobot_mtdagger.mixing import RolloutRules
 from lerobot_mtdagger.seeds import BETA_STREAM, EVAL_STREAM, stream_seed
 from lerobot_mtdagger.workers import (
     EnvWorkers,
     Episode,
     EpisodeSpec,
-    RolloutRules,
     Ticket,
     limited_torch_threads,
 )

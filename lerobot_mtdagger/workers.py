@@ -1,7 +1,8 @@
 """Env workers: the simulators of a run stepped in worker processes, one per core by default.
 
-A ``RolloutWorker`` owns envs and experts and runs the per-episode logic of a rollout (reset, the
-expert's label, the beta coin, the env step, recording, the end-of-episode rules). The main process
+A ``RolloutWorker`` owns envs and experts and runs each episode of a rollout (reset, the expert's
+label, the env step, recording) by the DAgger mixing rules of ``lerobot_mtdagger.mixing`` (who acts,
+when an episode ends). The main process
 keeps the policy and talks to the workers (see ``collect.run_episodes``): one message per worker
 per step of a group of episodes, carrying the learner's actions for that worker's episodes and the episodes to
 start, one reply carrying the new observations and the finished episodes.
@@ -22,7 +23,6 @@ from __future__ import annotations
 import contextlib
 import copy
 import logging
-import math
 import multiprocessing
 import pickle
 import signal
@@ -38,8 +38,14 @@ import numpy as np
 
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.experts import make_expert
+from lerobot_mtdagger.mixing import (
+    RolloutRules,
+    episode_ends,
+    expert_acts_now,
+    expert_episode_coin,
+    step_limit,
+)
 from lerobot_mtdagger.records import dagger_columns
-from lerobot_mtdagger.sampling import systematic_picks
 
 logger = logging.getLogger(__name__)
 
@@ -126,54 +132,6 @@ class EpisodeSpec:
     episode: int
     reset_seed: int
     beta_seed: tuple[int, ...]
-
-
-@dataclass(frozen=True)
-class RolloutRules:
-    """How the episodes of one ``run_episodes`` call behave (the same for every episode).
-
-    Attributes:
-        beta: Probability of executing the expert's action (at a step, or for a whole episode).
-        learner: Whether a learner acts at all (False: the expert always acts).
-        record: Keep the frames (observation, expert label, executed action, learner flag).
-        round_index: DAgger round written into the recorded frames.
-        max_steps: Longest episode (None: the env's own truncation).
-        steps_after_success: Steps kept after the first success.
-        mixing: ``step`` (a beta coin at every step) or ``episode`` (one coin when the episode
-            starts: the expert or the learner acts throughout).
-        expert_multiple: Cut an episode where the learner acts at ``ceil(expert_multiple * L)``
-            steps, ``L`` being the steps the expert alone takes to its first success from the same
-            reset seed (run first, unrecorded; no cut where the expert does not succeed). None: no
-            such cut. ``max_steps`` still applies.
-    """
-
-    beta: float
-    learner: bool
-    record: bool
-    round_index: int
-    max_steps: int | None
-    steps_after_success: int
-    mixing: str = "step"
-    expert_multiple: float | None = None
-
-    @property
-    def need_expert(self) -> bool:
-        """The expert is queried when its labels are stored or it may act."""
-        return self.record or self.beta > 0.0 or not self.learner or self.expert_multiple is not None
-
-
-def expert_episode_coin(beta_seed: tuple[int, ...], beta: float) -> bool:
-    """Whether the expert acts throughout an episode under episode mixing (systematic sampling).
-
-    ``beta_seed`` is ``(seed, BETA_STREAM, round, task, episode)``. One uniform offset ``u`` per
-    (seed, round, task) is drawn, and episode ``e`` goes to the expert when ``floor(beta * e + u)``
-    steps up at ``e + 1``: any ``n`` consecutive episodes of a task hold ``floor(beta * n)`` or
-    ``ceil(beta * n)`` expert episodes, so even a task given 3 episodes gets both kinds at beta 0.5
-    (independent coins would give it none of the learner's one time in eight).
-    """
-    *task_entropy, episode = beta_seed
-    offset = float(np.random.default_rng(np.random.SeedSequence(list(task_entropy))).random())
-    return bool(systematic_picks(beta, episode + 1, offset)[episode])
 
 
 @dataclass
@@ -294,10 +252,7 @@ class RolloutWorker:
         """
         expert_steps = _expert_steps_to_success(env, expert, reset_seed)
         expert.reset()
-        limits = [self.rules.max_steps]
-        if expert_steps is not None:
-            limits.append(math.ceil(self.rules.expert_multiple * expert_steps))
-        return min((limit for limit in limits if limit is not None), default=None)
+        return step_limit(self.rules, expert_steps)
 
     def _expert(self, task_index: int) -> Any:
         """A reset expert of the task that no running episode uses.
@@ -328,10 +283,7 @@ class RolloutWorker:
         rules = self.rules
         episode = running.episode
         expert_action = running.expert.act(running.privileged) if running.expert is not None else None
-        if learner_action is None or rules.mixing == "episode":
-            expert_acts = learner_action is None or running.expert_episode
-        else:
-            expert_acts = rules.beta > 0.0 and running.rng.random() < rules.beta
+        expert_acts = expert_acts_now(rules, learner_action is not None, running.expert_episode, running.rng)
         executed = expert_action if expert_acts else learner_action
         if rules.record:
             columns = dagger_columns(executed, learner_acted=not expert_acts, round_index=rules.round_index)
@@ -346,11 +298,8 @@ class RolloutWorker:
             running.steps_since_success = 0
         elif episode.success:
             running.steps_since_success += 1
-        return bool(
-            terminated
-            or truncated
-            or (running.max_steps is not None and episode.steps >= running.max_steps)
-            or (episode.success and running.steps_since_success >= rules.steps_after_success)
+        return bool(terminated or truncated) or episode_ends(
+            rules, episode.steps, running.max_steps, running.steps_since_success
         )
 
 

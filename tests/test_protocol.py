@@ -27,6 +27,7 @@ from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.evaluate import PolicyRunner
+from lerobot_mtdagger.mixing import expert_episode_coin
 from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.seeds import BETA_STREAM, COLLECT_STREAM
 from lerobot_mtdagger.train import (
@@ -42,7 +43,7 @@ from lerobot_mtdagger.train import (
     performance_gain,
     split_frames,
 )
-from lerobot_mtdagger.workers import EnvWorkers, expert_episode_coin
+from lerobot_mtdagger.workers import EnvWorkers
 from tests.test_toy import TOY_RUN
 from tests.test_train import normalised, small_policy, synthetic_data
 

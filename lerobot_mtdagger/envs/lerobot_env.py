@@ -45,29 +45,20 @@ class LeRobotSuiteEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 80}
 
-    def __init__(
-        self,
-        suite: str = "metaworld-mt10",
-        task: str = "reach-v3",
-        obs_mode: str = "state",
-        image_size: int = 84,
-        num_points: int = 1024,
-        episode_length: int | None = None,
-        render_mode: str | None = "rgb_array",
-        placement: str | None = None,
-        mesh_detail: float = 1.0,
-    ) -> None:
-        """Builds the suite env of ``task``."""
-        config = MTDAggerSuiteEnvConfig(
-            suite=suite,
-            task=task,
-            obs_mode=obs_mode,
-            image_size=image_size,
-            num_points=num_points,
-            episode_length=episode_length,
-            placement=placement,
-            mesh_detail=mesh_detail,
-        )
+    def __init__(self, render_mode: str | None = "rgb_array", **suite_options: Any) -> None:
+        """Builds the suite env of one task.
+
+        Args:
+            render_mode: Gymnasium's render mode (``rgb_array``).
+            **suite_options: ``MTDAggerSuiteEnvConfig`` fields: ``suite``, ``task``, ``obs_mode``,
+                ``image_size``, ``num_points``, ``episode_length``, ``placement``, ``mesh_detail``
+                (their defaults where left out), as ``MTDAggerSuiteEnvConfig.gym_kwargs`` gives them.
+
+        Raises:
+            TypeError: On an option that is not such a field.
+        """
+        config = MTDAggerSuiteEnvConfig(**suite_options)
+        task = config.task
         self._suite = suite_from_config(config)
         self._env = self._suite.make_env(task)
         self.task_description = task
