@@ -14,10 +14,14 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
+from typing import Any
 
+from lerobot.policies.factory import make_pre_post_processors
 from lerobot.processor.pipeline import ProcessorStepRegistry
 
 from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.quiet import quiet_third_party
 
 PROCESSOR_FILES = ("policy_preprocessor.json", "policy_postprocessor.json")
 POLICY_TYPE = "mtdagger"
@@ -157,3 +161,54 @@ def _check_safetensors(path: Path) -> None:
             f"{path} is not a readable safetensors file ({error}): the checkpoint is incomplete or "
             "corrupt; copy it again or retrain it."
         ) from None
+
+
+def load_policy(
+    path: str | Path, device: str = "cpu", trust_checkpoint: bool = False
+) -> tuple[Any, Any, Any]:
+    """Loads an ``mtdagger`` policy folder or Hub id with its saved processors, after the checks above.
+
+    Args:
+        path: A local policy folder or a Hub repo id.
+        device: Torch device.
+        trust_checkpoint: Let the processor configs name Python classes to import (LeRobot's
+            loader imports and calls them); otherwise every step must be a LeRobot registry name.
+
+    Returns:
+        The policy (in eval mode, on ``device``), its pre-processor and its post-processor.
+
+    Raises:
+        UntrustedCheckpointError: If a processor config names code and the checkpoint is not trusted.
+        UserError: If the path is not a complete ``mtdagger`` policy folder or a reachable Hub
+            policy, naming the path or file and the fix.
+    """
+    check_policy_path(path)
+    if Path(path).exists():
+        return _load_checked(path, device, trust_checkpoint)
+    from huggingface_hub.errors import HfHubHTTPError, LocalEntryNotFoundError
+
+    try:
+        return _load_checked(path, device, trust_checkpoint)
+    except (HfHubHTTPError, LocalEntryNotFoundError, OSError) as error:
+        raise UserError(
+            f"Cannot load the Hub policy {path} ({type(error).__name__}): check the repo id, the "
+            "network and HF_TOKEN, or pass a local policy folder."
+        ) from None
+
+
+def _load_checked(path: str | Path, device: str, trust_checkpoint: bool) -> tuple[Any, Any, Any]:
+    """Loads a checked policy path (see ``load_policy``)."""
+    if not trust_checkpoint:
+        if Path(path).is_dir():
+            check_policy_folder(Path(path))
+        else:
+            check_hub_policy(str(path))
+    with quiet_third_party():  # LeRobot prints "Loading weights from local directory"
+        policy = MTDAggerPolicy.from_pretrained(str(path))
+    policy.config.device = device
+    policy.to(device)
+    overrides = {"device_processor": {"device": device}}
+    pre, post = make_pre_post_processors(
+        policy.config, pretrained_path=str(path), preprocessor_overrides=overrides
+    )
+    return policy.eval(), pre, post

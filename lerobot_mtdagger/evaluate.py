@@ -14,13 +14,11 @@ from typing import Any
 
 import numpy as np
 import torch
-from lerobot.policies.factory import make_pre_post_processors
 
-from lerobot_mtdagger.checkpoints import check_hub_policy, check_policy_folder, check_policy_path
+from lerobot_mtdagger.checkpoints import load_policy
 from lerobot_mtdagger.collect import PolicyFn, run_episodes, success_by_task
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.policies import MTDAggerPolicy
-from lerobot_mtdagger.quiet import quiet_third_party
 from lerobot_mtdagger.seeds import EVAL_STREAM
 from lerobot_mtdagger.workers import EnvWorkers, Episode
 
@@ -40,49 +38,14 @@ class PolicyRunner:
     def from_pretrained(
         cls, path: str | Path, device: str = "cpu", trust_checkpoint: bool = False
     ) -> PolicyRunner:
-        """Loads a pretrained model folder or Hub id with its saved processors.
-
-        Args:
-            path: A local policy folder or a Hub repo id.
-            device: Torch device.
-            trust_checkpoint: Let the processor configs name Python classes to import (LeRobot's
-                loader imports and calls them); otherwise every step must be a LeRobot registry name.
+        """Loads a pretrained model folder or Hub id with its saved processors (``load_policy``).
 
         Raises:
             UntrustedCheckpointError: If a processor config names code and the checkpoint is not trusted.
             UserError: If the path is not a complete ``mtdagger`` policy folder or a reachable Hub
                 policy, naming the path or file and the fix.
         """
-        check_policy_path(path)
-        if Path(path).exists():
-            return cls._load(path, device, trust_checkpoint)
-        from huggingface_hub.errors import HfHubHTTPError, LocalEntryNotFoundError
-
-        try:
-            return cls._load(path, device, trust_checkpoint)
-        except (HfHubHTTPError, LocalEntryNotFoundError, OSError) as error:
-            raise UserError(
-                f"Cannot load the Hub policy {path} ({type(error).__name__}): check the repo id, the "
-                "network and HF_TOKEN, or pass a local policy folder."
-            ) from None
-
-    @classmethod
-    def _load(cls, path: str | Path, device: str, trust_checkpoint: bool) -> PolicyRunner:
-        """Loads a checked policy path (see ``from_pretrained``)."""
-        if not trust_checkpoint:
-            if Path(path).is_dir():
-                check_policy_folder(Path(path))
-            else:
-                check_hub_policy(str(path))
-        with quiet_third_party():  # LeRobot prints "Loading weights from local directory"
-            policy = MTDAggerPolicy.from_pretrained(str(path))
-        policy.config.device = device
-        policy.to(device)
-        overrides = {"device_processor": {"device": device}}
-        pre, post = make_pre_post_processors(
-            policy.config, pretrained_path=str(path), preprocessor_overrides=overrides
-        )
-        return cls(policy, pre, post)
+        return cls(*load_policy(path, device, trust_checkpoint))
 
     def check_inputs(self, suite_features: dict[str, dict[str, Any]], obs_mode: str) -> None:
         """Refuses a suite whose observations do not match the policy's inputs (key and shape).

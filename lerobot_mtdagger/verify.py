@@ -19,6 +19,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from lerobot_mtdagger.checkpoints import load_policy
 from lerobot_mtdagger.errors import CorruptExperimentError, UserError
 from lerobot_mtdagger.records import RoundRecord
 from lerobot_mtdagger.rounds import ExperimentDir, round_name
@@ -133,8 +134,6 @@ def verify_policy(experiment: ExperimentDir, round_index: int) -> list[str]:
     Returns:
         One message per problem, prefixed by the policy's folder.
     """
-    from lerobot_mtdagger.evaluate import PolicyRunner
-
     prefix = f"policies/{round_name(round_index)}"
     try:
         record = experiment.read_phase_record(round_index)
@@ -144,7 +143,7 @@ def verify_policy(experiment: ExperimentDir, round_index: int) -> list[str]:
     if record.files is None:
         problems.append("no checksums recorded (committed by an older version): files not checked")
     try:
-        PolicyRunner.from_pretrained(experiment.policy_root(round_index))
+        load_policy(experiment.policy_root(round_index))
     except (UserError, OSError, RuntimeError, json.JSONDecodeError) as error:
         problems.append(f"does not load: {type(error).__name__}: {error}")
     return [f"{prefix}: {problem}" for problem in problems]

@@ -190,3 +190,14 @@ def test_the_dagger_loop_hands_each_training_phase_to_train():
     assert len(from_train) <= 4, from_train
     (train_round,) = [n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == "train_round"]
     assert train_round.end_lineno - train_round.lineno + 1 <= 30
+
+
+def test_verify_loads_policies_without_the_rollout_stack():
+    """``verify`` checks rounds and loads policies; it never imports env workers or rollouts."""
+    seen, todo = set(), ["lerobot_mtdagger.verify"]
+    while todo:
+        name = todo.pop()
+        if name not in seen:
+            seen.add(name)
+            todo.extend(imports_of(name))
+    assert not seen & {"lerobot_mtdagger.workers", "lerobot_mtdagger.collect", "lerobot_mtdagger.evaluate"}
