@@ -1,14 +1,15 @@
 """What an experiment writes about itself: DAgger frame columns, round records and phase records.
 
-Every committed round dataset carries a ``RoundRecord`` under the key ``"mtdagger"`` of its
-``meta/info.json``; every committed training phase carries a ``PhaseRecord`` in
-``policies/round-XXX/training.json``. Both are written and read only through these classes
-(``to_dict`` / ``from_dict``), so the field list below is the on-disk format::
+Every committed round dataset carries a ``RoundRecord`` in ``meta/mtdagger.json``, mirrored under the
+key ``"mtdagger"`` of its ``meta/info.json`` for readers of the dataset info (rounds written before the
+file existed hold it only there; LeRobot may rewrite info.json without it, the file stays the truth);
+every committed training phase carries a ``PhaseRecord`` in ``policies/round-XXX/training.json``. Both
+are written and read only through these classes (``to_dict`` / ``from_dict``), so the field list below
+is the on-disk format::
 
-    rounds/round-002/meta/info.json
-        {..., "mtdagger": {"round": 2, "method": "need", "episodes_per_task": [...],
-                           "allocation": {...}, "scheduler_state": {...}, ..., "format_version": 1,
-                           "committed": true}}
+    rounds/round-002/meta/mtdagger.json
+        {"round": 2, "method": "need", "episodes_per_task": [...], "allocation": {...},
+         "scheduler_state": {...}, ..., "format_version": 1, "committed": true}
     policies/round-002/training.json
         {"round": 2, "loss_start": [...], "loss_end": [...], "gain": [...], "eval": {...}, ...}
 
@@ -25,7 +26,7 @@ from typing import Any
 import numpy as np
 
 RECORD_KEY = "mtdagger"
-"""Key of the round record in a round dataset's ``meta/info.json``."""
+"""Key of the round record's mirror in a round dataset's ``meta/info.json``."""
 
 FORMAT_VERSION = 1
 """Version of the round record format."""

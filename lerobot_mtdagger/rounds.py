@@ -7,7 +7,8 @@ Layout of an experiment directory::
         run.log                      log of every run and resume
         rounds/
             round-000/               LeRobotDataset v3.0 of round 0 (expert demonstrations)
-                meta/info.json       ... "mtdagger": the round's record (allocation, Kalman state, ...)
+                meta/mtdagger.json   the round's record (allocation, Kalman state, ...): the truth
+                meta/info.json       ... "mtdagger": a mirror of it for readers of the dataset info
             round-001/               LeRobotDataset of round 1 (DAgger rollouts, expert labels)
             .staging/round-002/      a round being written: never read, deleted on resume
         policies/
@@ -69,7 +70,14 @@ LOCK_FILE = ".lock"
 
 STATS_FILE = "meta/stats.json"
 INFO_FILE = "meta/info.json"
-"""The file of a round dataset holding its record (not covered by the round's checksums)."""
+"""LeRobot's dataset info; its ``mtdagger`` key mirrors the round's record (rounds written before the
+record had a file of its own hold it only there)."""
+
+RECORD_FILE = "meta/mtdagger.json"
+"""The round's record, in a file LeRobot never rewrites: readers and ``verify`` take it as the truth."""
+
+RECORD_FILES = (INFO_FILE, RECORD_FILE)
+"""The files of a round that its checksums do not cover (they hold the record, checksums included)."""
 
 
 class ExperimentLockedError(UserError):
@@ -317,7 +325,14 @@ class ExperimentDir:
         """Files of a committed round that differ from its record's checksums (none recorded: [])."""
         if record.files is None:
             return []
-        return digest_mismatches(self.round_root(record.round), record.files, exclude=(INFO_FILE,))
+        root = self.round_root(record.round)
+        problems = digest_mismatches(root, record.files, exclude=RECORD_FILES)
+        if (root / RECORD_FILE).is_file():
+            info = read_committed_json(root / INFO_FILE, "restore it")
+            mirror = info.get(RECORD_KEY) if isinstance(info, dict) else None
+            if mirror is not None and mirror != read_committed_json(root / RECORD_FILE, "restore it"):
+                problems.append(f"{root / INFO_FILE} holds a record that differs from {root / RECORD_FILE}")
+        return problems
 
     def phase_file_problems(self, record: PhaseRecord) -> list[str]:
         """Files of a committed policy folder that differ from its record's checksums."""
@@ -365,12 +380,20 @@ class ExperimentDir:
     def read_round_record_at(path: Path) -> RoundRecord:
         """The ``mtdagger`` record of the round dataset at ``path``.
 
+        Read from ``meta/mtdagger.json``, or, for a round written before that file existed, from
+        ``meta/info.json``.
+
         Raises:
             CorruptExperimentError: If ``path`` holds no readable round record.
         """
+        fix = "restore it, or move the round out of the experiment directory"
         info_path = path / INFO_FILE
-        info = read_committed_json(info_path, "restore it, or move the round out of the experiment directory")
-        record = info.get(RECORD_KEY) if isinstance(info, dict) else None
+        if (path / RECORD_FILE).is_file():
+            info_path = path / RECORD_FILE
+            record = read_committed_json(info_path, fix)
+        else:
+            info = read_committed_json(info_path, fix)
+            record = info.get(RECORD_KEY) if isinstance(info, dict) else None
         if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
             raise CorruptExperimentError(
                 f"{path} is not a lerobot-mtdagger round (no '{RECORD_KEY}' record of format "
@@ -437,7 +460,7 @@ class ExperimentDir:
         return dataset
 
     def commit_round(self, round_index: int, dataset: LeRobotDataset, record: RoundRecord) -> Path:
-        """Finalises a staged round, writes its record into meta/info.json and commits it atomically.
+        """Finalises a staged round, writes its record (its file and info.json's mirror), commits it.
 
         Raises:
             FileExistsError: If the round is already committed (a committed round is immutable).
@@ -450,10 +473,11 @@ class ExperimentDir:
         sort_stats_file(staging)
         info_path = staging / INFO_FILE
         info = json.loads(info_path.read_text())
-        files = folder_digests(staging, exclude=(INFO_FILE,))
+        files = folder_digests(staging, exclude=RECORD_FILES)
         info[RECORD_KEY] = dataclasses.replace(
             record, format_version=FORMAT_VERSION, committed=True, files=files
         ).to_dict()
+        write_json_atomic(staging / RECORD_FILE, info[RECORD_KEY])
         write_json_atomic(info_path, info)
         os.replace(staging, final)
         return final
@@ -842,7 +866,8 @@ def merge_rounds(
     """Merges round datasets into ONE LeRobotDataset with LeRobot's own aggregation.
 
     Task indices are preserved: every round holds the full vocabulary in the same order. The merged
-    dataset's meta/info.json gets a ``mtdagger`` record listing the merged rounds' records.
+    dataset gets a ``mtdagger`` record listing the merged rounds' records (``meta/mtdagger.json``,
+    mirrored in meta/info.json).
 
     The merge is written beside ``output`` and renamed onto it when complete, so a merge that stops
     half-way leaves no ``output`` (and a re-run starts clean).
@@ -877,6 +902,7 @@ def merge_rounds(
         "merged_rounds": list(rounds),
         "rounds": [record.to_dict() for record in records],
     }
+    write_json_atomic(staging / RECORD_FILE, info[RECORD_KEY])
     write_json_atomic(info_path, info)
     os.replace(staging, output)
     return output

@@ -24,6 +24,14 @@ import pyarrow.parquet as pq
 from safetensors.numpy import load_file
 
 
+def round_record(root: Path) -> dict:
+    """A round's record: ``meta/mtdagger.json``, or ``meta/info.json``'s mirror in older rounds."""
+    sidecar = root / "meta" / "mtdagger.json"
+    if sidecar.is_file():
+        return json.loads(sidecar.read_text())
+    return json.loads((root / "meta" / "info.json").read_text())["mtdagger"]
+
+
 def table_digest(path: Path) -> str:
     """sha256 of a parquet file's rows (the encoded file may differ in metadata only)."""
     table = pq.read_table(path)
@@ -38,7 +46,7 @@ def compare_dicts(old: dict, new: dict, where: str, skip: set[str]) -> list[str]
 
 def compare_round(old: Path, new: Path, ignore_config: set[str]) -> list[str]:
     """Differences of one round's record and data."""
-    records = [json.loads((p / "meta" / "info.json").read_text())["mtdagger"] for p in (old, new)]
+    records = [round_record(p) for p in (old, new)]
     problems = compare_dicts(records[0], records[1], old.name, {"config"})
     configs = [r["config"] for r in records]
     problems += compare_dicts(configs[0], configs[1], f"{old.name}.config", {"output_dir", *ignore_config})

@@ -25,6 +25,7 @@ from lerobot_mtdagger.records import RoundRecord
 from lerobot_mtdagger.rounds import ExperimentDir, merge_rounds
 from lerobot_mtdagger.verify import verify_experiment
 from tests.conftest import lerobot_train
+from tests.helpers import edit_round_record
 
 TASKS = ["reach-v3", "button-press-topdown-v3", "push-v3"]
 TINY = [
@@ -84,11 +85,12 @@ def test_verify_recomputes_every_allocation(experiment):
 def test_verify_detects_a_tampered_round(experiment, tmp_path):
     copy = tmp_path / "copy"
     shutil.copytree(experiment.root, copy)
-    info_path = copy / "rounds" / "round-002" / "meta" / "info.json"
-    info = json.loads(info_path.read_text())
-    info["mtdagger"]["allocation"]["metric"][0] += 0.5
-    info["mtdagger"]["episodes_per_task"] = [9, 0, 0]
-    info_path.write_text(json.dumps(info))
+
+    def tamper(record):
+        record["allocation"]["metric"][0] += 0.5
+        record["episodes_per_task"] = [9, 0, 0]
+
+    edit_round_record(copy / "rounds" / "round-002", tamper)
     _, _, problems = verify_experiment(ExperimentDir(copy))
     assert any("data holds" in p for p in problems)
     assert any("metric" in p for p in problems)

@@ -32,7 +32,8 @@ from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.errors import CorruptExperimentError, UserError
 from lerobot_mtdagger.hub import PushConfig, push_command, push_experiment, render_dataset_card
 from lerobot_mtdagger.integrity import folder_digests
-from lerobot_mtdagger.rounds import ExperimentDir
+from lerobot_mtdagger.rounds import RECORD_FILES, ExperimentDir
+from tests.helpers import edit_round_record
 
 TASKS = ["reach-v3", "button-press-topdown-v3"]
 DATASET_REPO = "tester/mtdagger-rounds"
@@ -205,10 +206,8 @@ def test_stale_files_of_an_earlier_round_vanish_but_user_files_stay(experiment_d
         path = ExperimentDir(copy).round_root(0) / name
         path.parent.mkdir(parents=True)
         shutil.copy(ExperimentDir(copy).round_root(0) / "data/chunk-000/file-000.parquet", path)
-    info_path = ExperimentDir(copy).round_root(0) / "meta" / "info.json"
-    info = json.loads(info_path.read_text())  # as if round 0 had been committed with those files
-    info["mtdagger"]["files"] = folder_digests(ExperimentDir(copy).round_root(0), exclude=["meta/info.json"])
-    info_path.write_text(json.dumps(info))
+    files = folder_digests(ExperimentDir(copy).round_root(0), exclude=RECORD_FILES)
+    edit_round_record(ExperimentDir(copy).round_root(0), lambda record: record.update(files=files))
     fake_api.create_repo(DATASET_REPO, repo_type="dataset")
     user_file = {".gitattributes": b"*.parquet filter=lfs\n", "images/plot.png": b"png"}
     fake_api._commit(fake_api.repos[("dataset", DATASET_REPO)], user_file, "a file the user added")

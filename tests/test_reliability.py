@@ -25,6 +25,7 @@ from lerobot_mtdagger.errors import CorruptExperimentError, UserError
 from lerobot_mtdagger.evaluate import PolicyRunner
 from lerobot_mtdagger.rounds import LOCK_FILE, ExperimentDir, ExperimentLockedError
 from lerobot_mtdagger.verify import verify_experiment
+from tests.helpers import edit_round_record
 from tests.test_toy import TOY_RUN, toy_config
 
 
@@ -152,6 +153,52 @@ def test_verify_passes_an_intact_experiment_and_counts_rounds_and_policies(finis
     assert "verified 2 round(s) and 2 policy folder(s)" in capsys.readouterr().out
 
 
+def drop_info_records(root: Path) -> None:
+    """Rewrites every round's meta/info.json as LeRobot's own writer may: without keys it does not know."""
+    for info_path in (root / "rounds").glob("round-*/meta/info.json"):
+        info = json.loads(info_path.read_text())
+        del info["mtdagger"]
+        info_path.write_text(json.dumps(info, indent=4))
+
+
+def test_the_round_record_survives_lerobot_rewriting_info_json(finished, tmp_path):
+    """The record lives in meta/mtdagger.json: verify, resume, merge and report read it there."""
+    from lerobot_mtdagger.results import results_rows
+    from lerobot_mtdagger.rounds import merge_rounds
+
+    copy = damaged_copy(finished, tmp_path, drop_info_records)
+    experiment = ExperimentDir(copy)
+    assert verify_experiment(experiment) == (2, 2, [])
+    assert run(toy_config(copy, "--rounds=2", "--resume=true"))[-1].startswith("round 2")
+    assert verify_experiment(experiment) == (3, 3, [])
+    merged = merge_rounds(experiment, [0, 1, 2], tmp_path / "merged")
+    assert json.loads((merged / "meta" / "mtdagger.json").read_text())["merged_rounds"] == [0, 1, 2]
+    assert {row["round"] for row in results_rows([copy])} == {0, 1, 2}
+
+
+def remove_record_files(root: Path) -> None:
+    """Makes every round look as rounds did before meta/mtdagger.json existed."""
+    for sidecar in (root / "rounds").glob("round-*/meta/mtdagger.json"):
+        sidecar.unlink()
+
+
+def test_rounds_written_before_the_record_file_existed_still_read_and_verify(finished, tmp_path):
+    copy = damaged_copy(finished, tmp_path, remove_record_files)
+    assert verify_experiment(ExperimentDir(copy)) == (2, 2, [])
+    assert ExperimentDir(copy).read_round_record(1).round == 1
+
+
+def test_an_info_json_mirror_that_disagrees_with_the_record_file_is_named(finished, tmp_path):
+    def edit_mirror(root: Path) -> None:
+        info_path = ExperimentDir(root).round_root(1) / "meta" / "info.json"
+        info = json.loads(info_path.read_text())
+        info["mtdagger"]["budget"] += 1
+        info_path.write_text(json.dumps(info))
+
+    _, _, problems = verify_experiment(ExperimentDir(damaged_copy(finished, tmp_path, edit_mirror)))
+    assert any("differs from" in problem and "round-001" in problem for problem in problems), problems
+
+
 @pytest.mark.parametrize("damage", list(DAMAGES))
 def test_verify_names_every_damaged_file_and_exits_non_zero(finished, tmp_path, capsys, damage):
     copy = damaged_copy(finished, tmp_path, DAMAGES[damage])
@@ -167,10 +214,9 @@ def test_verify_names_every_damaged_file_and_exits_non_zero(finished, tmp_path, 
 
 def test_verify_counts_frames_and_episodes_in_the_data_itself(finished, tmp_path):
     def forge_record(root: Path) -> None:  # a record that no longer matches its (intact) data
-        info_path = ExperimentDir(root).round_root(1) / "meta" / "info.json"
-        info = json.loads(info_path.read_text())
-        info["mtdagger"]["frames"] += 1
-        info_path.write_text(json.dumps(info))
+        edit_round_record(
+            ExperimentDir(root).round_root(1), lambda record: record.update(frames=record["frames"] + 1)
+        )
 
     _, _, problems = verify_experiment(ExperimentDir(damaged_copy(finished, tmp_path, forge_record)))
     assert any("data holds" in problem and "frames" in problem for problem in problems), problems
