@@ -22,11 +22,8 @@ complete. Every round dataset carries the experiment's full task vocabulary in t
 (``meta.save_episode_tasks(task_names)`` right after creation), so task_index i is the same task in
 every round and in merged datasets.
 
-A round is written in one go by :meth:`ExperimentDir.write_round` (:func:`write_round_episodes`): the
-same files, values, statistics and metadata as LeRobot's ``add_frame`` / ``save_episode`` loop, but
-with one Arrow conversion for the whole round instead of a ``datasets`` conversion and a per-row
-``map`` per episode, and cheaper statistics (6-10 times faster for vector features). Rounds with image
-or video features take LeRobot's own per-frame path.
+A round is written in one go by :meth:`ExperimentDir.write_round` with the fast writer of
+``lerobot_mtdagger.round_writer``.
 """
 
 from __future__ import annotations
@@ -38,24 +35,20 @@ import json
 import logging
 import os
 import shutil
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import datasets
-import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
-from datasets.features.features import numpy_to_pyarrow_listarray
-from datasets.table import cast_array_to_feature
-from lerobot.datasets.compute_stats import RunningQuantileStats, compute_episode_stats, get_feature_stats
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
-from lerobot.datasets.utils import DEFAULT_FEATURES, update_chunk_file_indices, validate_frame
+from lerobot.datasets.utils import update_chunk_file_indices
 
 from lerobot_mtdagger.errors import CorruptExperimentError, NotAnExperimentError, UserError
 from lerobot_mtdagger.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.quiet import quiet_third_party
 from lerobot_mtdagger.records import FORMAT_VERSION, RECORD_KEY, PhaseRecord, RoundRecord
+from lerobot_mtdagger.round_writer import EpisodeFrames, write_round_episodes
 
 logger = logging.getLogger(__name__)
 
@@ -85,9 +78,6 @@ class ExperimentLockedError(UserError):
 
 
 DATASET_FPS = 80
-
-EpisodeFrames = tuple[str, Sequence[Mapping[str, Any]]]
-"""One episode to write: its task (a string of the vocabulary) and its frames (feature -> array)."""
 
 
 def round_name(round_index: int) -> str:
@@ -540,250 +530,6 @@ def sort_stats_file(root: Path) -> None:
     if path.is_file():
         stats = json.loads(path.read_text())
         path.write_text(json.dumps(stats, indent=4, ensure_ascii=False, sort_keys=True))
-
-
-def write_round_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFrames]) -> None:
-    """Writes episodes into a new, empty LeRobotDataset as LeRobot's own recording loop would.
-
-    The result is what ``add_frame`` per frame and ``save_episode`` per episode write: the same data
-    parquet file (one row group per episode, same schema and values), the same per-episode statistics,
-    the same ``meta/episodes`` rows, ``tasks.parquet``, ``info.json`` and ``stats.json`` (written by
-    LeRobot's own ``meta.save_episode``). The only difference is the random ``datasets`` cache
-    fingerprint LeRobot leaves in the data file's schema metadata, which differs between any two
-    writes and is never read. What is saved: one column-wise Arrow conversion and one parquet writer
-    for the whole round instead of a ``datasets`` conversion plus a per-row ``map`` per episode
-    (LeRobot's ``embed_images``, a no-op without images, ~1 ms per frame), and LeRobot's statistics
-    computed with fewer passes (:class:`_FastQuantileStats`, checked bit for bit against LeRobot's
-    ``compute_episode_stats`` on each round's first episode, which is used instead if they differ).
-    A new data file is started where the next episode would take the current one past
-    ``data_files_size_in_mb``, measured on the uncompressed Arrow size (a conservative estimate of
-    the parquet size LeRobot measures). Datasets with image or video features are written through
-    ``add_frame`` / ``save_episode``.
-
-    Runs inside :func:`~lerobot_mtdagger.quiet.quiet_third_party`.
-
-    Args:
-        dataset: A dataset just created (``LeRobotDataset.create``), without episodes.
-        episodes: ``(task, frames)`` per episode (see :meth:`ExperimentDir.write_round`).
-
-    Raises:
-        ValueError: If the dataset already holds episodes, a frame does not match the features, or an
-            episode has no frame.
-    """
-    if dataset.meta.total_episodes != 0 or (dataset.episode_buffer or {}).get("size", 0) > 0:
-        raise ValueError(
-            f"write_round_episodes needs an empty, freshly created dataset; {dataset.root} already holds "
-            f"{dataset.meta.total_episodes} episode(s) or unsaved frames."
-        )
-    with quiet_third_party():
-        if any(ft["dtype"] in ("image", "video") for ft in dataset.features.values()):
-            for task, frames in episodes:
-                for frame in frames:
-                    dataset.add_frame({**frame, "task": task})
-                dataset.save_episode()
-            return
-        _write_vector_episodes(dataset, episodes)
-
-
-def _episode_buffer(
-    dataset: LeRobotDataset, episode_index: int, start: int, task: str, frames: Sequence[Mapping[str, Any]]
-) -> dict[str, np.ndarray]:
-    """The columns ``save_episode`` builds from ``add_frame``'s buffer, in the same (feature) order."""
-    if len(frames) == 0:
-        raise ValueError(
-            f"Episode {episode_index} ({task!r}) has no frame; a LeRobotDataset cannot store an empty "
-            "episode."
-        )
-    features = dataset.features
-    for frame in frames:
-        validate_frame({**frame, "task": task}, features)
-    dataset.meta.save_episode_tasks([task])  # a no-op for a task of the vocabulary, as in save_episode
-    length = len(frames)
-    frame_index = np.arange(length)
-    generated = {
-        "timestamp": frame_index / dataset.fps,
-        "frame_index": frame_index,
-        "episode_index": np.full((length,), episode_index),
-        "index": np.arange(start, start + length),
-        "task_index": np.full((length,), dataset.meta.get_task_index(task)),
-    }
-    return {
-        key: generated[key] if key in DEFAULT_FEATURES else np.stack([frame[key] for frame in frames])
-        for key in features
-    }
-
-
-def _arrow_table(columns: Mapping[str, np.ndarray], hf_features: datasets.Features) -> pa.Table:
-    """The Arrow table ``datasets.Dataset.from_dict(columns, features=hf_features)`` holds.
-
-    Same schema (with its ``huggingface`` metadata) and values, built column-wise instead of row by row.
-    """
-    arrays = []
-    for key, feature in hf_features.items():
-        column = np.asarray(columns[key])
-        if isinstance(feature, datasets.Value) and column.ndim == 2 and column.shape[1] == 1:
-            column = column[:, 0]  # shape (1,) features are scalar columns
-        array = pa.array(column) if column.ndim == 1 else numpy_to_pyarrow_listarray(column)
-        arrays.append(cast_array_to_feature(array, feature))
-    return pa.Table.from_arrays(arrays, schema=hf_features.arrow_schema)
-
-
-class _FastQuantileStats(RunningQuantileStats):
-    """LeRobot's ``RunningQuantileStats`` with cheaper histogram and quantile loops, same results.
-
-    The results are the same bit for bit (``_write_vector_episodes`` checks that on every round's
-    first episode and falls back to LeRobot's own statistics if they ever differ).
-
-    ``_update_histograms`` runs ``np.histogram``'s own algorithm for explicit bin edges (sorted data,
-    inclusive search of the edges) without its per-call checks, converting a bool column to uint8 as
-    ``np.histogram`` does, minus its RuntimeWarning. ``_compute_quantiles`` computes each histogram's
-    cumulative sum once instead of once per quantile.
-    """
-
-    def _update_histograms(self, batch: np.ndarray) -> None:
-        if batch.dtype == np.bool_:
-            batch = batch.astype(np.uint8)
-        columns = np.sort(np.ascontiguousarray(batch.T), axis=1)
-        for column, histogram, edges in zip(columns, self._histograms, self._bin_edges, strict=True):
-            cumulative = np.concatenate(
-                (column.searchsorted(edges[:-1], "left"), column.searchsorted(edges[-1:], "right"))
-            )
-            histogram += np.diff(cumulative)
-
-    def _compute_quantiles(self) -> list[np.ndarray]:
-        targets = [q * self._count for q in self._quantile_list]
-        per_dimension = []
-        for histogram, edges in zip(self._histograms, self._bin_edges, strict=True):
-            cumsum = np.cumsum(histogram)
-            per_dimension.append((cumsum, edges, cumsum.searchsorted(targets)))
-        return [
-            np.array(
-                [_quantile(cumsum, edges, int(found[q]), target) for cumsum, edges, found in per_dimension]
-            )
-            for q, target in enumerate(targets)
-        ]
-
-
-def _quantile(cumsum: np.ndarray, edges: np.ndarray, idx: int, target_count: float) -> Any:
-    """``RunningQuantileStats._compute_single_quantile`` given ``idx = searchsorted(cumsum, target)``."""
-    if idx == 0:
-        return edges[0]
-    if idx >= len(cumsum):
-        return edges[-1]
-    count_before = cumsum[idx - 1]
-    count_in_bin = cumsum[idx] - count_before
-    if count_in_bin == 0:
-        return edges[idx]
-    fraction = (target_count - count_before) / count_in_bin
-    return edges[idx] + fraction * (edges[idx + 1] - edges[idx])
-
-
-def _vector_episode_stats(buffer: Mapping[str, np.ndarray], features: Mapping[str, Any]) -> dict[str, Any]:
-    """``compute_episode_stats(buffer, features)`` for an episode without image or video features."""
-    stats: dict[str, Any] = {}
-    for key, data in buffer.items():
-        if features[key]["dtype"] == "string":
-            continue
-        array = data.reshape(-1, 1) if data.ndim == 1 else data
-        if array.shape[0] < 2:  # LeRobot's basic statistics
-            stats[key] = get_feature_stats(data, axis=0, keepdims=data.ndim == 1)
-            continue
-        running = _FastQuantileStats()
-        running.update(array)
-        stats[key] = running.get_statistics()
-        stats[key]["count"] = np.array([array.shape[0]])
-    return stats
-
-
-def _same_stats(ours: Mapping[str, Any], theirs: Mapping[str, Any]) -> bool:
-    """Whether two episode statistics are identical: keys in order, values, dtypes and shapes."""
-    if list(ours) != list(theirs):
-        return False
-    for key, feature_stats in ours.items():
-        if list(feature_stats) != list(theirs[key]):
-            return False
-        for name, value in feature_stats.items():
-            other = np.asarray(theirs[key][name])
-            value = np.asarray(value)
-            if value.dtype != other.dtype or not np.array_equal(value, other, equal_nan=True):
-                return False
-    return True
-
-
-def _checked_fast_stats(
-    buffer: Mapping[str, np.ndarray], dataset: LeRobotDataset
-) -> tuple[dict[str, Any], Callable[..., dict[str, Any]]]:
-    """The first episode's statistics and the statistics function for the round's other episodes.
-
-    The fast function if it gives exactly what LeRobot's ``compute_episode_stats`` gives on this
-    episode, else LeRobot's (with a warning).
-    """
-    reference = compute_episode_stats(buffer, dataset.features)
-    try:
-        fast = _vector_episode_stats(buffer, dataset.features)
-    except (AttributeError, TypeError, ValueError, IndexError) as error:  # LeRobot's internals changed
-        fast, reason = None, f"{type(error).__name__}: {error}"
-    else:
-        reason = "different results"
-    if fast is not None and _same_stats(fast, reference):
-        return fast, _vector_episode_stats
-    logger.warning(
-        "lerobot_mtdagger's fast episode statistics do not match this LeRobot version's (%s); using "
-        "LeRobot's own, slower, for %s.",
-        reason,
-        dataset.root,
-    )
-    return reference, compute_episode_stats
-
-
-def _write_vector_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFrames]) -> None:
-    """The fast path of :func:`write_round_episodes` (no image or video feature)."""
-    hf_features = dataset.hf_features
-    limit_bytes = dataset.meta.data_files_size_in_mb * 1024 * 1024
-    # Per file: the episodes' buffers; a new file when the next episode would pass the size limit.
-    files: list[list[tuple[str, dict[str, np.ndarray]]]] = [[]]
-    file_bytes, start = 0, 0
-    for episode_index, (task, frames) in enumerate(episodes):
-        buffer = _episode_buffer(dataset, episode_index, start, task, frames)
-        episode_bytes = sum(buffer[key].nbytes for key in hf_features)
-        if files[-1] and file_bytes + episode_bytes >= limit_bytes:
-            files.append([])
-            file_bytes = 0
-        files[-1].append((task, buffer))
-        file_bytes += episode_bytes
-        start += len(frames)
-    episode_stats = _vector_episode_stats
-    chunk_index, file_index, episode_index = 0, 0, 0
-    for position, file_episodes in enumerate(files):
-        if not file_episodes:
-            continue
-        if position > 0:
-            chunk_index, file_index = update_chunk_file_indices(
-                chunk_index, file_index, dataset.meta.chunks_size
-            )
-        columns = {key: np.concatenate([buffer[key] for _, buffer in file_episodes]) for key in hf_features}
-        table = _arrow_table(columns, hf_features)
-        path = dataset.root / dataset.meta.data_path.format(chunk_index=chunk_index, file_index=file_index)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        offset = 0
-        with pq.ParquetWriter(path, schema=table.schema, compression="snappy", use_dictionary=True) as writer:
-            for task, buffer in file_episodes:
-                length = len(buffer["index"])
-                writer.write_table(table.slice(offset, length))
-                if episode_index == 0:
-                    stats, episode_stats = _checked_fast_stats(buffer, dataset)
-                else:
-                    stats = episode_stats(buffer, dataset.features)
-                metadata = {
-                    "data/chunk_index": chunk_index,
-                    "data/file_index": file_index,
-                    "dataset_from_index": int(buffer["index"][0]),
-                    "dataset_to_index": int(buffer["index"][-1]) + 1,
-                }
-                dataset.meta.save_episode(episode_index, length, [task], stats, metadata)
-                offset += length
-                episode_index += 1
-    logger.debug("Wrote %d episodes (%d frames) to %s", episode_index, start, dataset.root)
 
 
 RENUMBERED_COLUMNS = ("episode_index", "index", "task_index")

@@ -23,7 +23,8 @@ import pytest
 from lerobot_mtdagger import quiet
 from lerobot_mtdagger.quiet import quiet_third_party
 from lerobot_mtdagger.records import dagger_columns, round_features
-from lerobot_mtdagger.rounds import ExperimentDir, _vector_episode_stats, round_name
+from lerobot_mtdagger.round_writer import _vector_episode_stats
+from lerobot_mtdagger.rounds import ExperimentDir, round_name
 
 hf_tqdm = importlib.import_module("datasets.utils.tqdm")
 
@@ -367,7 +368,7 @@ def test_write_round_writes_what_lerobots_loop_writes(tmp_path, pointcloud):
 def test_write_round_falls_back_to_lerobots_stats_if_the_fast_ones_differ(
     tmp_path, monkeypatch, caplog, failure
 ):
-    from lerobot_mtdagger import rounds
+    from lerobot_mtdagger import round_writer as rounds
 
     fast = rounds._vector_episode_stats
 
@@ -427,7 +428,7 @@ def test_write_round_is_loaded_and_merged_like_lerobots(tmp_path, root_records):
 def test_write_round_starts_a_new_data_file_at_the_size_limit(tmp_path):
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    from lerobot_mtdagger.rounds import write_round_episodes
+    from lerobot_mtdagger.round_writer import write_round_episodes
 
     experiment = ExperimentDir(tmp_path)
     episodes = _episodes(np.random.default_rng(2), [50, 50, 50, 50])
@@ -498,7 +499,7 @@ def test_write_round_refuses_bad_frames_empty_episodes_and_used_datasets(tmp_pat
     with pytest.raises(ValueError, match="action"):
         experiment.write_round(0, _features(), TASKS, bad)
     dataset = experiment.write_round(0, _features(), TASKS, good)
-    from lerobot_mtdagger.rounds import write_round_episodes
+    from lerobot_mtdagger.round_writer import write_round_episodes
 
     with pytest.raises(ValueError, match="empty, freshly created"):
         write_round_episodes(dataset, good)
