@@ -191,13 +191,15 @@ def test_a_simplified_render_model_differs_only_on_the_meshes_it_simplified():
 
 
 def test_mesh_detail_gives_clouds_of_the_same_scene():
-    clouds = []
+    clouds, faces = [], []
     for detail in (1.0, 0.2):
         suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=512, mesh_detail=detail)
         env = suite.make_env("push-v3", seed=3)
         observation, _ = env.reset()
         clouds.append(observation[POINTCLOUD_KEY])
+        faces.append(int(env.unwrapped._renderer.model.mesh_facenum.sum()))
         env.close()
+    assert faces[1] < 0.3 * faces[0], "the renderer draws the simplified model"
     assert np.all(METAWORLD_CROP.contains(clouds[1].astype(np.float64)))
     nearest = np.linalg.norm(clouds[1][:, None] - clouds[0][None], axis=2).min(axis=1)
     assert np.median(nearest) < 0.01, "the simplified scene's points lie on the exact scene"
