@@ -16,7 +16,8 @@ import re
 from pathlib import Path
 from typing import Any
 
-from lerobot.policies.factory import make_pre_post_processors
+from lerobot.configs.policies import PreTrainedConfig
+from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 from lerobot.processor.pipeline import ProcessorStepRegistry
 
 from lerobot_mtdagger.errors import UserError
@@ -25,6 +26,8 @@ from lerobot_mtdagger.quiet import quiet_third_party
 
 PROCESSOR_FILES = ("policy_preprocessor.json", "policy_postprocessor.json")
 POLICY_TYPE = "mtdagger"
+POLICY_TYPES = ("mtdagger", "act", "diffusion")
+"""Policy types this toolkit trains and evaluates (``--policy.type``)."""
 HUB_ID_PATTERN = re.compile(r"[A-Za-z0-9][\w.-]*/[A-Za-z0-9][\w.-]*")
 """``owner/name``: a ``--policy_path`` of this form that is not a local folder is read from the Hub."""
 
@@ -113,7 +116,7 @@ def check_policy_path(path: str | Path) -> None:
 
 
 def check_local_policy(folder: Path) -> None:
-    """Checks that a local folder is a complete ``mtdagger`` policy with readable safetensors files.
+    """Checks that a local folder is a complete policy of ``POLICY_TYPES`` with readable safetensors files.
 
     Raises:
         UserError: If it is a file, a dataset, an experiment, another policy type, or a file of it is
@@ -138,10 +141,10 @@ def check_local_policy(folder: Path) -> None:
         raise UserError(
             f"{config} is not a policy config (unreadable JSON); the checkpoint is corrupt."
         ) from None
-    if policy_type != POLICY_TYPE:
+    if policy_type not in POLICY_TYPES:
         raise UserError(
-            f"{config} describes a {policy_type!r} policy; this command evaluates {POLICY_TYPE!r} policies "
-            "(stock lerobot-eval evaluates the others)."
+            f"{config} describes a {policy_type!r} policy; this command evaluates {list(POLICY_TYPES)} "
+            "policies (stock lerobot-eval evaluates the others)."
         )
     if not (folder / "model.safetensors").is_file():
         raise UserError(f"{folder / 'model.safetensors'} is missing: the checkpoint is incomplete.")
@@ -166,7 +169,7 @@ def _check_safetensors(path: Path) -> None:
 def load_policy(
     path: str | Path, device: str = "cpu", trust_checkpoint: bool = False
 ) -> tuple[Any, Any, Any]:
-    """Loads an ``mtdagger`` policy folder or Hub id with its saved processors, after the checks above.
+    """Loads a policy folder or Hub id (``POLICY_TYPES``) with its saved processors, after the checks above.
 
     Args:
         path: A local policy folder or a Hub repo id.
@@ -204,7 +207,9 @@ def _load_checked(path: str | Path, device: str, trust_checkpoint: bool) -> tupl
         else:
             check_hub_policy(str(path))
     with quiet_third_party():  # LeRobot prints "Loading weights from local directory"
-        policy = MTDAggerPolicy.from_pretrained(str(path))
+        config = PreTrainedConfig.from_pretrained(str(path))
+        policy_class = MTDAggerPolicy if config.type == POLICY_TYPE else get_policy_class(config.type)
+        policy = policy_class.from_pretrained(str(path), config=config)
     policy.config.device = device
     policy.to(device)
     overrides = {"device_processor": {"device": device}}

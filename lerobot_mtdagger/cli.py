@@ -199,7 +199,7 @@ def merge_command(config: MergeConfig) -> Path:
 
 @dataclass
 class EvalConfig:
-    """Options of ``lerobot-mtdagger eval``: success per task of a pretrained ``mtdagger`` policy.
+    """Options of ``lerobot-mtdagger eval``: success per task of a policy (mtdagger, ACT, Diffusion).
 
     Attributes:
         policy_path: Pretrained model folder or Hub id (with its processors).

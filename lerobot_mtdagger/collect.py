@@ -64,6 +64,8 @@ class _Lane:
         worker: Worker running the episode.
         observation: Its latest observation (None until the worker has reset the env).
         start: The episode to start in the next message (None once started).
+        fresh: Whether the learner has not yet acted in the running episode (its next observation
+            is the episode's first: a policy with per-episode state restarts it).
     """
 
     home_task: int
@@ -72,6 +74,7 @@ class _Lane:
     worker: int = 0
     observation: dict[str, np.ndarray] | None = None
     start: EpisodeSpec | None = None
+    fresh: bool = False
 
 
 @dataclass
@@ -224,6 +227,7 @@ def _assign(lanes: list[_Lane], handle: int, schedule: _Schedule, worker_count: 
         lane.task_index = None
         return
     lane.task_index, lane.worker, lane.start = spec.task_index, _least_loaded(lanes, lane, worker_count), spec
+    lane.fresh = True
 
 
 def _least_loaded(lanes: list[_Lane], lane: _Lane, worker_count: int) -> int:
@@ -248,13 +252,23 @@ def _least_loaded(lanes: list[_Lane], lane: _Lane, worker_count: int) -> int:
 def _learner_actions(
     policy: PolicyFn | None, lanes: list[_Lane], members: list[int], task_names: Sequence[str]
 ) -> dict[int, np.ndarray | None]:
-    """The learner's action for each lane of ``members`` with an observation (None: no learner)."""
+    """The learner's action for each lane of ``members`` with an observation (None: no learner).
+
+    A policy with ``tracks_episodes`` (an action queue per episode, ``evaluate.ChunkRunner``) is also
+    told each row's lane and whether it is its episode's first observation.
+    """
     ready = [handle for handle in members if lanes[handle].observation is not None]
     if policy is None or not ready:
         return dict.fromkeys(ready)
     observations = [lanes[handle].observation for handle in ready]
     tasks = [task_names[lanes[handle].task_index] for handle in ready]
-    actions = np.asarray(policy(observations, tasks), dtype=np.float32)
+    if getattr(policy, "tracks_episodes", False):
+        starts = [lanes[handle].fresh for handle in ready]
+        actions = np.asarray(policy(observations, tasks, lanes=ready, starts=starts), dtype=np.float32)
+    else:
+        actions = np.asarray(policy(observations, tasks), dtype=np.float32)
+    for handle in ready:
+        lanes[handle].fresh = False
     return {handle: actions[position] for position, handle in enumerate(ready)}
 
 

@@ -75,6 +75,86 @@ UNSEEN_TASK_DROPOUT = 0.1
 """Task dropout of runs on suites with held-out tasks: one sample in ten trains the shared embedding."""
 
 
+def _lerobot_student(config_class: type) -> type:
+    """``config_class`` (a LeRobot policy config) with the run's training batch size added.
+
+    Every option is LeRobot's own (``--policy.type=act --policy.chunk_size=20``); the learning rate
+    is the policy's ``optimizer_lr`` (its optimiser preset), so a preset's ``policy.lr`` does not
+    apply. Defaults that differ from LeRobot's: ``device=cpu`` (as ``mtdagger``), ``push_to_hub=False``
+    (``push`` uploads), and no pretrained vision backbone (nothing is downloaded during a run; pass
+    ``--policy.pretrained_backbone_weights=...`` where the weights are cached).
+    """
+    extra: list[tuple[str, Any, Any]] = [
+        ("batch_size", int | None, field(default=None)),
+        ("device", str | None, field(default="cpu")),
+        ("push_to_hub", bool, field(default=False)),
+    ]
+    if any(f.name == "pretrained_backbone_weights" for f in dataclasses.fields(config_class)):
+        extra.append(("pretrained_backbone_weights", str | None, field(default=None)))
+    student = dataclasses.make_dataclass(f"{config_class.__name__}Student", extra, bases=(config_class,))
+    student.__doc__ = f"{config_class.__doc__ or config_class.__name__}\n\n{_lerobot_student.__doc__}"
+    return student
+
+
+def _lerobot_student_classes() -> dict[str, type]:
+    """The LeRobot policy types the runner can train as its student, by ``--policy.type``."""
+    from lerobot.policies.act.configuration_act import ACTConfig
+    from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
+
+    return {"act": _lerobot_student(ACTConfig), "diffusion": _lerobot_student(DiffusionConfig)}
+
+
+LEROBOT_STUDENTS: dict[str, type] = _lerobot_student_classes()
+"""``--policy.type`` values other than ``mtdagger``: LeRobot's own policies as the student."""
+
+
+class StudentOptions:
+    """The student policy and its options: ``--policy.type`` (draccus choice type; default ``mtdagger``).
+
+    ``mtdagger`` takes ``PolicyOptions``; ``act`` and ``diffusion`` take LeRobot's own config of that
+    policy (``LEROBOT_STUDENTS``) plus ``batch_size``. A stored config without ``type`` is ``mtdagger``.
+    """
+
+    @classmethod
+    def get_choice_class(cls, name: str) -> type:
+        """The options class of a ``--policy.type``."""
+        return cls.get_known_choices()[name]
+
+    @classmethod
+    def get_known_choices(cls) -> dict[str, type]:
+        """Every ``--policy.type`` and its options class."""
+        return {"mtdagger": PolicyOptions, **LEROBOT_STUDENTS}
+
+    @classmethod
+    def get_choice_name(cls, subcls: type) -> str:
+        """The ``--policy.type`` of an options class.
+
+        Raises:
+            ValueError: If ``subcls`` is not a student's options class.
+        """
+        for name, choice in cls.get_known_choices().items():
+            if choice is subcls:
+                return name
+        raise ValueError(f"{subcls} is not a student policy's options class.")
+
+    @classmethod
+    def default_choice_name(cls) -> str:
+        """``mtdagger``."""
+        return "mtdagger"
+
+
+def student_type(options: Any) -> str:
+    """The ``--policy.type`` of a run's policy options."""
+    return StudentOptions.get_choice_name(type(options))
+
+
+def lerobot_policy_config(options: Any) -> Any:
+    """The plain LeRobot config of a LeRobot student's options (without ``batch_size``)."""
+    base = type(options).__mro__[1]
+    values = {f.name: getattr(options, f.name) for f in dataclasses.fields(base) if f.init}
+    return base(**values)
+
+
 RUN_MODES: tuple[str, ...] = ("dagger", "bc")
 MIXING_MODES: tuple[str, ...] = ("episode", "step")
 """``episode``: one beta coin per episode (the expert or the learner acts throughout); ``step``: a coin
@@ -205,8 +285,10 @@ class RunConfig:
         placement: ``drawers`` suite only: how resets move and recolour the drawers (``kitchen``
             when None, stored as such; ``narrow``: the suite's first ranges, which runs made before
             this option existed used). Refused for other suites.
-        policy: Policy and optimiser options (``policy.lr`` and ``policy.batch_size`` from the preset
-            when unset).
+        policy: The student and its options: ``--policy.type=mtdagger`` (default; ``PolicyOptions``)
+            or a LeRobot policy (``act``, ``diffusion``) with LeRobot's own options plus
+            ``batch_size`` (``StudentOptions``). ``policy.batch_size`` (and for ``mtdagger``
+            ``policy.lr``) come from the preset when unset.
         output_dir: Experiment directory (refused if it exists, unless ``resume``); default
             ``outputs/mtdagger/<preset>-<method>-seed<seed>``.
         seed: Seed of everything (collection, evaluation, training).
@@ -250,7 +332,7 @@ class RunConfig:
     image_size: int = 84
     mesh_detail: float = 1.0
     placement: str | None = None
-    policy: PolicyOptions = field(default_factory=PolicyOptions)
+    policy: StudentOptions = field(default_factory=PolicyOptions)
     output_dir: Path | None = None
     seed: int = 0
     resume: bool = False
@@ -264,6 +346,8 @@ class RunConfig:
             raise ValueError(f"Unknown mode {self.mode!r}; choose one of {list(RUN_MODES)}.")
         for path, value in PRESETS[self.preset].items():
             owner, name = self._field_owner(path)
+            if not hasattr(owner, name):  # policy.lr: a LeRobot student's is its optimizer_lr
+                continue
             if getattr(owner, name) is None:
                 setattr(owner, name, value)
         if self.output_dir is None:
@@ -320,18 +404,40 @@ class RunConfig:
             raise ValueError(f"gain_split must be 'train' or 'heldout', got {self.gain_split!r}.")
         if not 0.0 < self.heldout_fraction < 1.0:
             raise ValueError(f"heldout_fraction must be in (0, 1), got {self.heldout_fraction}.")
-        if self.policy.batch_size <= 0 or not (math.isfinite(self.policy.lr) and self.policy.lr > 0):
+        lr = getattr(self.policy, "lr", getattr(self.policy, "optimizer_lr", None))
+        if self.policy.batch_size <= 0 or not (math.isfinite(lr) and lr > 0):
             raise ValueError(
-                f"policy.batch_size and policy.lr must be finite and > 0, "
-                f"got {self.policy.batch_size}, {self.policy.lr}."
+                f"policy.batch_size and the policy's learning rate must be finite and > 0, "
+                f"got {self.policy.batch_size}, {lr}."
             )
         check_device(self.policy.device)
+        self._check_student()
         if self.placement is not None and self.suite != "drawers":
             raise ValueError(f"placement applies to the drawers suite only; drop it for {self.suite!r}.")
         if self.placement is not None and self.placement not in PLACEMENTS:
             raise ValueError(
                 f"Unknown drawer placement {self.placement!r}; choose one of {sorted(PLACEMENTS)}."
             )
+
+    def _check_student(self) -> None:
+        """Refuses a LeRobot student the runner cannot train (point clouds, temporal ensembling)."""
+        if self.student_type == "mtdagger":
+            return
+        if self.obs_mode == "pointcloud":
+            raise ValueError(
+                f"--policy.type={self.student_type} cannot read point clouds (a LeRobot policy takes "
+                "state and images): use --policy.type=mtdagger or --obs_mode=state|rgb."
+            )
+        if getattr(self.policy, "temporal_ensemble_coeff", None) is not None:
+            raise ValueError(
+                "--policy.temporal_ensemble_coeff is not supported for a DAgger student (its action "
+                "queue is kept per episode): drop it and set --policy.n_action_steps instead."
+            )
+
+    @property
+    def student_type(self) -> str:
+        """``--policy.type``: ``mtdagger`` or a LeRobot policy type."""
+        return student_type(self.policy)
 
     @property
     def is_bc(self) -> bool:
@@ -388,9 +494,20 @@ class RunConfig:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (stored in every round's record)."""
         record = dataclasses.asdict(self)
+        record["policy"] = policy_options_dict(self.policy)
         record["output_dir"] = str(self.output_dir)
         record["scheduler"] = {"type": self.scheduler.type, **self.scheduler.hyperparameters()}
         return record
+
+
+def policy_options_dict(options: Any) -> dict[str, Any]:
+    """JSON-ready policy options: ``mtdagger``'s fields as before (no ``type``), else type + LeRobot's."""
+    if isinstance(options, PolicyOptions):
+        return dataclasses.asdict(options)
+    import draccus
+
+    encoded = draccus.encode(lerobot_policy_config(options))
+    return {"type": student_type(options), "batch_size": options.batch_size, **encoded}
 
 
 def check_device(device: str) -> None:

@@ -58,7 +58,7 @@ from lerobot_mtdagger.configs import RunConfig
 from lerobot_mtdagger.envs import suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.evaluate import EvalResult, PolicyRunner, evaluate
+from lerobot_mtdagger.evaluate import EvalResult, PolicyRunner, evaluate, make_runner
 from lerobot_mtdagger.quiet import quiet_third_party
 from lerobot_mtdagger.records import RoundRecord, round_features
 from lerobot_mtdagger.rounds import ExperimentDir
@@ -289,7 +289,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     staging = ctx.experiment.staging_policy_root(round_index)
     trained.save(staging)
     evaluations = evaluate_student(
-        ctx, PolicyRunner(trained.policy, trained.preprocessor, trained.postprocessor)
+        ctx, make_runner(trained.policy, trained.preprocessor, trained.postprocessor)
     )
     timing = {
         "load_s": loaded - start + trained.prepare_s,

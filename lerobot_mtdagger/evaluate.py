@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -14,24 +15,32 @@ from typing import Any
 
 import numpy as np
 import torch
+from lerobot.utils.constants import OBS_IMAGES
 
 from lerobot_mtdagger.checkpoints import load_policy
 from lerobot_mtdagger.collect import PolicyFn, run_episodes, success_by_task
 from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.policies import TASK_FEATURE, MTDAggerPolicy
 from lerobot_mtdagger.seeds import EVAL_STREAM
 from lerobot_mtdagger.workers import EnvWorkers, Episode
 
 
 class PolicyRunner:
-    """Batched inference: observations + task names -> unnormalised actions (B, action_dim)."""
+    """Batched inference: observations + task names -> unnormalised actions (B, action_dim).
 
-    def __init__(self, policy: MTDAggerPolicy, preprocessor: Any, postprocessor: Any) -> None:
+    ``make_runner`` picks the runner of a policy: this one for ``mtdagger`` (one action per
+    observation), ``ChunkRunner`` for LeRobot policies that act in chunks from a history.
+    """
+
+    tracks_episodes = False
+    """Whether the rollouts must say which running episode each row belongs to (``ChunkRunner``)."""
+
+    def __init__(self, policy: Any, preprocessor: Any, postprocessor: Any) -> None:
         """Wraps a policy in eval mode with its processors."""
         self.policy = policy.eval()
         self.preprocessor = preprocessor
         self.postprocessor = postprocessor
-        self.input_keys = list(policy.config.input_features)
+        self.input_keys = [key for key in policy.config.input_features if key != TASK_FEATURE]
         self.image_keys = set(policy.config.image_features)
 
     @classmethod
@@ -40,12 +49,15 @@ class PolicyRunner:
     ) -> PolicyRunner:
         """Loads a pretrained model folder or Hub id with its saved processors (``load_policy``).
 
+        Returns:
+            The runner of its policy type (``make_runner``).
+
         Raises:
             UntrustedCheckpointError: If a processor config names code and the checkpoint is not trusted.
-            UserError: If the path is not a complete ``mtdagger`` policy folder or a reachable Hub
-                policy, naming the path or file and the fix.
+            UserError: If the path is not a complete policy folder or a reachable Hub policy, naming
+                the path or file and the fix.
         """
-        return cls(*load_policy(path, device, trust_checkpoint))
+        return make_runner(*load_policy(path, device, trust_checkpoint))
 
     def check_inputs(self, suite_features: dict[str, dict[str, Any]], obs_mode: str) -> None:
         """Refuses a suite whose observations do not match the policy's inputs (key and shape).
@@ -53,8 +65,8 @@ class PolicyRunner:
         Raises:
             UserError: Naming the input, both shapes and the option to change.
         """
-        for key, feature in self.policy.config.input_features.items():
-            given = suite_features.get(key)
+        for key in self.input_keys:
+            feature, given = self.policy.config.input_features[key], suite_features.get(key)
             if given is None:
                 raise UserError(
                     f"The policy takes {key!r}, which --obs_mode={obs_mode} does not give (it gives "
@@ -89,6 +101,12 @@ class PolicyRunner:
         Raises:
             KeyError: If an input the policy was trained on is missing.
         """
+        with torch.inference_mode():
+            action = self.postprocessor(self.policy.select_action(self.preprocess(inputs, tasks)))
+        return action.cpu()
+
+    def preprocess(self, inputs: dict[str, torch.Tensor], tasks: Sequence[str]) -> dict[str, Any]:
+        """The policy's normalised batch for raw inputs (images to float CHW in [0, 1], as LeRobot's)."""
         batch: dict[str, Any] = {}
         for key in self.input_keys:
             tensor = inputs[key]
@@ -97,8 +115,113 @@ class PolicyRunner:
             batch[key] = tensor.float()
         batch["task"] = list(tasks)
         with torch.inference_mode():
-            action = self.postprocessor(self.policy.select_action(self.preprocessor(batch)))
-        return action.cpu()
+            return self.preprocessor(batch)
+
+
+class ChunkRunner(PolicyRunner):
+    """A LeRobot policy that acts in chunks (ACT, Diffusion Policy), one action queue PER EPISODE.
+
+    LeRobot's ``select_action`` keeps one queue for its whole batch, but the episodes of a rollout
+    batch start and end at different steps. Here each running episode (a rollout lane) has its own
+    observation history (``n_obs_steps``, the first observation repeated at the start, as LeRobot
+    does) and its own queue of the chunk's first ``n_action_steps`` actions; the policy is queried,
+    batched, for the episodes whose queue is empty. Called without lanes (``shift``, a plain call),
+    every row is a fresh episode: the first action of a new chunk.
+    """
+
+    tracks_episodes = True
+
+    def __init__(self, policy: Any, preprocessor: Any, postprocessor: Any) -> None:
+        """Wraps a LeRobot policy in eval mode with its processors."""
+        super().__init__(policy, preprocessor, postprocessor)
+        deltas = policy.config.observation_delta_indices
+        self.history_length = 1 if deltas is None else len(deltas)
+        self.action_steps = int(policy.config.n_action_steps)
+        self.histories: dict[int, deque[dict[str, torch.Tensor]]] = {}
+        self.queues: dict[int, deque[torch.Tensor]] = {}
+
+    def __call__(
+        self,
+        observations: list[dict[str, np.ndarray]],
+        tasks: list[str],
+        lanes: Sequence[int] | None = None,
+        starts: Sequence[bool] | None = None,
+    ) -> np.ndarray:
+        """Actions for a batch of running episodes.
+
+        Args:
+            observations: One observation per row.
+            tasks: Task name of each row.
+            lanes: The running episode (rollout lane) of each row (None: every row a fresh episode).
+            starts: Whether the row is its episode's first observation (its lane's queue restarts).
+        """
+        if lanes is None:
+            self.reset()
+            lanes, starts = range(len(observations)), [True] * len(observations)
+        inputs = {
+            key: torch.from_numpy(np.stack([observation[key] for observation in observations]))
+            for key in self.input_keys
+        }
+        batch = self.preprocess(inputs, tasks)
+        keys = [key for key in batch if key.startswith("observation.")]
+        for row, (lane, start) in enumerate(
+            zip(lanes, starts if starts is not None else [False] * len(lanes), strict=True)
+        ):
+            self._remember(lane, start, {key: batch[key][row] for key in keys})
+        self._refill([lane for lane in lanes if not self.queues[lane]])
+        return np.stack([self.queues[lane].popleft().numpy() for lane in lanes])
+
+    def reset(self) -> None:
+        """Forgets every episode's history and queue."""
+        self.histories.clear()
+        self.queues.clear()
+
+    def _remember(self, lane: int, start: bool, observation: dict[str, torch.Tensor]) -> None:
+        """Adds an episode's newest observation to its history (a new episode restarts it)."""
+        if start or lane not in self.histories:
+            self.histories[lane] = deque([observation] * self.history_length, maxlen=self.history_length)
+            self.queues[lane] = deque()
+        else:
+            self.histories[lane].append(observation)
+
+    def _refill(self, lanes: Sequence[int]) -> None:
+        """Queries the policy, batched, for the next chunk of the episodes in ``lanes``."""
+        if not lanes:
+            return
+        keys = list(self.histories[lanes[0]][0])
+        if self.history_length == 1:
+            batch = {key: torch.stack([self.histories[lane][0][key] for lane in lanes]) for key in keys}
+        else:
+            batch = {
+                key: torch.stack(
+                    [torch.stack([frame[key] for frame in self.histories[lane]]) for lane in lanes]
+                )
+                for key in keys
+            }
+        with torch.inference_mode():
+            chunk = self._predict_chunk(batch)[:, : self.action_steps]
+            actions = self.postprocessor(chunk).cpu()
+        for lane, lane_actions in zip(lanes, actions, strict=True):
+            self.queues[lane].extend(lane_actions)
+
+    def _history(self, lane: int, key: str) -> torch.Tensor:
+        """An episode's history of one input, (n_obs_steps, ...)."""
+        return torch.stack([frame[key] for frame in self.histories[lane]])
+
+    def _predict_chunk(self, batch: dict[str, torch.Tensor]) -> torch.Tensor:
+        """The policy's normalised action chunk (B, n, action_dim) for current observations or histories."""
+        if self.history_length == 1:
+            return self.policy.predict_action_chunk(batch)
+        image_keys = list(self.policy.config.image_features)
+        if image_keys:
+            batch = {**batch, OBS_IMAGES: torch.stack([batch[key] for key in image_keys], dim=-4)}
+        return self.policy.diffusion.generate_actions(batch)
+
+
+def make_runner(policy: Any, preprocessor: Any, postprocessor: Any) -> PolicyRunner:
+    """The runner of a policy: ``PolicyRunner`` for ``mtdagger``, ``ChunkRunner`` for LeRobot's."""
+    runner_class = PolicyRunner if isinstance(policy, MTDAggerPolicy) else ChunkRunner
+    return runner_class(policy, preprocessor, postprocessor)
 
 
 @dataclass

@@ -34,11 +34,12 @@ from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.datasets.utils import dataset_to_policy_features
 from tqdm import tqdm
 
-from lerobot_mtdagger.configs import RunConfig
+from lerobot_mtdagger.configs import UNSEEN_TASK_DROPOUT, PolicyOptions, RunConfig
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.evaluate import PolicyRunner
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
+from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE
 from lerobot_mtdagger.records import PhaseRecord
 from lerobot_mtdagger.sampling import systematic_picks
 from lerobot_mtdagger.seeds import HELDOUT_STREAM, TRAINING_STREAM, stream_seed
@@ -455,6 +456,49 @@ def make_optimizer(policy: MTDAggerPolicy, lr: float) -> torch.optim.AdamW:
     )
 
 
+class MTDAggerOps:
+    """The training seam for the ``mtdagger`` policy (``students.LeRobotOps`` for LeRobot's).
+
+    A step's loss is ``policy.imitation_loss`` (the first step of each log interval calls the full
+    ``policy.forward``: same loss and gradient, with per-task losses logged at debug level); the
+    per-task loss is the action MSE of ``policy.predict``; the optimiser is a fused AdamW.
+    """
+
+    def __init__(self, policy: MTDAggerPolicy, data: NormalisedData, lr: float) -> None:
+        """Remembers the policy, its frames and the learning rate."""
+        self.policy = policy
+        self.data = data
+        self.lr = lr
+
+    def step_loss(self, index: torch.Tensor, first_of_interval: bool) -> torch.Tensor:
+        """The imitation loss on the frames at ``index``."""
+        batch = self.data.batch(index)
+        if not first_of_interval:
+            return self.policy.imitation_loss(batch, task_index=batch["task_index"])
+        loss, info = self.policy.forward(batch)
+        info = info or {}
+        logger.debug("loss %s, per task %s", info.get("loss"), info.get("per_task_loss"))
+        return loss
+
+    def task_losses(self, index: torch.Tensor, num_tasks: int) -> tuple[list, list]:
+        """Mean action MSE per task (``per_task_loss``)."""
+        return per_task_loss(self.policy, self.data, index, num_tasks)
+
+    def optimizer(self, steps: int) -> tuple[torch.optim.Optimizer, Any, float]:
+        """Fused AdamW (``make_optimizer``), no scheduler, the config's gradient clip norm."""
+        del steps
+        return make_optimizer(self.policy, self.lr), None, self.policy.config.optimizer_grad_clip_norm
+
+
+def phase_ops(policy: Any, data: NormalisedData, options: StepOptions) -> Any:
+    """The training seam of ``policy``: ``MTDAggerOps`` or ``students.LeRobotOps``."""
+    if isinstance(policy, MTDAggerPolicy):
+        return MTDAggerOps(policy, data, options.lr)
+    from lerobot_mtdagger.students import LeRobotOps
+
+    return LeRobotOps(policy, data, options.task_dropout, options.seed)
+
+
 @dataclass(frozen=True)
 class PlateauStop:
     """Ends a phase when the loss on held-out frames stops improving (``steps_rule=plateau``).
@@ -477,9 +521,10 @@ class PlateauStop:
 class _PlateauTracker:
     """The held-out loss curve of a phase and the weights of its minimum."""
 
-    def __init__(self, stop: PlateauStop, policy: MTDAggerPolicy, data: NormalisedData):
+    def __init__(self, stop: PlateauStop, ops: Any, data: NormalisedData):
         self.stop = stop
-        self.policy = policy
+        self.ops = ops
+        self.policy = ops.policy
         self.data = data
         self.curve: list[list[float]] = []
         self.best_loss = math.inf
@@ -489,7 +534,7 @@ class _PlateauTracker:
 
     def measure(self, step: int) -> bool:
         """Measures the held-out loss after ``step`` steps; True when the phase should end."""
-        losses, _ = per_task_loss(self.policy, self.data, self.stop.index, len(self.data.task_names))
+        losses, _ = self.ops.task_losses(self.stop.index, len(self.data.task_names))
         self.policy.train()
         measured = [loss for loss in losses if loss is not None]
         mean = float(np.mean(measured))
@@ -543,6 +588,7 @@ class StepOptions:
         plateau: End the phase when the held-out loss stops improving and keep the weights of its
             minimum (None: train all ``steps``).
         log_interval: Steps between two reads of the loss.
+        task_dropout: A LeRobot student's task dropout (``mtdagger``'s is in its config).
     """
 
     steps: int
@@ -552,6 +598,7 @@ class StepOptions:
     sampling: str = "uniform"
     plateau: PlateauStop | None = None
     log_interval: int = LOG_INTERVAL
+    task_dropout: float = 0.0
 
 
 def train_phase(
@@ -595,14 +642,14 @@ def train_phase(
     steps, log_interval, plateau = options.steps, options.log_interval, options.plateau
     _check_phase_inputs(policy, data, log_interval, plateau)
     num_tasks = len(data.task_names)
-    loss_start, _ = per_task_loss(policy, data, loss_index, num_tasks)
+    ops = phase_ops(policy, data, options)
+    loss_start, _ = ops.task_losses(loss_index, num_tasks)
     generator = torch.Generator().manual_seed(options.seed)
     draw = batch_sampler(train_index, data.data.task_index, options.sampling, generator)
-    optimizer = make_optimizer(policy, options.lr)
+    optimizer, scheduler, clip_norm = ops.optimizer(steps)
     parameters = [p for p in policy.parameters() if p.requires_grad]
-    clip_norm = policy.config.optimizer_grad_clip_norm
     size = min(options.batch_size, len(train_index))
-    tracker = None if plateau is None else _PlateauTracker(plateau, policy, data)
+    tracker = None if plateau is None else _PlateauTracker(plateau, ops, data)
     stopped = tracker is not None and tracker.measure(0)
     policy.train()
     losses = _LossWindow(on_step)
@@ -613,18 +660,15 @@ def train_phase(
         if offset == 0:
             # One interval's batch indices at once, drawn on the CPU (device independent).
             picks = draw((min(log_interval, steps - done), size)).to(data.device)
-        batch = data.batch(picks[offset])
+        loss = ops.step_loss(picks[offset], first_of_interval=offset == 0)
         if offset == 0:
-            loss, info = policy.forward(batch)
             _check_finite(loss.detach().reshape(1), done)
-            info = info or {}
-            logger.debug("step %d: loss %s, per task %s", done, info.get("loss"), info.get("per_task_loss"))
-        else:
-            loss = policy.imitation_loss(batch, task_index=batch["task_index"])
         optimizer.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(parameters, clip_norm, foreach=True)
         optimizer.step()
+        if scheduler is not None:
+            scheduler.step()
         losses.add(loss)
         done += 1
         if offset == log_interval - 1 or done == steps:
@@ -634,7 +678,7 @@ def train_phase(
             stopped = tracker.measure(done)
     if tracker is not None:
         tracker.restore_best()
-    loss_end, counts = per_task_loss(policy, data, loss_index, num_tasks)
+    loss_end, counts = ops.task_losses(loss_index, num_tasks)
     return PhaseResult(
         loss_start=loss_start,
         loss_end=loss_end,
@@ -648,12 +692,17 @@ def train_phase(
 
 
 def _check_phase_inputs(
-    policy: MTDAggerPolicy, data: NormalisedData, log_interval: int, plateau: PlateauStop | None
+    policy: Any, data: NormalisedData, log_interval: int, plateau: PlateauStop | None
 ) -> None:
     """Refuses a policy of other tasks, a log interval < 1 and a plateau stop without held-out frames."""
-    if list(policy.config.task_names) != data.task_names:
+    task_names = getattr(policy.config, "task_names", None)
+    if task_names is not None and list(task_names) != data.task_names:
+        raise UserError(f"The policy's tasks {task_names} differ from the data's {data.task_names}.")
+    task_vector = policy.config.input_features.get(TASK_FEATURE)
+    if task_names is None and (task_vector is None or task_vector.shape != (len(data.task_names),)):
         raise UserError(
-            f"The policy's tasks {policy.config.task_names} differ from the data's {data.task_names}."
+            f"The policy reads no one-hot task vector over the data's {len(data.task_names)} tasks "
+            f"({TASK_FEATURE}: {task_vector}); build it with students.lerobot_student_config."
         )
     if log_interval < 1:
         raise ValueError(f"log_interval must be >= 1, got {log_interval}.")
@@ -744,10 +793,41 @@ class RoundCache:
 
 def student_config(
     config: RunConfig, features: dict[str, Any], task_names: Sequence[str], unseen: bool
-) -> MTDAggerConfig:
-    """The student's policy config for a run on a suite's ``features`` (``unseen``: it has held-out tasks)."""
-    task_dropout = config.policy.resolved_task_dropout(unseen)
-    return policy_config(features, task_names, config.policy, config.policy.device, task_dropout)
+) -> Any:
+    """The student's policy config for a run on a suite's ``features`` (``unseen``: it has held-out tasks).
+
+    An ``MTDAggerConfig`` for ``--policy.type=mtdagger``, else a ``students.LeRobotStudentConfig``
+    (task dropout ``UNSEEN_TASK_DROPOUT`` on a suite with held-out tasks, else 0).
+    """
+    if isinstance(config.policy, PolicyOptions):
+        task_dropout = config.policy.resolved_task_dropout(unseen)
+        return policy_config(features, task_names, config.policy, config.policy.device, task_dropout)
+    from lerobot_mtdagger.students import lerobot_student_config
+
+    return lerobot_student_config(config.policy, features, task_names, UNSEEN_TASK_DROPOUT if unseen else 0.0)
+
+
+def _new_student(policy_cfg: Any, stats: dict[str, dict[str, np.ndarray]]) -> tuple[Any, Any, Any]:
+    """A freshly initialised student and its processors for ``stats``."""
+    if isinstance(policy_cfg, MTDAggerConfig):
+        return MTDAggerPolicy(policy_cfg), *build_processors(policy_cfg, stats)
+    from lerobot_mtdagger.students import make_lerobot_processors, make_lerobot_student
+
+    return make_lerobot_student(policy_cfg), *make_lerobot_processors(policy_cfg, stats)
+
+
+def _previous_losses(
+    runner: PolicyRunner, normalised: NormalisedData, index: torch.Tensor, options: StepOptions
+) -> list[float | None]:
+    """The previous phase's policy's per-task loss on this phase's loss frames (performance gain's start).
+
+    ``mtdagger``: the MSE of its actions (through its own processors) in this phase's normalisation;
+    a LeRobot student: its own training loss on this phase's normalised frames.
+    """
+    num_tasks = len(normalised.task_names)
+    if isinstance(runner.policy, MTDAggerPolicy):
+        return per_task_loss_of(runner.predict, normalised, index, num_tasks)
+    return phase_ops(runner.policy, normalised, options).task_losses(index, num_tasks)[0]
 
 
 @dataclass
@@ -814,7 +894,7 @@ class TrainedPhase:
 
 def train_on_rounds(
     config: RunConfig,
-    policy_cfg: MTDAggerConfig,
+    policy_cfg: Any,
     data: TrainingData,
     round_index: int,
     previous: Path | None,
@@ -842,23 +922,21 @@ def train_on_rounds(
     )
     stats = compute_stats(data.subset(normalisation_frames(config, data, split.train)), image_keys)
     torch.manual_seed(phase_seed)
-    policy = MTDAggerPolicy(policy_cfg)
+    policy, preprocessor, postprocessor = _new_student(policy_cfg, stats)
     runner = None if previous is None else PolicyRunner.from_pretrained(previous, config.policy.device)
     if runner is not None and config.warm_start:
         policy.load_state_dict(runner.policy.state_dict())
-    preprocessor, postprocessor = build_processors(policy_cfg, stats)
     normalised = NormalisedData(data, preprocessor, image_keys, list(policy_cfg.task_names))
-    loss_previous = None
-    if runner is not None:
-        loss_previous = per_task_loss_of(runner.predict, normalised, split.loss, len(policy_cfg.task_names))
     options = StepOptions(
         steps=config.phase_steps(len(split.train)),
         batch_size=config.policy.batch_size,
-        lr=config.policy.lr,
+        lr=getattr(config.policy, "lr", None) or config.policy.optimizer_lr,
         seed=phase_seed,
         sampling=config.sampling,
         plateau=plateau_stop(config, split),
+        task_dropout=getattr(policy_cfg, "task_dropout", 0.0),
     )
+    loss_previous = None if runner is None else _previous_losses(runner, normalised, split.loss, options)
     prepared = time.perf_counter()
     with tqdm(
         total=options.steps, desc=f"round {round_index} train", leave=False, disable=not show_progress

@@ -1,6 +1,7 @@
 """LeRobot policy plugins (``--policy.discover_packages_path=lerobot_mtdagger.policies``).
 
-Importing this package registers the ``mtdagger`` policy type with LeRobot.
+Importing this package registers the ``mtdagger`` policy type with LeRobot, and the processor step
+that gives LeRobot policies trained as students their one-hot task vector (``task_conditioning``).
 """
 
 from lerobot_mtdagger.policies.mtdagger import (
@@ -8,5 +9,12 @@ from lerobot_mtdagger.policies.mtdagger import (
     MTDAggerPolicy,
     make_mtdagger_pre_post_processors,
 )
+from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE, TaskOneHotProcessorStep
 
-__all__ = ["MTDAggerConfig", "MTDAggerPolicy", "make_mtdagger_pre_post_processors"]
+__all__ = [
+    "TASK_FEATURE",
+    "MTDAggerConfig",
+    "MTDAggerPolicy",
+    "TaskOneHotProcessorStep",
+    "make_mtdagger_pre_post_processors",
+]

@@ -1,0 +1,229 @@
+"""LeRobot's own policies (ACT, Diffusion Policy) as the DAgger student: config, batches, losses.
+
+The runner trains its student through one seam (``train.PhaseOps``): a training batch at given
+frames, the loss of one step, the per-task imitation loss and the optimiser. ``mtdagger`` has its
+fast implementation in ``train.py``; ``LeRobotOps`` here implements it for any LeRobot
+``PreTrainedPolicy`` of ``configs.LEROBOT_STUDENTS`` from what LeRobot's policies declare:
+
+- **Windows of frames**, as LeRobot's ``delta_timestamps`` give them: a frame's observation history
+  (``observation_delta_indices``: Diffusion's ``n_obs_steps``) and its action chunk
+  (``action_delta_indices``: ACT's ``chunk_size``, Diffusion's ``horizon``), taken within the frame's
+  episode, clamped at its ends, with ``action_is_pad`` where a chunk runs past them. DAgger frames
+  are labelled by the expert at every state the rollout visited, so a chunk is the expert's labels
+  at the next states of the same rollout.
+- **The task** as a one-hot ``observation.environment_state`` (``policies.task_conditioning``),
+  zeroed with probability ``task_dropout`` in training (the "any task" input unseen tasks get).
+- **The step's loss** is the policy's own ``forward`` loss; the **per-task imitation loss** (what
+  performance gain and the plateau stop measure) is that same loss per task, measured without
+  gradients under a fixed seed (ACT's VAE and dropout, Diffusion's noise draw are random), so the
+  same weights always measure the same.
+- **The optimiser and scheduler** are the policy config's presets (``get_optimizer_preset``,
+  ``get_scheduler_preset``) over ``get_optim_params()``, as ``lerobot-train`` builds them, with the
+  preset's gradient clipping; the scheduler runs over the phase's steps.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import torch
+from lerobot.configs.types import FeatureType, PolicyFeature
+from lerobot.datasets.utils import dataset_to_policy_features
+from lerobot.policies.factory import get_policy_class, make_pre_post_processors
+
+from lerobot_mtdagger.configs import lerobot_policy_config
+from lerobot_mtdagger.policies.task_conditioning import (
+    TASK_FEATURE,
+    TaskOneHotProcessorStep,
+    task_feature,
+    task_one_hot,
+)
+
+LOSS_CHUNK = 256
+"""Frames per forward pass when measuring a LeRobot student's per-task loss."""
+
+
+@dataclass
+class LeRobotStudentConfig:
+    """A LeRobot student: its LeRobot policy config and the run's tasks.
+
+    Attributes:
+        policy: The LeRobot policy config, with the suite's observations and the one-hot task vector
+            as inputs.
+        task_names: The training tasks, in the order of the one-hot positions.
+        task_dropout: Probability of zeroing a training frame's task vector.
+    """
+
+    policy: Any
+    task_names: list[str]
+    task_dropout: float
+
+    @property
+    def input_features(self) -> dict[str, PolicyFeature]:
+        """The observations the student reads from the suite (without the task vector)."""
+        return {k: f for k, f in self.policy.input_features.items() if k != TASK_FEATURE}
+
+    @property
+    def image_features(self) -> dict[str, PolicyFeature]:
+        """The image inputs."""
+        return dict(self.policy.image_features)
+
+
+def lerobot_student_config(
+    options: Any, suite_features: dict[str, Any], task_names: Sequence[str], task_dropout: float
+) -> LeRobotStudentConfig:
+    """The LeRobot student of a run's ``--policy.type=act|diffusion`` options for a suite.
+
+    Raises:
+        ValueError: If the policy refuses the features (LeRobot's own check names what is missing).
+    """
+    config = lerobot_policy_config(options)
+    features = dataset_to_policy_features(suite_features)
+    config.input_features = {k: f for k, f in features.items() if f.type is not FeatureType.ACTION}
+    config.input_features[TASK_FEATURE] = task_feature(len(task_names))
+    config.output_features = {
+        "action": PolicyFeature(type=FeatureType.ACTION, shape=features["action"].shape)
+    }
+    config.validate_features()
+    return LeRobotStudentConfig(policy=config, task_names=list(task_names), task_dropout=task_dropout)
+
+
+def make_lerobot_student(spec: LeRobotStudentConfig) -> Any:
+    """A freshly initialised LeRobot policy of ``spec`` (seed torch before for reproducible weights)."""
+    return get_policy_class(spec.policy.type)(spec.policy)
+
+
+def make_lerobot_processors(spec: LeRobotStudentConfig, stats: dict[str, dict[str, Any]]) -> tuple[Any, Any]:
+    """LeRobot's processors of the policy type, with the one-hot task step first in the pre-processor."""
+    preprocessor, postprocessor = make_pre_post_processors(spec.policy, dataset_stats=stats)
+    preprocessor.steps.insert(0, TaskOneHotProcessorStep(spec.task_names))
+    return preprocessor, postprocessor
+
+
+class EpisodeWindows:
+    """Frame indices of each frame's observation history and action chunk within its episode.
+
+    Frames of one episode must be consecutive (as round datasets store them).
+    """
+
+    def __init__(
+        self, episode_id: torch.Tensor, observation_deltas: Sequence[int] | None, action_deltas: Sequence[int]
+    ) -> None:
+        """Finds each frame's episode bounds.
+
+        Raises:
+            ValueError: If an episode's frames are not consecutive.
+        """
+        count = len(episode_id)
+        starts_here = torch.ones(count, dtype=torch.bool)
+        if count:
+            starts_here[1:] = episode_id[1:] != episode_id[:-1]
+        first = torch.nonzero(starts_here).flatten()
+        if len(torch.unique(episode_id[first])) != len(first):
+            raise ValueError("An episode's frames are not consecutive; windows need them in order.")
+        lengths = torch.diff(torch.cat([first, torch.tensor([count])]))
+        self.start = torch.repeat_interleave(first, lengths)
+        self.end = torch.repeat_interleave(first + lengths - 1, lengths)
+        self.observation_deltas = (
+            None if observation_deltas is None else torch.tensor(list(observation_deltas))
+        )
+        self.action_deltas = torch.tensor(list(action_deltas))
+
+    def observations(self, index: torch.Tensor) -> torch.Tensor | None:
+        """(B, n_obs) history indices, clamped to the episode (None: the policy reads one frame)."""
+        if self.observation_deltas is None:
+            return None
+        return self._clamped(index, self.observation_deltas)[0]
+
+    def actions(self, index: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """(B, H) chunk indices clamped to the episode, and where they ran past it (``action_is_pad``)."""
+        return self._clamped(index, self.action_deltas)
+
+    def _clamped(self, index: torch.Tensor, deltas: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        wanted = index[:, None] + deltas[None, :]
+        low, high = self.start[index][:, None], self.end[index][:, None]
+        clamped = torch.minimum(torch.maximum(wanted, low), high)
+        return clamped, (wanted < low) | (wanted > high)
+
+
+class LeRobotOps:
+    """The training seam for a LeRobot policy (see the module docstring).
+
+    Args:
+        policy: The LeRobot policy.
+        data: The phase's normalised frames (``train.NormalisedData``).
+        task_dropout: Probability of zeroing a training frame's task vector.
+        seed: Seed of the task dropout and of the loss measurements.
+    """
+
+    def __init__(self, policy: Any, data: Any, task_dropout: float, seed: int) -> None:
+        """Prepares the frame windows of ``data``."""
+        self.policy = policy
+        self.data = data
+        self.task_dropout = task_dropout
+        self.seed = seed
+        self.generator = torch.Generator().manual_seed(seed)
+        config = policy.config
+        self.windows = EpisodeWindows(
+            data.data.episode_id, config.observation_delta_indices, config.action_delta_indices
+        )
+        self.observation_keys = [k for k in config.input_features if k != TASK_FEATURE]
+        self.num_tasks = int(config.input_features[TASK_FEATURE].shape[0])
+
+    def batch(self, index: torch.Tensor, dropout: bool = True) -> dict[str, torch.Tensor]:
+        """The training batch at frames ``index``: windows of normalised inputs, chunk, task vector."""
+        index = index.cpu()
+        history = self.windows.observations(index)
+        rows = index if history is None else history
+        batch: dict[str, torch.Tensor] = {}
+        for key in self.observation_keys:
+            if key in self.data.image_keys:
+                images = self.data.data.inputs[key][rows].to(self.data.device)
+                batch[key] = images.movedim(-1, -3).float() / 255.0
+            else:
+                batch[key] = self.data.vector[key][rows.to(self.data.device)]
+        tasks = self.data.data.task_index[index].clone()
+        if dropout and self.task_dropout > 0:
+            tasks[torch.rand(len(tasks), generator=self.generator) < self.task_dropout] = -1
+        vector = task_one_hot(tasks, self.num_tasks).to(self.data.device)
+        batch[TASK_FEATURE] = vector if history is None else vector[:, None].expand(-1, history.shape[1], -1)
+        chunk, pad = self.windows.actions(index)
+        batch["action"] = self.data.vector["action"][chunk.to(self.data.device)]
+        batch["action_is_pad"] = pad.to(self.data.device)
+        return batch
+
+    def step_loss(self, index: torch.Tensor, first_of_interval: bool) -> torch.Tensor:
+        """The policy's own training loss on the frames at ``index``."""
+        del first_of_interval  # LeRobot's forward is the only loss
+        loss, _ = self.policy.forward(self.batch(index))
+        return loss
+
+    @torch.no_grad()
+    def task_losses(self, index: torch.Tensor, num_tasks: int) -> tuple[list, list]:
+        """The policy's loss per task over frames ``index`` (None where none) and the frame counts."""
+        was_training = self.policy.training
+        self.policy.train()  # ACT's loss needs its VAE encoder, which runs in training mode only
+        sums = torch.zeros(num_tasks, dtype=torch.float64)
+        counts = torch.zeros(num_tasks, dtype=torch.float64)
+        task_of = self.data.data.task_index
+        with torch.random.fork_rng(devices=[]):
+            torch.manual_seed(self.seed)
+            for task in torch.unique(task_of[index.cpu()]).tolist():
+                frames = index.cpu()[task_of[index.cpu()] == task]
+                for chunk in torch.split(frames, LOSS_CHUNK):
+                    loss, _ = self.policy.forward(self.batch(chunk, dropout=False))
+                    sums[task] += float(loss) * len(chunk)
+                    counts[task] += len(chunk)
+        self.policy.train(was_training)
+        losses = [float(sums[i] / counts[i]) if counts[i] > 0 else None for i in range(num_tasks)]
+        return losses, [int(c) for c in counts.tolist()]
+
+    def optimizer(self, steps: int) -> tuple[torch.optim.Optimizer, Any, float]:
+        """The policy config's optimiser and scheduler presets (over ``steps``) and gradient clip norm."""
+        preset = self.policy.config.get_optimizer_preset()
+        optimizer = preset.build(self.policy.get_optim_params())
+        schedule = self.policy.config.get_scheduler_preset()
+        scheduler = None if schedule is None else schedule.build(optimizer, steps)
+        return optimizer, scheduler, float(preset.grad_clip_norm)
