@@ -335,3 +335,30 @@ def test_policy_options_are_lerobots_own_and_mtdagger_stays_the_default():
 def test_a_student_the_runner_cannot_train_is_refused_before_anything_runs(options, message):
     with pytest.raises(UserError, match=message):
         parse_options(RunConfig, options, "t")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("student", [TINY_ACT, TINY_DIFFUSION], ids=["act", "diffusion"])
+def test_a_lerobot_student_runs_on_a_metaworld_state_subset(tmp_path, student):
+    root = tmp_path / "run"
+    lines = run(
+        draccus.parse(
+            RunConfig,
+            args=[
+                "--tasks=[reach-v3,button-press-topdown-v3,push-v3]",
+                "--rounds=1",
+                "--steps_per_round=40",
+                "--eval_episodes=1",
+                "--max_rollout_steps=60",
+                "--policy.batch_size=64",
+                "--progress=false",
+                "--workers=1",
+                f"--output_dir={root}",
+                *student,
+            ],
+        )
+    )
+    assert len(lines) == 2
+    assert verify_experiment(ExperimentDir(root))[2] == []
+    runner = PolicyRunner.from_pretrained(ExperimentDir(root).policy_root(1))
+    assert isinstance(runner, ChunkRunner) and runner.input_keys == ["observation.state"]
