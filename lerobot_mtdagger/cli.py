@@ -570,7 +570,8 @@ def configure_console_logging() -> None:
     console = logging.StreamHandler()
     console.setLevel(logging.WARNING)
     console.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
-    logging.basicConfig(level=logging.INFO, handlers=[console])
+    # force: a library may have configured the root logger already (LeRobot logs at import time).
+    logging.basicConfig(level=logging.INFO, handlers=[console], force=True)
     logging.getLogger(HUB_LOGGER).setLevel(logging.ERROR)
 
 

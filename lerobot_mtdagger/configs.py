@@ -23,6 +23,7 @@ a step (classic DAgger; the paper's text is ambiguous): 0.5 in the first DAgger 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 from dataclasses import dataclass, field
@@ -96,23 +97,24 @@ def _lerobot_student(config_class: type) -> type:
     return student
 
 
-def _lerobot_student_classes() -> dict[str, type]:
-    """The LeRobot policy types the runner can train as its student, by ``--policy.type``."""
+LEROBOT_STUDENT_TYPES: tuple[str, ...] = ("act", "diffusion")
+"""``--policy.type`` values other than ``mtdagger``: LeRobot's own policies as the student."""
+
+
+@functools.cache
+def lerobot_students() -> dict[str, type]:
+    """The options class of each LeRobot student type (LeRobot's policies imported on first use)."""
     from lerobot.policies.act.configuration_act import ACTConfig
     from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
 
     return {"act": _lerobot_student(ACTConfig), "diffusion": _lerobot_student(DiffusionConfig)}
 
 
-LEROBOT_STUDENTS: dict[str, type] = _lerobot_student_classes()
-"""``--policy.type`` values other than ``mtdagger``: LeRobot's own policies as the student."""
-
-
 class StudentOptions:
     """The student policy and its options: ``--policy.type`` (draccus choice type; default ``mtdagger``).
 
     ``mtdagger`` takes ``PolicyOptions``; ``act`` and ``diffusion`` take LeRobot's own config of that
-    policy (``LEROBOT_STUDENTS``) plus ``batch_size``. A stored config without ``type`` is ``mtdagger``.
+    policy (``lerobot_students()``) plus ``batch_size``. A stored config without ``type`` is ``mtdagger``.
     """
 
     @classmethod
@@ -123,7 +125,7 @@ class StudentOptions:
     @classmethod
     def get_known_choices(cls) -> dict[str, type]:
         """Every ``--policy.type`` and its options class."""
-        return {"mtdagger": PolicyOptions, **LEROBOT_STUDENTS}
+        return {"mtdagger": PolicyOptions, **lerobot_students()}
 
     @classmethod
     def get_choice_name(cls, subcls: type) -> str:
@@ -145,6 +147,8 @@ class StudentOptions:
 
 def student_type(options: Any) -> str:
     """The ``--policy.type`` of a run's policy options."""
+    if isinstance(options, PolicyOptions):
+        return "mtdagger"
     return StudentOptions.get_choice_name(type(options))
 
 

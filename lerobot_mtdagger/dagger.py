@@ -60,7 +60,7 @@ from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.evaluate import EvalResult, PolicyRunner, evaluate, make_runner
 from lerobot_mtdagger.quiet import quiet_third_party
-from lerobot_mtdagger.records import RoundRecord, round_features
+from lerobot_mtdagger.records import RoundRecord
 from lerobot_mtdagger.rounds import ExperimentDir
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
 from lerobot_mtdagger.seeds import COLLECT_STREAM
@@ -181,7 +181,7 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
     collected = time.perf_counter()
     dataset = ctx.experiment.write_round(
         round_index,
-        round_features(ctx.suite.features),
+        ctx.experiment.round_features(ctx.suite.features),
         ctx.task_names,
         [(ctx.task_names[episode.task_index], episode.frames) for episode in episodes],
     )

@@ -44,6 +44,22 @@ LEARNER_ACTED = "learner_acted"
 DAGGER_ROUND = "dagger_round"
 """Per frame: the DAgger round the frame was collected in (int64, shape (1,))."""
 
+INTERVENTION = "intervention"
+"""Per frame, in LeRobot's name (its DAgger rollouts mark expert frames so): the EXPERT's action was
+executed (bool, shape (1,); ``not learner_acted``)."""
+
+NEXT_REWARD = "next.reward"
+"""Per frame, as ``lerobot-eval`` records it: the env's reward for this frame's executed action."""
+
+NEXT_SUCCESS = "next.success"
+"""Per frame, as ``lerobot-eval`` records it: the env reported success after this frame's action."""
+
+NEXT_DONE = "next.done"
+"""Per frame, as ``lerobot-eval`` records it: the episode ended after this frame's action (its last frame)."""
+
+EPISODE_SUCCESS = "success"
+"""Per episode, in ``meta/episodes``: whether the env reported success at any step of the episode."""
+
 # The names avoid the "action" and "observation" prefixes, which LeRobot would turn into policy
 # outputs and inputs.
 _FLAG_FEATURES: dict[str, dict[str, Any]] = {
@@ -51,21 +67,62 @@ _FLAG_FEATURES: dict[str, dict[str, Any]] = {
     DAGGER_ROUND: {"dtype": "int64", "shape": (1,), "names": None},
 }
 
+_PROVENANCE_FEATURES: dict[str, dict[str, Any]] = {
+    INTERVENTION: {"dtype": "bool", "shape": (1,), "names": None},
+    NEXT_REWARD: {"dtype": "float32", "shape": (1,), "names": None},
+    NEXT_SUCCESS: {"dtype": "bool", "shape": (1,), "names": None},
+    NEXT_DONE: {"dtype": "bool", "shape": (1,), "names": None},
+}
 
-def round_features(suite_features: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
-    """The features of a round dataset: the suite's, ``executed_action`` and the DAgger flags."""
+
+def round_features(
+    suite_features: dict[str, dict[str, Any]], provenance: bool = True
+) -> dict[str, dict[str, Any]]:
+    """The features of a round dataset: the suite's, ``executed_action``, the DAgger flags, provenance.
+
+    The provenance columns (``provenance``) are LeRobot's ``intervention`` and ``next.*``. Rounds of
+    an experiment started before they existed are written without them (``provenance=False``), so
+    all its rounds share one schema.
+    """
     action = suite_features["action"]
     executed = {"dtype": action["dtype"], "shape": tuple(action["shape"]), "names": action["names"]}
-    return {**suite_features, EXECUTED_ACTION: executed, **_FLAG_FEATURES}
+    extra = _PROVENANCE_FEATURES if provenance else {}
+    return {**suite_features, EXECUTED_ACTION: executed, **_FLAG_FEATURES, **extra}
 
 
-def dagger_columns(executed_action: np.ndarray, learner_acted: bool, round_index: int) -> dict[str, Any]:
-    """The DAgger columns of one frame (added beside the observation and the expert's ``action``)."""
+@dataclass(frozen=True)
+class StepOutcome:
+    """What the env returned for a frame's executed action.
+
+    Attributes:
+        reward: The env's reward.
+        success: Whether the env reported success.
+        done: Whether the episode ended with this step.
+    """
+
+    reward: float
+    success: bool
+    done: bool
+
+
+def dagger_columns(
+    executed_action: np.ndarray, learner_acted: bool, round_index: int, outcome: StepOutcome
+) -> dict[str, Any]:
+    """The DAgger and provenance columns of one frame (beside the observation and the expert's ``action``)."""
     return {
         EXECUTED_ACTION: np.asarray(executed_action, dtype=np.float32),
         LEARNER_ACTED: np.array([learner_acted]),
         DAGGER_ROUND: np.array([round_index], dtype=np.int64),
+        INTERVENTION: np.array([not learner_acted]),
+        NEXT_REWARD: np.array([outcome.reward], dtype=np.float32),
+        NEXT_SUCCESS: np.array([outcome.success]),
+        NEXT_DONE: np.array([outcome.done]),
     }
+
+
+def has_provenance(features: Mapping[str, Any]) -> bool:
+    """Whether a round's features hold the provenance columns (rounds written before them do not)."""
+    return INTERVENTION in features
 
 
 # -------------------------------------------------------------------------------------------------

@@ -21,9 +21,11 @@ from datasets.features.features import numpy_to_pyarrow_listarray
 from datasets.table import cast_array_to_feature
 from lerobot.datasets.compute_stats import RunningQuantileStats, compute_episode_stats, get_feature_stats
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
-from lerobot.datasets.utils import DEFAULT_FEATURES, update_chunk_file_indices, validate_frame
+from lerobot.datasets.utils import update_chunk_file_indices
 
+from lerobot_mtdagger.lerobot_compat import DEFAULT_FEATURES, unsaved_frames, validate_frame
 from lerobot_mtdagger.quiet import quiet_third_party
+from lerobot_mtdagger.records import EPISODE_SUCCESS, NEXT_SUCCESS
 
 logger = logging.getLogger(__name__)
 
@@ -59,7 +61,7 @@ def write_round_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFram
         ValueError: If the dataset already holds episodes, a frame does not match the features, or an
             episode has no frame.
     """
-    if dataset.meta.total_episodes != 0 or (dataset.episode_buffer or {}).get("size", 0) > 0:
+    if dataset.meta.total_episodes != 0 or unsaved_frames(dataset) > 0:
         raise ValueError(
             f"write_round_episodes needs an empty, freshly created dataset; {dataset.root} already holds "
             f"{dataset.meta.total_episodes} episode(s) or unsaved frames."
@@ -69,9 +71,37 @@ def write_round_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFram
             for task, frames in episodes:
                 for frame in frames:
                     dataset.add_frame({**frame, "task": task})
-                dataset.save_episode()
+                save_episode_with_success(dataset, frames)
             return
         _write_vector_episodes(dataset, episodes)
+
+
+def episode_success_metadata(columns: Mapping[str, Any]) -> dict[str, bool]:
+    """The ``meta/episodes`` success of an episode's ``next.success`` column ({} without one)."""
+    if NEXT_SUCCESS not in columns:
+        return {}
+    return {EPISODE_SUCCESS: bool(np.any(np.asarray(columns[NEXT_SUCCESS])))}
+
+
+def save_episode_with_success(dataset: LeRobotDataset, frames: Sequence[Mapping[str, Any]]) -> None:
+    """``dataset.save_episode()`` with the episode's success added to its ``meta/episodes`` row.
+
+    LeRobot's ``save_episode`` builds the row itself; its metadata call is wrapped for this one episode.
+    """
+    if not frames or NEXT_SUCCESS not in frames[0]:
+        dataset.save_episode()
+        return
+    extra = episode_success_metadata({NEXT_SUCCESS: [frame[NEXT_SUCCESS] for frame in frames]})
+    save = dataset.meta.save_episode
+
+    def save_with_success(index: int, length: int, tasks: list[str], stats: dict, metadata: dict) -> None:
+        save(index, length, tasks, stats, {**metadata, **extra})
+
+    dataset.meta.save_episode = save_with_success
+    try:
+        dataset.save_episode()
+    finally:
+        del dataset.meta.save_episode  # back to the class's method
 
 
 def _episode_buffer(
@@ -268,6 +298,7 @@ def _write_vector_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFr
                     "data/file_index": file_index,
                     "dataset_from_index": int(buffer["index"][0]),
                     "dataset_to_index": int(buffer["index"][-1]) + 1,
+                    **episode_success_metadata(buffer),
                 }
                 dataset.meta.save_episode(episode_index, length, [task], stats, metadata)
                 offset += length

@@ -47,7 +47,14 @@ from lerobot.datasets.utils import update_chunk_file_indices
 from lerobot_mtdagger.errors import CorruptExperimentError, NotAnExperimentError, UserError
 from lerobot_mtdagger.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.quiet import quiet_third_party
-from lerobot_mtdagger.records import FORMAT_VERSION, RECORD_KEY, PhaseRecord, RoundRecord
+from lerobot_mtdagger.records import (
+    FORMAT_VERSION,
+    RECORD_KEY,
+    PhaseRecord,
+    RoundRecord,
+    has_provenance,
+    round_features,
+)
 from lerobot_mtdagger.round_writer import EpisodeFrames, write_round_episodes
 
 logger = logging.getLogger(__name__)
@@ -142,6 +149,11 @@ def adds_dagger_rounds(stored: Mapping[str, Any], given: Mapping[str, Any]) -> b
         and all(isinstance(r, int) for r in rounds)
         and rounds[1] > rounds[0]
     )
+
+
+def _only(frame: Mapping[str, Any], features: Mapping[str, Any]) -> dict[str, Any]:
+    """The frame's values of ``features`` (a round without provenance columns drops them)."""
+    return {key: value for key, value in frame.items() if key in features}
 
 
 class ExperimentDir:
@@ -446,8 +458,19 @@ class ExperimentDir:
             ValueError: If a frame does not match the features or an episode has no frame.
         """
         dataset = self.create_round(round_index, features, task_names)
-        write_round_episodes(dataset, episodes)
+        kept = [(task, [_only(frame, features) for frame in frames]) for task, frames in episodes]
+        write_round_episodes(dataset, kept)
         return dataset
+
+    def round_features(self, suite_features: dict[str, Any]) -> dict[str, Any]:
+        """The features of this experiment's next round (``records.round_features``).
+
+        With the provenance columns, unless round 0 was written without them: an experiment started
+        before they existed keeps one schema.
+        """
+        first = self.round_root(0) / INFO_FILE
+        provenance = not first.is_file() or has_provenance(json.loads(first.read_text())["features"])
+        return round_features(suite_features, provenance=provenance)
 
     def commit_round(self, round_index: int, dataset: LeRobotDataset, record: RoundRecord) -> Path:
         """Finalises a staged round, writes its record (its file and info.json's mirror), commits it.

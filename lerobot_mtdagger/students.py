@@ -3,7 +3,7 @@
 The runner trains its student through one seam (``train.PhaseOps``): a training batch at given
 frames, the loss of one step, the per-task imitation loss and the optimiser. ``mtdagger`` has its
 fast implementation in ``train.py``; ``LeRobotOps`` here implements it for any LeRobot
-``PreTrainedPolicy`` of ``configs.LEROBOT_STUDENTS`` from what LeRobot's policies declare:
+``PreTrainedPolicy`` of ``configs.lerobot_students()`` from what LeRobot's policies declare:
 
 - **Windows of frames**, as LeRobot's ``delta_timestamps`` give them: a frame's observation history
   (``observation_delta_indices``: Diffusion's ``n_obs_steps``) and its action chunk
@@ -30,10 +30,10 @@ from typing import Any
 
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
-from lerobot.datasets.utils import dataset_to_policy_features
 from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 
 from lerobot_mtdagger.configs import lerobot_policy_config
+from lerobot_mtdagger.lerobot_compat import dataset_to_policy_features
 from lerobot_mtdagger.policies.task_conditioning import (
     TASK_FEATURE,
     TaskOneHotProcessorStep,

@@ -31,12 +31,12 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
-from lerobot.datasets.utils import dataset_to_policy_features
 from tqdm import tqdm
 
 from lerobot_mtdagger.configs import UNSEEN_TASK_DROPOUT, PolicyOptions, RunConfig
 from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.evaluate import PolicyRunner
+from lerobot_mtdagger.lerobot_compat import dataset_to_policy_features
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE

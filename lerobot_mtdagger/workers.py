@@ -45,7 +45,7 @@ from lerobot_mtdagger.mixing import (
     expert_episode_coin,
     step_limit,
 )
-from lerobot_mtdagger.records import dagger_columns
+from lerobot_mtdagger.records import StepOutcome, dagger_columns
 
 logger = logging.getLogger(__name__)
 
@@ -285,10 +285,8 @@ class RolloutWorker:
         expert_action = running.expert.act(running.privileged) if running.expert is not None else None
         expert_acts = expert_acts_now(rules, learner_action is not None, running.expert_episode, running.rng)
         executed = expert_action if expert_acts else learner_action
-        if rules.record:
-            columns = dagger_columns(executed, learner_acted=not expert_acts, round_index=rules.round_index)
-            episode.frames.append({**running.observation, "action": expert_action, **columns})
-        running.observation, _, terminated, truncated, info = running.env.step(executed)
+        observation = running.observation
+        running.observation, reward, terminated, truncated, info = running.env.step(executed)
         running.privileged = info["privileged_state"]
         episode.steps += 1
         episode.learner_steps += int(not expert_acts)
@@ -298,9 +296,14 @@ class RolloutWorker:
             running.steps_since_success = 0
         elif episode.success:
             running.steps_since_success += 1
-        return bool(terminated or truncated) or episode_ends(
+        ended = bool(terminated or truncated) or episode_ends(
             rules, episode.steps, running.max_steps, running.steps_since_success
         )
+        if rules.record:
+            outcome = StepOutcome(reward=float(reward), success=bool(info["success"]), done=ended)
+            columns = dagger_columns(executed, not expert_acts, rules.round_index, outcome)
+            episode.frames.append({**observation, "action": expert_action, **columns})
+        return ended
 
 
 def _expert_steps_to_success(env: Any, expert: Any, reset_seed: int) -> int | None:

@@ -22,8 +22,8 @@ import pytest
 
 from lerobot_mtdagger import quiet
 from lerobot_mtdagger.quiet import quiet_third_party
-from lerobot_mtdagger.records import dagger_columns, round_features
-from lerobot_mtdagger.round_writer import _vector_episode_stats
+from lerobot_mtdagger.records import StepOutcome, dagger_columns, round_features
+from lerobot_mtdagger.round_writer import _vector_episode_stats, save_episode_with_success
 from lerobot_mtdagger.rounds import ExperimentDir, round_name
 
 hf_tqdm = importlib.import_module("datasets.utils.tqdm")
@@ -264,7 +264,12 @@ def _episodes(rng, lengths, pointcloud: bool = True, round_index: int = 1) -> li
             frame = {
                 "observation.state": rng.standard_normal(39).astype(np.float32),
                 "action": np.array([0.5, -1.0, t, 0.0], dtype=np.float32),  # constant and ramp columns
-                **dagger_columns(rng.standard_normal(4), bool(rng.random() < 0.5), round_index),
+                **dagger_columns(
+                    rng.standard_normal(4),
+                    bool(rng.random() < 0.5),
+                    round_index,
+                    StepOutcome(float(rng.random()), t == length - 1, t == length - 1),
+                ),
             }
             if pointcloud:
                 frame["observation.environment_state"] = rng.standard_normal((8, 6)).astype(np.float32)
@@ -310,7 +315,7 @@ def _write_with_lerobot_loop(experiment: ExperimentDir, round_index: int, featur
         for task, frames in episodes:
             for frame in frames:
                 dataset.add_frame({**frame, "task": task})
-            dataset.save_episode()
+            save_episode_with_success(dataset, frames)  # LeRobot's save_episode, success in meta/episodes
     return experiment.commit_round(round_index, dataset, _record_stub())
 
 
@@ -469,7 +474,7 @@ def test_write_round_with_images_takes_lerobots_path_quietly(tmp_path, capfd):
                 {
                     "observation.image": rng.integers(0, 255, (8, 8, 3), dtype=np.uint8),
                     "action": rng.standard_normal(2).astype(np.float32),
-                    **dagger_columns(rng.standard_normal(2), True, 1),
+                    **dagger_columns(rng.standard_normal(2), True, 1, StepOutcome(0.0, False, False)),
                 }
                 for _ in range(3)
             ],

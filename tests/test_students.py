@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 import torch
 
-from lerobot_mtdagger.configs import LEROBOT_STUDENTS, RunConfig
+from lerobot_mtdagger.configs import RunConfig, lerobot_students
 from lerobot_mtdagger.dagger import run
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.errors import UserError
@@ -310,7 +310,7 @@ def test_the_per_task_loss_of_a_lerobot_student_is_reproducible(act_run):
 
 
 def test_policy_options_are_lerobots_own_and_mtdagger_stays_the_default():
-    assert set(LEROBOT_STUDENTS) == {"act", "diffusion"}
+    assert set(lerobot_students()) == {"act", "diffusion"}
     default = parse_options(RunConfig, [], "t")
     assert default.student_type == "mtdagger" and "type" not in default.to_dict()["policy"]
     act = parse_options(

@@ -394,3 +394,60 @@ def test_nan_loss_is_an_error_and_committed_rounds_survive(tmp_path, monkeypatch
     monkeypatch.undo()
     run(toy_config(tmp_path / "exp", "--rounds=1", "--resume=true"))
     assert experiment.committed_phases() == [0, 1]
+
+
+def test_rounds_carry_provenance_in_lerobots_column_names(tmp_path):
+    """intervention, next.reward / next.success / next.done per frame; success per episode."""
+    import pyarrow.parquet as pq
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    from lerobot_mtdagger.records import INTERVENTION, NEXT_DONE, NEXT_REWARD, NEXT_SUCCESS
+
+    run(toy_config(tmp_path / "run", "--rounds=1"))
+    experiment = ExperimentDir(tmp_path / "run")
+    for k in (0, 1):
+        root = experiment.round_root(k)
+        frames = pq.read_table(sorted((root / "data").glob("*/*.parquet"))).to_pandas()
+        episodes = pq.read_table(sorted((root / "meta" / "episodes").glob("*/*.parquet"))).to_pandas()
+        assert (frames[INTERVENTION] == ~frames[LEARNER_ACTED]).all()
+        assert frames[INTERVENTION].all() if k == 0 else not frames[INTERVENTION].all()
+        last = frames.groupby("episode_index")["frame_index"].transform("max") == frames["frame_index"]
+        assert (frames[NEXT_DONE] == last).all()
+        reached = frames.groupby("episode_index")[NEXT_SUCCESS].any()
+        assert (
+            episodes.set_index("episode_index")["success"].sort_index().tolist()
+            == reached.sort_index().tolist()
+        )
+        assert np.isfinite(frames[NEXT_REWARD]).all()
+        assert LeRobotDataset("local/round", root=root)[0][NEXT_SUCCESS].dtype == torch.bool
+    record = experiment.read_round_record(0)
+    assert sum(record.expert_success[i] * record.rollout_episodes[i] for i in range(3)) == pytest.approx(
+        episodes_success_total(experiment.round_root(0))
+    )
+    assert verify_experiment(experiment) == (2, 2, [])
+
+
+def episodes_success_total(root) -> int:
+    import pyarrow.parquet as pq
+
+    return int(
+        pq.read_table(sorted((root / "meta" / "episodes").glob("*/*.parquet")))["success"].to_numpy().sum()
+    )
+
+
+def test_an_experiment_started_without_provenance_columns_keeps_its_schema(tmp_path, suite):
+    from lerobot_mtdagger.records import INTERVENTION, StepOutcome, dagger_columns
+
+    experiment = ExperimentDir(tmp_path / "old")
+    old_features = round_features(suite.features, provenance=False)
+    frame = {
+        "observation.state": np.zeros(suite.features["observation.state"]["shape"], np.float32),
+        "action": np.zeros(2, np.float32),
+        **dagger_columns(np.zeros(2), False, 0, StepOutcome(0.0, False, True)),
+    }
+    experiment.initialise({"seed": 0})
+    staged = experiment.write_round(0, old_features, TASKS, [(TASKS[0], [frame])])  # provenance dropped
+    assert INTERVENTION not in staged.features
+    experiment.commit_round(0, staged, minimal_record(0, [1, 0, 0]))
+    assert INTERVENTION not in experiment.round_features(suite.features)
+    assert INTERVENTION in ExperimentDir(tmp_path / "new").round_features(suite.features)

@@ -20,8 +20,7 @@ from typing import Any
 
 import torch
 from lerobot.configs.types import FeatureType, PipelineFeatureType, PolicyFeature
-from lerobot.processor import ProcessorStep, ProcessorStepRegistry
-from lerobot.processor.core import EnvTransition, TransitionKey
+from lerobot.processor import EnvTransition, ProcessorStep, ProcessorStepRegistry, TransitionKey
 
 TASK_FEATURE = "observation.environment_state"
 """The input a LeRobot student reads its task from (one-hot over the training tasks)."""
