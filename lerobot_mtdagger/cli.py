@@ -468,7 +468,8 @@ def report_command(config: ReportConfig) -> str:
     """
     if config.results:
         return _report_saved_tables(config)
-    from lerobot_mtdagger.report import check_comparable, learning_curves, markdown_table, run_progress
+    from lerobot_mtdagger.report import curves_table
+    from lerobot_mtdagger.results import check_comparable, learning_curves, run_progress
 
     all_roots, labels = config.experiment_dirs, config.labels  # each lists the run folders once
     configs = check_comparable(all_roots, labels)
@@ -487,7 +488,7 @@ def report_command(config: ReportConfig) -> str:
             f"None of the {len(progress)} run(s) has a committed round yet: report once the first "
             "round is written."
         )
-    table = _print_table(markdown_table(learning_curves(roots, labels)), config)
+    table = _print_table(curves_table(learning_curves(roots, labels)), config)
     if config.output_dir is not None:
         from lerobot_mtdagger.results import results_rows, write_results
         from lerobot_mtdagger.rounds import ExperimentDir
@@ -501,11 +502,11 @@ def report_command(config: ReportConfig) -> str:
 
 def _report_saved_tables(config: ReportConfig) -> str:
     """``report --results``: the table, figures and summary of saved results tables, joined."""
-    from lerobot_mtdagger.report import curves_from_rows, markdown_table
+    from lerobot_mtdagger.report import curves_from_rows, curves_table
     from lerobot_mtdagger.results import merge_tables, read_results
 
     saved = merge_tables([read_results(path) for path in config.results])
-    table = _print_table(markdown_table(curves_from_rows(saved.rows)), config)
+    table = _print_table(curves_table(curves_from_rows(saved.rows)), config)
     _write_figures(saved.rows, saved.task_names, config, saved.unfinished)
     return table
 

@@ -335,8 +335,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     if unknown:
         raise UserError(f"Unknown method(s) {unknown} in --methods; choose among {list(known)}.")
     from lerobot_mtdagger.envs import suite_from_config
-    from lerobot_mtdagger.report import check_comparable
-    from lerobot_mtdagger.results import results_rows, write_results
+    from lerobot_mtdagger.results import check_comparable, results_rows, write_results
 
     task_names = suite_from_config(base_run_config(run_args)).task_names
     jobs = jobs_for(compare_config, run_args, len(task_names))

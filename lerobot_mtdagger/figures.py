@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.markdown import markdown_table
 from lerobot_mtdagger.report import is_bc
 from lerobot_mtdagger.results import PHASE_TIMINGS
 from lerobot_mtdagger.stats import Interval, correlation, demos_to_reach, mean_interval, paired_difference
@@ -68,7 +69,7 @@ def runs_by_method(rows: Sequence[Row]) -> dict[str, dict[int, list[Row]]]:
 def point_columns(seeds: dict[int, list[Row]]) -> list[list[Row]]:
     """The seeds' rows grouped point by point: one column per (round, mean demos per task), in order.
 
-    Every seed of a finished method has the same points (``report.check_comparable``); a run still
+    Every seed of a finished method has the same points (``results.check_comparable``); a run still
     being written, or BC run at fewer budgets for one seed, has fewer, and its columns hold fewer
     seeds.
     """
@@ -397,9 +398,8 @@ def reach_lines(rows: Sequence[Row], levels: Sequence[float]) -> list[str]:
         "Per task, at the first crossing of each seed's curve (interpolated; BC: along its budgets), mean "
         "over the seeds that reached the level with its 95% t interval; k/n: seeds that reached it.",
         "",
-        "| method | level | expert demos per task | expert-labelled frames per task | seeds |",
-        "|---|---:|---:|---:|---:|",
     ]
+    table = []
     for method, seeds in runs_by_method(rows).items():
         for level in levels:
             demos = [seed_reach(curve, level, demos_of) for curve in seeds.values()]
@@ -410,10 +410,9 @@ def reach_lines(rows: Sequence[Row], levels: Sequence[float]) -> list[str]:
                 demo_interval = mean_interval([d for d, _ in reached])
                 frame_interval = mean_interval([f for _, f in reached])
                 cells = [_format_amount(demo_interval, "{:.1f}"), _format_amount(frame_interval, "{:.0f}")]
-            lines.append(
-                f"| {method} | {level:.0%} | {cells[0]} | {cells[1]} | {len(reached)}/{len(demos)} |"
-            )
-    return lines + [""]
+            table.append([method, f"{level:.0%}", *cells, f"{len(reached)}/{len(demos)}"])
+    header = ["method", "level", "expert demos per task", "expert-labelled frames per task", "seeds"]
+    return [*lines, markdown_table(header, table, "lrrrr"), ""]
 
 
 def _format_amount(interval: Interval, pattern: str) -> str:
@@ -434,13 +433,12 @@ def task_gap_lines(rows: Sequence[Row], hardest: Sequence[int]) -> list[str]:
         "BC on them is biased in the method's favour (regression to the mean); against Uniform "
         "DAgger it is not.",
         "",
-        "| method | baseline | demos per task | hardest tasks | other tasks |",
-        "|---|---|---:|---|---|",
     ]
     task_count = len(rows[0]["eval_success"]) if rows else 0
     if task_count <= len(hardest):
         return lines[:2] + [f"Not shown: with {task_count} task(s), no task is left besides the hardest.", ""]
     grouped = runs_by_method(rows)
+    table = []
     for method, baseline in comparison_pairs(rows):
         if method not in grouped or baseline not in grouped:
             continue
@@ -454,9 +452,10 @@ def task_gap_lines(rows: Sequence[Row], hardest: Sequence[int]) -> list[str]:
             hard.append(float(difference[list(hardest)].mean()))
             other.append(float(np.delete(difference, list(hardest)).mean()))
         if hard:
-            cells = f"{format_difference(mean_interval(hard))} | {format_difference(mean_interval(other))}"
-            lines.append(f"| {method} | {baseline} | {budget:.1f} | {cells} |")
-    return lines + [""]
+            differences = [format_difference(mean_interval(hard)), format_difference(mean_interval(other))]
+            table.append([method, baseline, f"{budget:.1f}", *differences])
+    header = ["method", "baseline", "demos per task", "hardest tasks", "other tasks"]
+    return [*lines, markdown_table(header, table, "llrll"), ""]
 
 
 def _budgets(seeds: dict[int, list[Row]]) -> set[float]:
@@ -471,9 +470,8 @@ def stability_lines(rows: Sequence[Row]) -> list[str]:
         "rounds; the mean absolute change of a seed's success from one round to the next; the "
         "share of those changes that are drops.",
         "",
-        "| method | std over seeds (mean over rounds) | round-to-round change | drops |",
-        "|---|---:|---:|---:|",
     ]
+    table = []
     for method, seeds in runs_by_method(rows).items():
         curves = [[row["eval_success_mean"] for row in curve] for curve in seeds.values()]
         if any(is_bc(curve[0]) for curve in seeds.values()) or len(curves) < 2:
@@ -483,8 +481,9 @@ def stability_lines(rows: Sequence[Row]) -> list[str]:
         changes = np.concatenate([np.diff(curve) for curve in curves])
         drops = float(np.mean(changes < 0)) if changes.size else math.nan
         mean_change = float(np.mean(np.abs(changes))) if changes.size else math.nan
-        lines.append(f"| {method} | {spread:.3f} | {mean_change:.3f} | {drops:.0%} |")
-    return lines + [""]
+        table.append([method, f"{spread:.3f}", f"{mean_change:.3f}", f"{drops:.0%}"])
+    header = ["method", "std over seeds (mean over rounds)", "round-to-round change", "drops"]
+    return [*lines, markdown_table(header, table, "lrrr"), ""]
 
 
 def cost_lines(rows: Sequence[Row]) -> list[str]:
@@ -494,15 +493,15 @@ def cost_lines(rows: Sequence[Row]) -> list[str]:
         "Wall time of the committed phases (collect + write + load + train + eval; start-up not "
         "counted), from each phase's record. A BC run is one budget of one seed.",
         "",
-        "| method | runs | phase time per run, mean (s) | all runs (min) |",
-        "|---|---:|---:|---:|",
     ]
+    table = []
     for method in runs_by_method(rows):
         method_rows = [row for row in rows if row["method"] == method]
         seconds = sum(sum(row[name] for name in PHASE_TIMINGS) for row in method_rows)
         runs = len({row["experiment"] for row in method_rows})
-        lines.append(f"| {method} | {runs} | {seconds / runs:.0f} | {seconds / 60:.1f} |")
-    return lines + [""]
+        table.append([method, runs, f"{seconds / runs:.0f}", f"{seconds / 60:.1f}"])
+    header = ["method", "runs", "phase time per run, mean (s)", "all runs (min)"]
+    return [*lines, markdown_table(header, table, "lrrr"), ""]
 
 
 def unseen_lines(rows: Sequence[Row]) -> list[str]:
@@ -519,9 +518,6 @@ def unseen_lines(rows: Sequence[Row]) -> list[str]:
         "Mean over seeds (95% t interval) after each phase; unseen = held-out tasks, acted on with the "
         "policy's shared task embedding. Progress: 0-3.",
         "",
-        "| method | demos per task | in-domain success | unseen success | in-domain progress "
-        "| unseen progress |",
-        "|---|---:|---|---|---|---|",
     ]
 
     def cell(column: list[Row], key: str) -> str:
@@ -533,14 +529,14 @@ def unseen_lines(rows: Sequence[Row]) -> list[str]:
             return f"{interval.mean:.3f}"
         return f"{interval.mean:.3f} [{interval.low:.3f}, {interval.high:.3f}]"
 
+    table = []
+    keys = ("eval_success_mean", "unseen_success_mean", "eval_progress_mean", "unseen_progress_mean")
     for method, seeds in runs_by_method(rows).items():
         for column in point_columns(seeds):
             demos = float(np.mean([row["demos_per_task_mean"] for row in column]))
-            keys = ("eval_success_mean", "unseen_success_mean", "eval_progress_mean", "unseen_progress_mean")
-            lines.append(
-                f"| {method} | {demos:.1f} | " + " | ".join(cell(column, key) for key in keys) + " |"
-            )
-    return lines + [""]
+            table.append([method, f"{demos:.1f}", *(cell(column, key) for key in keys)])
+    header = ["method", "demos per task", "in-domain success", "unseen success", "in-domain progress"]
+    return [*lines, markdown_table([*header, "unseen progress"], table, "lrllll"), ""]
 
 
 def interim_lines(unfinished: Sequence[str]) -> list[str]:
@@ -564,22 +560,23 @@ def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[
     lines += [f"Pearson r, metric vs final success: {notes['correlations']}.", ""]
     lines += [f"Hardest tasks: {notes['hardest']}.", ""]
     lines += ["## Paired differences of average success (method - baseline), 95% t interval over seeds", ""]
-    lines += ["`*`: the interval excludes 0.", "", "| method | baseline | demos per task | difference |"]
-    lines += ["|---|---|---:|---|"]
+    lines += ["`*`: the interval excludes 0.", ""]
     pairs = comparison_pairs(rows)
-    for method, baseline in pairs:
-        for budget, interval in paired_rows(rows, method, baseline):
-            lines.append(f"| {method} | {baseline} | {budget:.1f} | {format_difference(interval)} |")
-    lines += ["", "## Demos needed to reach a level, ratio method / baseline (mean over paired seeds)", ""]
-    lines += [
-        "| method | baseline | level | ratio | seeds where both reached it |",
-        "|---|---|---:|---:|---:|",
+    differences = [
+        [method, baseline, f"{budget:.1f}", format_difference(interval)]
+        for method, baseline in pairs
+        for budget, interval in paired_rows(rows, method, baseline)
     ]
+    lines.append(markdown_table(["method", "baseline", "demos per task", "difference"], differences, "llrl"))
+    lines += ["", "## Demos needed to reach a level, ratio method / baseline (mean over paired seeds)", ""]
+    ratios = []
     for method, baseline in pairs:
         for level in levels:
             ratio, paired, seeds = demos_ratio(rows, method, baseline, level)
             shown = "n/a" if ratio is None else f"{ratio:.2f}"
-            lines.append(f"| {method} | {baseline} | {level:.0%} | {shown} | {paired}/{seeds} |")
+            ratios.append([method, baseline, f"{level:.0%}", shown, f"{paired}/{seeds}"])
+    header = ["method", "baseline", "level", "ratio", "seeds where both reached it"]
+    lines.append(markdown_table(header, ratios, "llrrr"))
     lines += ["", *reach_lines(rows, levels), *task_gap_lines(rows, notes["hardest_indices"])]
     lines += [*unseen_lines(rows), *stability_lines(rows), *cost_lines(rows)]
     return "\n".join(lines) + "\n"

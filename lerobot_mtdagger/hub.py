@@ -36,6 +36,7 @@ from huggingface_hub import DatasetCardData, HfApi
 
 from lerobot_mtdagger.datasets_cards import card_template
 from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.markdown import markdown_table
 from lerobot_mtdagger.records import PhaseRecord, RoundRecord
 from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir, round_name
 
@@ -65,27 +66,22 @@ def card_metadata_yaml() -> str:
 
 
 def _cell(value: Any) -> str:
-    """A markdown table cell: pipes escaped, floats with three decimals, None as ``n/a``."""
+    """A card table cell: floats with three decimals, None as ``n/a`` (pipes are escaped by the table)."""
     if value is None:
         return NOT_AVAILABLE
     if isinstance(value, float):
         return f"{value:.3f}"
-    return str(value).replace("|", "\\|")
+    return str(value)
 
 
-def markdown_table(header: Sequence[Any], rows: Sequence[Sequence[Any]]) -> str:
-    """A GitHub-flavoured markdown table."""
-    lines = [
-        "| " + " | ".join(_cell(h) for h in header) + " |",
-        "|" + "|".join("---" for _ in header) + "|",
-    ]
-    lines += ["| " + " | ".join(_cell(v) for v in row) + " |" for row in rows]
-    return "\n".join(lines)
+def card_table(header: Sequence[Any], rows: Sequence[Sequence[Any]]) -> str:
+    """A card's markdown table: floats with three decimals, None as ``n/a`` (``markdown.markdown_table``)."""
+    return markdown_table([_cell(h) for h in header], [[_cell(v) for v in row] for row in rows])
 
 
 def task_table(task_names: Sequence[str]) -> str:
     """Table of the task vocabulary: task_index and name."""
-    return markdown_table(["task_index", "task"], [[i, name] for i, name in enumerate(task_names)])
+    return card_table(["task_index", "task"], [[i, name] for i, name in enumerate(task_names)])
 
 
 def revision_table(records: Sequence[RoundRecord]) -> str:
@@ -93,7 +89,7 @@ def revision_table(records: Sequence[RoundRecord]) -> str:
     rows = [
         [r.round, f"`{round_name(r.round)}`", sum(r.episodes_per_task), r.frames, r.beta] for r in records
     ]
-    return markdown_table(["round", "revision", "episodes", "frames", "beta"], rows)
+    return card_table(["round", "revision", "episodes", "frames", "beta"], rows)
 
 
 def allocation_table(task_names: Sequence[str], records: Sequence[RoundRecord]) -> str:
@@ -101,7 +97,7 @@ def allocation_table(task_names: Sequence[str], records: Sequence[RoundRecord]) 
     header = ["task", *(f"round {r.round}" for r in records)]
     rows = [[name, *(r.episodes_per_task[i] for r in records)] for i, name in enumerate(task_names)]
     rows.append(["**total**", *(sum(r.episodes_per_task) for r in records)])
-    return markdown_table(header, rows)
+    return card_table(header, rows)
 
 
 def eval_table(task_names: Sequence[str], evals: dict[int, dict[str, Any] | None]) -> str:
@@ -130,7 +126,7 @@ def eval_table(task_names: Sequence[str], evals: dict[int, dict[str, Any] | None
     )
     if episodes:
         note += f", over {'/'.join(map(str, episodes))} evaluation episode(s) per task"
-    return f"{note}.\n\n{markdown_table(header, rows)}"
+    return f"{note}.\n\n{card_table(header, rows)}"
 
 
 def _phase_eval(experiment: ExperimentDir, round_index: int) -> dict[str, Any] | None:

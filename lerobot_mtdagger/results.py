@@ -6,7 +6,9 @@ scheduler's signals at that point and the wall time of the round. ``write_result
 as CSV (list columns as JSON) and JSON next to the runs, with the task names, the config each
 method's runs share and, for a study in progress, its unfinished runs in ``results_meta.json``.
 ``read_results`` reads them back and ``merge_tables`` joins tables made apart (other seeds, other
-machines), so a report can be drawn from saved tables alone, when the run folders are gone::
+machines), so a report can be drawn from saved tables alone, when the run folders are gone. This is
+the one module that reads experiment folders for studies (also ``learning_curves``,
+``check_comparable`` and ``run_progress``); ``report`` and ``figures`` work from its rows::
 
     <folder>/
         results.csv         one row per run x evaluated phase, list columns as JSON
@@ -27,8 +29,8 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.report import config_differences
-from lerobot_mtdagger.rounds import ExperimentDir
+from lerobot_mtdagger.report import CurvePoint, RunPoints, average_runs, curve_name
+from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir
 
 RESULTS_FILE = "results.json"
 META_FILE = "results_meta.json"
@@ -166,7 +168,7 @@ def write_results(
         rows: The rows (``results_rows``).
         folder: Where they go (made if missing).
         task_names: The suite's task names in task-index order (the per-task columns' order).
-        configs: The config each method's runs share (``report.check_comparable``).
+        configs: The config each method's runs share (``check_comparable``).
         unfinished: One line per unfinished run of a study in progress (``RunProgress.describe``).
 
     Returns:
@@ -328,3 +330,142 @@ def _read_json(path: Path) -> Any:
         return json.loads(path.read_text())
     except json.JSONDecodeError as error:
         raise UserError(f"{path} is not JSON ({error}); rewrite it with report.") from None
+
+
+# -------------------------------------------------------------------------------------------------
+# Learning curves and progress of experiment folders
+# -------------------------------------------------------------------------------------------------
+
+
+PER_RUN_FIELDS = ("seed", "output_dir", "resume", "progress", "workers")
+"""Config fields that may differ between the runs of one method (they never change a result, or are
+what the runs are repeated over)."""
+
+BC_BUDGET_FIELDS = ("rounds", "scheduler")
+"""Fields that may also differ between BC runs: the budget (``rounds``) and the unused scheduler."""
+
+
+@dataclass(frozen=True)
+class RunProgress:
+    """How far one run has got: its committed rounds and training phases against its last phase.
+
+    Attributes:
+        root: The experiment folder.
+        rounds: Committed rounds (0 for a run that has just started).
+        phases: Indices of the committed training phases.
+        last_phase: The phase the run ends with: 0 for BC, ``rounds`` for DAgger (its config).
+    """
+
+    root: Path
+    rounds: int
+    phases: tuple[int, ...]
+    last_phase: int
+
+    @property
+    def finished(self) -> bool:
+        """Whether the last phase is committed."""
+        return self.last_phase in self.phases
+
+    def describe(self) -> str:
+        """One line for a report: the run's folder name and how far it has got."""
+        done = f"phases 0-{max(self.phases)}" if self.phases else "no phase yet"
+        return f"{self.root.name}: {done} of 0-{self.last_phase}"
+
+
+def run_progress(root: Path) -> RunProgress:
+    """How far the run in ``root`` has got (a run still being written is read as it stands).
+
+    Raises:
+        UserError: If ``root`` has no ``config.json`` or holds a corrupt round.
+    """
+    path = Path(root) / CONFIG_FILE
+    if not path.is_file():
+        raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
+    config = json.loads(path.read_text())
+    experiment = ExperimentDir(root)
+    last_phase = 0 if config.get("mode") == "bc" else int(config.get("rounds") or 0)
+    return RunProgress(
+        root=Path(root),
+        rounds=len(experiment.committed_rounds()),
+        phases=tuple(experiment.committed_phases()),
+        last_phase=last_phase,
+    )
+
+
+def experiment_curve(root: Path, label: str | None = None) -> RunPoints:
+    """The evaluated points of one experiment folder.
+
+    Args:
+        root: The experiment folder.
+        label: The method name to report it under (default: its method, ``bc`` for BC).
+    """
+    experiment = ExperimentDir(root)
+    record = experiment.read_round_record(0)
+    points = []
+    for round_index in experiment.committed_phases():
+        phase = experiment.read_phase_record(round_index)
+        if phase.eval_mean is not None:
+            points.append((round_index, float(np.mean(phase.demos_per_task)), phase.eval_mean))
+    name = curve_name(label or record.method, record.method == "bc", float(np.mean(record.demos_so_far)))
+    return name, record.seed, points
+
+
+def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> list[CurvePoint]:
+    """Groups experiments by method and averages their curves over seeds, round by round.
+
+    Args:
+        roots: Experiment folders.
+        labels: Method name per folder where it is not the run's own (a variant of a method, e.g.
+            BC with balanced sampling reported as ``bc-balanced`` beside ``bc``).
+
+    Raises:
+        ValueError: If two runs of one method used the same seed (a duplicate would bias the mean),
+            their configs differ in more than the seed (``check_comparable``), or no run has an
+            evaluated phase.
+    """
+    labels = labels or {}
+    check_comparable(roots, labels)
+    return average_runs([experiment_curve(Path(root), labels.get(Path(root))) for root in roots])
+
+
+def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> dict[str, dict]:
+    """Refuses to group runs of one method whose configs differ in more than ``PER_RUN_FIELDS``.
+
+    BC runs may also differ in ``BC_BUDGET_FIELDS`` (one BC run per budget). A run given a label in
+    ``labels`` is grouped under that label, not under its method.
+
+    Returns:
+        The config each method's runs share (without those fields), by method name.
+
+    Raises:
+        ValueError: Naming the method, the differing fields with their values and two such runs.
+    """
+    first_of_method: dict[str, tuple[Path, dict]] = {}
+    for root in roots:
+        root = Path(root)
+        path = root / CONFIG_FILE
+        if not path.is_file():
+            raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
+        config = json.loads(path.read_text())
+        is_bc = config.get("mode") == "bc"
+        method = (labels or {}).get(root) or ("bc" if is_bc else config.get("scheduler", {}).get("type"))
+        ignored = PER_RUN_FIELDS + (BC_BUDGET_FIELDS if is_bc else ())
+        shared = {key: value for key, value in config.items() if key not in ignored}
+        if method not in first_of_method:
+            first_of_method[method] = (root, shared)
+            continue
+        other_root, other = first_of_method[method]
+        differing = config_differences(other, shared)
+        if differing:
+            raise UserError(
+                f"Refusing to average {method} runs with different configs ({differing}) in {other_root} "
+                f"and {root}: report them separately, give one set a label of its own (report "
+                "--variants), or rerun them with the same options."
+            )
+    return {method: shared for method, (_, shared) in first_of_method.items()}
+
+
+def config_differences(first: Mapping, second: Mapping) -> str:
+    """``"key: a vs b, ..."`` for every top-level key whose value differs (empty when none does)."""
+    differing = sorted(key for key in set(first) | set(second) if first.get(key) != second.get(key))
+    return ", ".join(f"{key}: {first.get(key)!r} vs {second.get(key)!r}" for key in differing)

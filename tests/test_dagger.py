@@ -128,7 +128,7 @@ def test_merged_rounds_load_as_one_dataset_with_the_same_task_indices(experiment
 
 
 def test_report_gives_success_against_demos(experiment, tmp_path, capsys):
-    from lerobot_mtdagger.report import learning_curves
+    from lerobot_mtdagger.results import learning_curves
 
     curves = learning_curves([experiment.root])
     assert [(p.method, p.round, p.demos_per_task, p.seeds) for p in curves][:2] == [
@@ -143,7 +143,7 @@ def test_report_gives_success_against_demos(experiment, tmp_path, capsys):
 
 
 def test_report_refuses_to_average_runs_of_different_configs(experiment, tmp_path):
-    from lerobot_mtdagger.report import learning_curves
+    from lerobot_mtdagger.results import learning_curves
 
     other = tmp_path / "need-longer"
     shutil.copytree(experiment.root, other)
@@ -155,7 +155,7 @@ def test_report_refuses_to_average_runs_of_different_configs(experiment, tmp_pat
 
 
 def test_report_refuses_runs_without_evaluation(tmp_path):
-    from lerobot_mtdagger.report import learning_curves
+    from lerobot_mtdagger.results import learning_curves
     from tests.test_toy import toy_config
 
     run(toy_config(tmp_path / "blind", "--rounds=0", "--eval_episodes=0"))
