@@ -408,10 +408,11 @@ class RunConfig:
             raise ValueError(f"gain_split must be 'train' or 'heldout', got {self.gain_split!r}.")
         if not 0.0 < self.heldout_fraction < 1.0:
             raise ValueError(f"heldout_fraction must be in (0, 1), got {self.heldout_fraction}.")
-        lr = getattr(self.policy, "lr", getattr(self.policy, "optimizer_lr", None))
+        lr_name = "lr" if isinstance(self.policy, PolicyOptions) else "optimizer_lr"
+        lr = getattr(self.policy, lr_name)
         if self.policy.batch_size <= 0 or not (math.isfinite(lr) and lr > 0):
             raise ValueError(
-                f"policy.batch_size and the policy's learning rate must be finite and > 0, "
+                f"policy.batch_size and policy.{lr_name} must be finite and > 0, "
                 f"got {self.policy.batch_size}, {lr}."
             )
         check_device(self.policy.device)
