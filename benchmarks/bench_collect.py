@@ -30,16 +30,16 @@ import time
 
 import numpy as np
 
-from lerobot_mtdagger.collect import run_episodes
-from lerobot_mtdagger.configs import PolicyOptions
+from lerobot_mtdagger.datasets.records import EXECUTED_ACTION
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.metaworld import _make_raw_env
-from lerobot_mtdagger.evaluate import PolicyRunner, evaluate
 from lerobot_mtdagger.policies import MTDAggerPolicy
-from lerobot_mtdagger.records import EXECUTED_ACTION
-from lerobot_mtdagger.seeds import COLLECT_STREAM
-from lerobot_mtdagger.train import build_processors, policy_config
-from lerobot_mtdagger.workers import EnvWorkers
+from lerobot_mtdagger.runner.collect import run_episodes
+from lerobot_mtdagger.runner.configs import PolicyOptions
+from lerobot_mtdagger.runner.evaluate import PolicyRunner, evaluate
+from lerobot_mtdagger.runner.train import build_processors, policy_config
+from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
 TARGET = 0.7
 RAW_STEPS = 2000

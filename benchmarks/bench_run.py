@@ -30,7 +30,7 @@ import threading
 import time
 from pathlib import Path
 
-from lerobot_mtdagger.results import PHASE_TIMINGS as PHASES
+from lerobot_mtdagger.studies.results import PHASE_TIMINGS as PHASES
 
 TARGET_S = 60.0
 

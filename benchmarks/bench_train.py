@@ -38,7 +38,7 @@ import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
-from lerobot_mtdagger.train import (
+from lerobot_mtdagger.runner.train import (
     LOG_INTERVAL,
     NormalisedData,
     StepOptions,

@@ -38,21 +38,21 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lerobot_mtdagger.compare import CompareConfig, follow_parent, split_arguments
-from lerobot_mtdagger.configs import RunConfig, renamed_option_error, resolve_workers
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.hub import PushConfig, push_command
-from lerobot_mtdagger.parsing import parse_options
+from lerobot_mtdagger.datasets.hub import PushConfig, push_command
+from lerobot_mtdagger.runner.configs import RunConfig, renamed_option_error, resolve_workers
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
-from lerobot_mtdagger.simulate import SyntheticTasks, simulate
+from lerobot_mtdagger.studies.compare import CompareConfig, follow_parent, split_arguments
+from lerobot_mtdagger.studies.simulate import SyntheticTasks, simulate
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.parsing import parse_options
 
 HELDOUT_TASKS = "heldout"
 """``--tasks=heldout``: the suite's unseen tasks (``eval``, ``shift``)."""
 
 if TYPE_CHECKING:
     from lerobot_mtdagger.envs.base import TaskSuite
-    from lerobot_mtdagger.evaluate import PolicyRunner
-    from lerobot_mtdagger.shift import ShiftResult
+    from lerobot_mtdagger.runner.evaluate import PolicyRunner
+    from lerobot_mtdagger.studies.shift import ShiftResult
 
 logger = logging.getLogger(__name__)
 
@@ -120,7 +120,7 @@ def run_demo(config: DemoConfig) -> list[dict]:
 
 def run_experiment(config: RunConfig) -> list[str]:
     """Runs ``lerobot-mtdagger run`` and prints the per-round summary."""
-    from lerobot_mtdagger.dagger import run
+    from lerobot_mtdagger.runner.dagger import run
 
     follow_parent()
     print(f"experiment {config.output_dir} ({config.method}, seed {config.seed}):", flush=True)
@@ -144,8 +144,8 @@ class VerifyConfig:
 
 def verify_command(config: VerifyConfig) -> list[str]:
     """Checks every committed round and policy against its files and record; exits 1 on a problem."""
-    from lerobot_mtdagger.rounds import ExperimentDir
-    from lerobot_mtdagger.verify import verify_experiment
+    from lerobot_mtdagger.datasets.rounds import ExperimentDir
+    from lerobot_mtdagger.datasets.verify import verify_experiment
 
     num_rounds, num_policies, problems = verify_experiment(ExperimentDir(config.experiment_dir))
     for problem in problems:
@@ -182,7 +182,7 @@ class MergeConfig:
 
 def merge_command(config: MergeConfig) -> Path:
     """Merges rounds 0..k with LeRobot's aggregation; the result trains with stock lerobot-train."""
-    from lerobot_mtdagger.rounds import ExperimentDir, merge_rounds
+    from lerobot_mtdagger.datasets.rounds import ExperimentDir, merge_rounds
 
     experiment = ExperimentDir(config.experiment_dir)
     experiment.read_config()  # refuses a folder that is not an experiment
@@ -252,7 +252,7 @@ class EvalConfig:
 def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
     """The suite the config names and its pretrained policy, checked to take the suite's observations."""
     from lerobot_mtdagger.envs import suite_from_config
-    from lerobot_mtdagger.evaluate import PolicyRunner
+    from lerobot_mtdagger.runner.evaluate import PolicyRunner
 
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
     config = dataclasses.replace(config, **observation_options(runner, config))
@@ -293,8 +293,8 @@ def observation_options(runner: PolicyRunner, config: EvalConfig) -> dict[str, A
 
 def eval_command(config: EvalConfig) -> dict:
     """Evaluates a pretrained policy per task with the pure policy acting."""
-    from lerobot_mtdagger.evaluate import evaluate
-    from lerobot_mtdagger.workers import EnvWorkers
+    from lerobot_mtdagger.runner.evaluate import evaluate
+    from lerobot_mtdagger.runner.workers import EnvWorkers
 
     suite, runner = _suite_and_policy(config)
     with EnvWorkers(suite, config.worker_count) as workers:
@@ -322,8 +322,8 @@ class ShiftConfig(EvalConfig):
 
 def shift_command(config: ShiftConfig) -> dict:
     """Measures a pretrained policy's covariate shift per task and prints it."""
-    from lerobot_mtdagger.shift import measure_shift
-    from lerobot_mtdagger.workers import EnvWorkers
+    from lerobot_mtdagger.runner.workers import EnvWorkers
+    from lerobot_mtdagger.studies.shift import measure_shift
 
     suite, runner = _suite_and_policy(config)
     with EnvWorkers(suite, config.worker_count) as workers:
@@ -402,7 +402,7 @@ class ReportConfig:
             raise ValueError(f"{self.compare_dir} is not a compare folder (no runs/ in it).")
         if self.compare_dir is not None and self.output_dir is None:
             self.output_dir = self.compare_dir / "report"
-        from lerobot_mtdagger.rounds import CONFIG_FILE
+        from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
 
         for name, folder in self.variants.items():
             if not (Path(folder) / "runs").is_dir() and not (Path(folder) / CONFIG_FILE).is_file():
@@ -447,7 +447,7 @@ class ReportConfig:
     @property
     def runs_not_started(self) -> list[str]:
         """The runs the compare folders plan (``compare.json``) that have no folder yet."""
-        from lerobot_mtdagger.compare import runs_not_started
+        from lerobot_mtdagger.studies.compare import runs_not_started
 
         folders = [self.compare_dir] if self.compare_dir is not None else []
         folders += [Path(folder) for folder in self.variants.values() if (Path(folder) / "runs").is_dir()]
@@ -468,8 +468,8 @@ def report_command(config: ReportConfig) -> str:
     """
     if config.results:
         return _report_saved_tables(config)
-    from lerobot_mtdagger.report import curves_table
-    from lerobot_mtdagger.results import check_comparable, learning_curves, run_progress
+    from lerobot_mtdagger.studies.report import curves_table
+    from lerobot_mtdagger.studies.results import check_comparable, learning_curves, run_progress
 
     all_roots, labels = config.experiment_dirs, config.labels  # each lists the run folders once
     configs = check_comparable(all_roots, labels)
@@ -490,8 +490,8 @@ def report_command(config: ReportConfig) -> str:
         )
     table = _print_table(curves_table(learning_curves(roots, labels)), config)
     if config.output_dir is not None:
-        from lerobot_mtdagger.results import results_rows, write_results
-        from lerobot_mtdagger.rounds import ExperimentDir
+        from lerobot_mtdagger.datasets.rounds import ExperimentDir
+        from lerobot_mtdagger.studies.results import results_rows, write_results
 
         rows = results_rows(roots, labels)
         task_names = ExperimentDir(roots[0]).read_round_record(0).task_names
@@ -502,8 +502,8 @@ def report_command(config: ReportConfig) -> str:
 
 def _report_saved_tables(config: ReportConfig) -> str:
     """``report --results``: the table, figures and summary of saved results tables, joined."""
-    from lerobot_mtdagger.report import curves_from_rows, curves_table
-    from lerobot_mtdagger.results import merge_tables, read_results
+    from lerobot_mtdagger.studies.report import curves_from_rows, curves_table
+    from lerobot_mtdagger.studies.results import merge_tables, read_results
 
     saved = merge_tables([read_results(path) for path in config.results])
     table = _print_table(curves_table(curves_from_rows(saved.rows)), config)
@@ -523,7 +523,7 @@ def _write_figures(
     rows: list[dict], task_names: list[str], config: ReportConfig, unfinished: list[str]
 ) -> None:
     """Writes every figure and ``report.md`` into ``--output_dir`` and prints where."""
-    from lerobot_mtdagger.figures import write_report
+    from lerobot_mtdagger.studies.figures import write_report
 
     path = write_report(rows, task_names, config.output_dir, levels=config.levels, unfinished=unfinished)
     print(f"figures and summary: {path}")
@@ -531,7 +531,7 @@ def _write_figures(
 
 def compare_command(config: CompareConfig, run_args: list[str]) -> list[dict]:
     """Runs every method over every seed (and BC at every budget) and writes the results table."""
-    from lerobot_mtdagger.compare import compare
+    from lerobot_mtdagger.studies.compare import compare
 
     rows = compare(config, run_args)
     runs = len({row["experiment"] for row in rows})

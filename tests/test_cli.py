@@ -16,7 +16,7 @@ import pytest
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets_cards import card_template
 from lerobot_mtdagger.scheduler import allocation_mismatches, make_scheduler
-from lerobot_mtdagger.simulate import SyntheticTasks, simulate
+from lerobot_mtdagger.studies.simulate import SyntheticTasks, simulate
 
 
 def test_console_script_demo_runs_and_writes_records(tmp_path):

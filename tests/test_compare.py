@@ -17,7 +17,8 @@ from pathlib import Path
 import pytest
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.compare import (
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.studies.compare import (
     PARENT_PID_ENV,
     CompareConfig,
     bc_rounds_for,
@@ -26,8 +27,7 @@ from lerobot_mtdagger.compare import (
     jobs_for,
     split_arguments,
 )
-from lerobot_mtdagger.configs import RunConfig
-from lerobot_mtdagger.figures import hardest_tasks, seed_reach
+from lerobot_mtdagger.studies.figures import hardest_tasks, seed_reach
 from tests.test_dagger import _children, _running
 
 TINY = [
@@ -486,7 +486,7 @@ def test_report_refuses_a_variant_folder_that_holds_no_runs(compared, tmp_path, 
 
 
 def test_reach_table_gives_demos_and_frames_at_the_first_crossing():
-    from lerobot_mtdagger.figures import reach_lines
+    from lerobot_mtdagger.studies.figures import reach_lines
 
     def curve(seed, successes):
         return [

@@ -6,7 +6,7 @@ import draccus
 import pytest
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.configs import PRESET_FIELDS, PRESETS, RunConfig
+from lerobot_mtdagger.runner.configs import PRESET_FIELDS, PRESETS, RunConfig
 
 
 def parse(*args: str) -> RunConfig:

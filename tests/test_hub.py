@@ -1,4 +1,4 @@
-"""Tests of ``lerobot_mtdagger.hub`` against a LOCAL STAND-IN for the Hugging Face Hub API.
+"""Tests of ``lerobot_mtdagger.datasets.hub`` against a LOCAL STAND-IN for the Hugging Face Hub API.
 
 ``FakeHfApi`` implements the ``HfApi`` methods the push uses (create_repo, upload_folder, create_tag)
 with the Hub's semantics as read in huggingface_hub's source: ``delete_patterns`` are fnmatch patterns
@@ -27,12 +27,12 @@ import requests
 from huggingface_hub.errors import LocalTokenNotFoundError
 from huggingface_hub.utils import filter_repo_objects
 
-from lerobot_mtdagger import hub
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.errors import CorruptExperimentError, UserError
-from lerobot_mtdagger.hub import PushConfig, push_command, push_experiment, render_dataset_card
-from lerobot_mtdagger.integrity import folder_digests
-from lerobot_mtdagger.rounds import RECORD_FILES, ExperimentDir
+from lerobot_mtdagger.datasets import hub
+from lerobot_mtdagger.datasets.hub import PushConfig, push_command, push_experiment, render_dataset_card
+from lerobot_mtdagger.datasets.integrity import folder_digests
+from lerobot_mtdagger.datasets.rounds import RECORD_FILES, ExperimentDir
+from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
 from tests.helpers import edit_round_record
 
 TASKS = ["reach-v3", "button-press-topdown-v3"]

@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.rounds import ExperimentDir
-from lerobot_mtdagger.verify import verify_experiment
+from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.verify import verify_experiment
 from tests.test_dagger import _children, _cli, _running
 
 pytestmark = pytest.mark.slow

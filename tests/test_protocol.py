@@ -21,16 +21,14 @@ import numpy as np
 import pytest
 import torch
 
-from lerobot_mtdagger.collect import learner_success_by_task, run_episodes, success_by_task
-from lerobot_mtdagger.configs import RunConfig
-from lerobot_mtdagger.dagger import run
+from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.evaluate import PolicyRunner
-from lerobot_mtdagger.mixing import expert_episode_coin
-from lerobot_mtdagger.rounds import ExperimentDir
-from lerobot_mtdagger.seeds import BETA_STREAM, COLLECT_STREAM
-from lerobot_mtdagger.train import (
+from lerobot_mtdagger.runner.collect import learner_success_by_task, run_episodes, success_by_task
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.dagger import run
+from lerobot_mtdagger.runner.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.mixing import expert_episode_coin
+from lerobot_mtdagger.runner.train import (
     EPISODE_ID_STRIDE,
     NormalisedData,
     TrainingData,
@@ -43,7 +41,9 @@ from lerobot_mtdagger.train import (
     performance_gain,
     split_frames,
 )
-from lerobot_mtdagger.workers import EnvWorkers
+from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.seeds import BETA_STREAM, COLLECT_STREAM
 from tests.test_toy import TOY_RUN
 from tests.test_train import normalised, small_policy, synthetic_data
 

@@ -1,4 +1,4 @@
-"""The quiet console (``lerobot_mtdagger.quiet``) and the one-go round writer (``ExperimentDir.write_round``).
+"""The quiet console (``utils.quiet``) and the one-go round writer (``ExperimentDir.write_round``).
 
 ``quiet_third_party`` must silence exactly the known third-party noise and put everything back; the
 round writer must produce what LeRobot's own ``add_frame`` / ``save_episode`` loop produces.
@@ -20,11 +20,11 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from lerobot_mtdagger import quiet
-from lerobot_mtdagger.quiet import quiet_third_party
-from lerobot_mtdagger.records import StepOutcome, dagger_columns, round_features
-from lerobot_mtdagger.round_writer import _vector_episode_stats, save_episode_with_success
-from lerobot_mtdagger.rounds import ExperimentDir, round_name
+from lerobot_mtdagger.datasets.records import StepOutcome, dagger_columns, round_features
+from lerobot_mtdagger.datasets.round_writer import _vector_episode_stats, save_episode_with_success
+from lerobot_mtdagger.datasets.rounds import ExperimentDir, round_name
+from lerobot_mtdagger.utils import quiet
+from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 hf_tqdm = importlib.import_module("datasets.utils.tqdm")
 
@@ -279,7 +279,7 @@ def _episodes(rng, lengths, pointcloud: bool = True, round_index: int = 1) -> li
 
 
 def _record_stub():
-    from lerobot_mtdagger.records import RoundRecord
+    from lerobot_mtdagger.datasets.records import RoundRecord
 
     blank = dict.fromkeys(("success_rate", "episodes", "gain", "metric", "score", "probability"))
     return RoundRecord(
@@ -373,7 +373,7 @@ def test_write_round_writes_what_lerobots_loop_writes(tmp_path, pointcloud):
 def test_write_round_falls_back_to_lerobots_stats_if_the_fast_ones_differ(
     tmp_path, monkeypatch, caplog, failure
 ):
-    from lerobot_mtdagger import round_writer as rounds
+    from lerobot_mtdagger.datasets import round_writer as rounds
 
     fast = rounds._vector_episode_stats
 
@@ -388,7 +388,7 @@ def test_write_round_falls_back_to_lerobots_stats_if_the_fast_ones_differ(
     episodes = _episodes(np.random.default_rng(6), [5, 7, 3])
     theirs = _write_with_lerobot_loop(ExperimentDir(tmp_path / "theirs"), 0, _features(), episodes)
     ours_dir = ExperimentDir(tmp_path / "ours")
-    with caplog.at_level(logging.WARNING, logger="lerobot_mtdagger.rounds"):
+    with caplog.at_level(logging.WARNING, logger="lerobot_mtdagger.datasets.rounds"):
         ours = ours_dir.commit_round(0, ours_dir.write_round(0, _features(), TASKS, episodes), _record_stub())
     assert "do not match this LeRobot version" in caplog.text
     _assert_same_dataset_files(ours, theirs)
@@ -433,7 +433,7 @@ def test_write_round_is_loaded_and_merged_like_lerobots(tmp_path, root_records):
 def test_write_round_starts_a_new_data_file_at_the_size_limit(tmp_path):
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    from lerobot_mtdagger.round_writer import write_round_episodes
+    from lerobot_mtdagger.datasets.round_writer import write_round_episodes
 
     experiment = ExperimentDir(tmp_path)
     episodes = _episodes(np.random.default_rng(2), [50, 50, 50, 50])
@@ -504,7 +504,7 @@ def test_write_round_refuses_bad_frames_empty_episodes_and_used_datasets(tmp_pat
     with pytest.raises(ValueError, match="action"):
         experiment.write_round(0, _features(), TASKS, bad)
     dataset = experiment.write_round(0, _features(), TASKS, good)
-    from lerobot_mtdagger.round_writer import write_round_episodes
+    from lerobot_mtdagger.datasets.round_writer import write_round_episodes
 
     with pytest.raises(ValueError, match="empty, freshly created"):
         write_round_episodes(dataset, good)

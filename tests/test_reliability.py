@@ -15,16 +15,16 @@ import pytest
 from safetensors import safe_open
 from safetensors.torch import load_file, save_file
 
-from lerobot_mtdagger import dagger as dagger_module
-from lerobot_mtdagger import rounds as rounds_module
-from lerobot_mtdagger.checkpoints import UntrustedCheckpointError
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.configs import RunConfig
-from lerobot_mtdagger.dagger import run
-from lerobot_mtdagger.errors import CorruptExperimentError, UserError
-from lerobot_mtdagger.evaluate import PolicyRunner
-from lerobot_mtdagger.rounds import LOCK_FILE, ExperimentDir, ExperimentLockedError
-from lerobot_mtdagger.verify import verify_experiment
+from lerobot_mtdagger.datasets import rounds as rounds_module
+from lerobot_mtdagger.datasets.checkpoints import UntrustedCheckpointError
+from lerobot_mtdagger.datasets.rounds import LOCK_FILE, ExperimentDir, ExperimentLockedError
+from lerobot_mtdagger.datasets.verify import verify_experiment
+from lerobot_mtdagger.runner import dagger as dagger_module
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.dagger import run
+from lerobot_mtdagger.runner.evaluate import PolicyRunner
+from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
 from tests.helpers import edit_round_record
 from tests.test_toy import TOY_RUN, toy_config
 
@@ -48,7 +48,7 @@ def test_a_second_writer_is_refused_at_once_naming_the_folder_and_the_process(fi
 def test_a_killed_writer_leaves_no_stale_lock(finished):
     code = (
         "import sys, time\n"
-        "from lerobot_mtdagger.rounds import ExperimentDir\n"
+        "from lerobot_mtdagger.datasets.rounds import ExperimentDir\n"
         f"with ExperimentDir({str(finished)!r}).writer_lock():\n"
         "    print('locked', flush=True)\n"
         "    time.sleep(60)\n"
@@ -163,8 +163,8 @@ def drop_info_records(root: Path) -> None:
 
 def test_the_round_record_survives_lerobot_rewriting_info_json(finished, tmp_path):
     """The record lives in meta/mtdagger.json: verify, resume, merge and report read it there."""
-    from lerobot_mtdagger.results import results_rows
-    from lerobot_mtdagger.rounds import merge_rounds
+    from lerobot_mtdagger.datasets.rounds import merge_rounds
+    from lerobot_mtdagger.studies.results import results_rows
 
     copy = damaged_copy(finished, tmp_path, drop_info_records)
     experiment = ExperimentDir(copy)

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from lerobot_mtdagger.stats import correlation, demos_to_reach, mean_interval, paired_difference
+from lerobot_mtdagger.studies.stats import correlation, demos_to_reach, mean_interval, paired_difference
 
 
 def test_mean_interval_of_1_2_3():

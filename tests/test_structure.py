@@ -151,7 +151,7 @@ def test_every_module_imports_alone_in_a_fresh_process():
     assert {"lerobot_mtdagger.envs.drawers.variants", "lerobot_mtdagger.experts.drawers"} <= set(modules)
 
 
-WIDE_FUNCTIONS = {"collect.run_episodes", "envs.make_suite"}
+WIDE_FUNCTIONS = {"runner.collect.run_episodes", "envs.make_suite"}
 """Functions still taking more than MAX_PARAMETERS (the composed-config work folds them); none may join."""
 
 MAX_PARAMETERS = 8
@@ -180,11 +180,11 @@ def test_no_function_takes_more_than_eight_parameters():
 
 def test_the_dagger_loop_hands_each_training_phase_to_train():
     """``dagger.train_round`` is short and takes at most four names from ``train``."""
-    tree = ast.parse(module_path("lerobot_mtdagger.dagger").read_text())
+    tree = ast.parse(module_path("lerobot_mtdagger.runner.dagger").read_text())
     from_train = [
         alias.name
         for node in tree.body
-        if isinstance(node, ast.ImportFrom) and node.module == "lerobot_mtdagger.train"
+        if isinstance(node, ast.ImportFrom) and node.module == "lerobot_mtdagger.runner.train"
         for alias in node.names
     ]
     assert len(from_train) <= 4, from_train
@@ -194,10 +194,64 @@ def test_the_dagger_loop_hands_each_training_phase_to_train():
 
 def test_verify_loads_policies_without_the_rollout_stack():
     """``verify`` checks rounds and loads policies; it never imports env workers or rollouts."""
-    seen, todo = set(), ["lerobot_mtdagger.verify"]
+    seen, todo = set(), ["lerobot_mtdagger.datasets.verify"]
     while todo:
         name = todo.pop()
         if name not in seen:
             seen.add(name)
             todo.extend(imports_of(name))
-    assert not seen & {"lerobot_mtdagger.workers", "lerobot_mtdagger.collect", "lerobot_mtdagger.evaluate"}
+    assert not seen & {
+        "lerobot_mtdagger.runner.workers",
+        "lerobot_mtdagger.runner.collect",
+        "lerobot_mtdagger.runner.evaluate",
+    }
+
+
+WING_RANKS = {
+    "lerobot_mtdagger.cli": 6,
+    "lerobot_mtdagger.studies": 5,
+    "lerobot_mtdagger.runner": 4,
+    "lerobot_mtdagger.envs": 3,
+    "lerobot_mtdagger.experts": 3,
+    "lerobot_mtdagger.datasets": 2,
+    "lerobot_mtdagger.policies": 2,
+    "lerobot_mtdagger.scheduler": 1,
+    "lerobot_mtdagger.utils": 0,
+}
+"""Imports run one way: studies -> runner -> envs and experts -> datasets and policies -> scheduler ->
+utils. Within a rank, experts may use envs and datasets may use policies (not the reverse)."""
+
+SAME_RANK_ALLOWED = {
+    ("lerobot_mtdagger.experts", "lerobot_mtdagger.envs"),
+    ("lerobot_mtdagger.datasets", "lerobot_mtdagger.policies"),
+}
+
+
+def wing(name: str) -> str | None:
+    """The wing a module belongs to (None: the package itself or a loose module)."""
+    return next((w for w in WING_RANKS if name == w or name.startswith(w + ".")), None)
+
+
+def test_every_module_sits_in_a_wing():
+    data_only = ("lerobot_mtdagger", "lerobot_mtdagger.datasets_cards")  # the package, the card template
+    loose = [n for n in package_modules() if wing(n) is None and n not in data_only]
+    assert loose == [], f"modules outside the wings {sorted(WING_RANKS)}: {loose}"
+
+
+def test_imports_run_one_way_between_wings():
+    """Function-level imports included: no import from a lower wing to a higher one."""
+    wrong = []
+    for name in package_modules():
+        source = wing(name)
+        for target in imports_of(name):
+            destination = wing(target)
+            if source is None or destination is None or source == destination:
+                continue
+            higher = WING_RANKS[destination] > WING_RANKS[source]
+            sideways = (
+                WING_RANKS[destination] == WING_RANKS[source]
+                and (source, destination) not in SAME_RANK_ALLOWED
+            )
+            if higher or sideways:
+                wrong.append(f"{name} -> {target}")
+    assert wrong == [], wrong

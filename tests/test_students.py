@@ -20,17 +20,17 @@ import numpy as np
 import pytest
 import torch
 
-from lerobot_mtdagger.configs import RunConfig, lerobot_students
-from lerobot_mtdagger.dagger import run
+from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.evaluate import ChunkRunner, PolicyRunner, evaluate
-from lerobot_mtdagger.parsing import parse_options
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE, TaskOneHotProcessorStep, task_one_hot
-from lerobot_mtdagger.rounds import ExperimentDir
-from lerobot_mtdagger.students import EpisodeWindows, LeRobotOps, lerobot_student_config
-from lerobot_mtdagger.verify import verify_experiment
-from lerobot_mtdagger.workers import EnvWorkers
+from lerobot_mtdagger.runner.configs import RunConfig, lerobot_students
+from lerobot_mtdagger.runner.dagger import run
+from lerobot_mtdagger.runner.evaluate import ChunkRunner, PolicyRunner, evaluate
+from lerobot_mtdagger.runner.students import EpisodeWindows, LeRobotOps, lerobot_student_config
+from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.parsing import parse_options
 
 TOY_STUDENT_RUN = [
     "--suite=toy",
@@ -227,7 +227,7 @@ def tiny_act_policy(suite, n_action_steps: int = 3):
         RunConfig, ["--suite=toy", *TINY_ACT, f"--policy.n_action_steps={n_action_steps}"], "t"
     )
     spec = lerobot_student_config(options.policy, suite.features, suite.task_names, task_dropout=0.0)
-    from lerobot_mtdagger.students import make_lerobot_processors, make_lerobot_student
+    from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
 
     torch.manual_seed(0)
     policy = make_lerobot_student(spec)
@@ -289,7 +289,7 @@ def test_rollouts_tell_a_chunking_student_its_lanes(suite):
 
 
 def test_the_per_task_loss_of_a_lerobot_student_is_reproducible(act_run):
-    from lerobot_mtdagger.train import NormalisedData, RoundCache
+    from lerobot_mtdagger.runner.train import NormalisedData, RoundCache
 
     runner = PolicyRunner.from_pretrained(ExperimentDir(act_run).policy_root(2))
     experiment = ExperimentDir(act_run)

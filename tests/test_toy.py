@@ -10,20 +10,26 @@ import numpy as np
 import pytest
 import torch
 
-from lerobot_mtdagger.collect import episode_seed, run_episodes, success_by_task
-from lerobot_mtdagger.configs import RunConfig
-from lerobot_mtdagger.dagger import run
+from lerobot_mtdagger.datasets.records import (
+    DAGGER_ROUND,
+    EXECUTED_ACTION,
+    LEARNER_ACTED,
+    RoundRecord,
+    round_features,
+)
+from lerobot_mtdagger.datasets.rounds import STAGING_DIR, ExperimentDir
+from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.toy import MAX_EPISODE_STEPS, TOY_TASKS
-from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.records import DAGGER_ROUND, EXECUTED_ACTION, LEARNER_ACTED, RoundRecord, round_features
-from lerobot_mtdagger.rounds import STAGING_DIR, ExperimentDir
+from lerobot_mtdagger.runner.collect import episode_seed, run_episodes, success_by_task
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.dagger import run
+from lerobot_mtdagger.runner.train import LOSS_SAMPLES_PER_TASK, TrainingData, split_frames
+from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.scheduler import scheduling_methods
-from lerobot_mtdagger.seeds import COLLECT_STREAM, EVAL_STREAM
-from lerobot_mtdagger.train import LOSS_SAMPLES_PER_TASK, TrainingData, split_frames
-from lerobot_mtdagger.verify import verify_experiment
-from lerobot_mtdagger.workers import EnvWorkers
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.seeds import COLLECT_STREAM, EVAL_STREAM
 
 TASKS = list(TOY_TASKS)
 
@@ -401,7 +407,7 @@ def test_rounds_carry_provenance_in_lerobots_column_names(tmp_path):
     import pyarrow.parquet as pq
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    from lerobot_mtdagger.records import INTERVENTION, NEXT_DONE, NEXT_REWARD, NEXT_SUCCESS
+    from lerobot_mtdagger.datasets.records import INTERVENTION, NEXT_DONE, NEXT_REWARD, NEXT_SUCCESS
 
     run(toy_config(tmp_path / "run", "--rounds=1"))
     experiment = ExperimentDir(tmp_path / "run")
@@ -436,7 +442,7 @@ def episodes_success_total(root) -> int:
 
 
 def test_an_experiment_started_without_provenance_columns_keeps_its_schema(tmp_path, suite):
-    from lerobot_mtdagger.records import INTERVENTION, StepOutcome, dagger_columns
+    from lerobot_mtdagger.datasets.records import INTERVENTION, StepOutcome, dagger_columns
 
     experiment = ExperimentDir(tmp_path / "old")
     old_features = round_features(suite.features, provenance=False)

@@ -12,7 +12,7 @@ from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
-from lerobot_mtdagger.train import (
+from lerobot_mtdagger.runner.train import (
     EPISODE_ID_STRIDE,
     NormalisedData,
     PlateauStop,

@@ -15,12 +15,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.collect import run_episodes
+from lerobot_mtdagger.datasets.records import EXECUTED_ACTION, LEARNER_ACTED
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.records import EXECUTED_ACTION, LEARNER_ACTED
-from lerobot_mtdagger.seeds import COLLECT_STREAM
-from lerobot_mtdagger.workers import EnvWorkers
+from lerobot_mtdagger.runner.collect import run_episodes
+from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
 DRAWERS = ["drawer-bar-wide", "drawer-knob-small", "drawer-lip-shallow"]
 STATE = "observation.state"

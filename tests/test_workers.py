@@ -10,15 +10,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lerobot_mtdagger.collect import run_episodes
-from lerobot_mtdagger.configs import RunConfig
-from lerobot_mtdagger.dagger import run
+from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.evaluate import evaluate
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.rounds import ExperimentDir
-from lerobot_mtdagger.seeds import COLLECT_STREAM
-from lerobot_mtdagger.workers import EnvWorkers, RemoteWorkerError, WorkerDiedError
+from lerobot_mtdagger.runner.collect import run_episodes
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.dagger import run
+from lerobot_mtdagger.runner.evaluate import evaluate
+from lerobot_mtdagger.runner.workers import EnvWorkers, RemoteWorkerError, WorkerDiedError
+from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
 from .test_toy import TOY_RUN
 
@@ -178,7 +178,7 @@ def test_lanes_are_spread_evenly_over_the_workers(tasks, workers):
     """
     from collections import deque
 
-    from lerobot_mtdagger.collect import LANE_GROUPS, _assign, _Lane, _Schedule
+    from lerobot_mtdagger.runner.collect import LANE_GROUPS, _assign, _Lane, _Schedule
 
     lanes = [_Lane(home_task=task, group=task % LANE_GROUPS) for task in range(tasks)]
     schedule = _Schedule(

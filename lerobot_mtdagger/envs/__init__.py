@@ -41,7 +41,7 @@ from lerobot_mtdagger.envs.base import (  # noqa: E402
     ObservationConfig,
     TaskSuite,
 )
-from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.utils.errors import UserError
 
 SUITE_NAMES: tuple[str, ...] = (
     "metaworld-mt10",

@@ -44,7 +44,7 @@ from lerobot_mtdagger.envs.rendering import (
     camera_rays,
     simplified_model,
 )
-from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.utils.errors import UserError
 
 logger = logging.getLogger(__name__)
 

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 from metaworld.policies import ENV_POLICY_MAP
 
-from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.utils.errors import UserError
 
 # The scripted policies warn on every step whose proportional gain saturates; the env clips the
 # action to [-1, 1] anyway (we clip too), so the warning carries no information.

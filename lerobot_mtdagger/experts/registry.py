@@ -20,8 +20,8 @@ import importlib
 from collections.abc import Callable
 from typing import Any
 
-from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.experts.base import ActionCheckedExpert, Expert
+from lerobot_mtdagger.utils.errors import UserError
 
 ANY_TASK = "*"
 """Task key of a factory that serves every task of its suite family."""

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.figures import format_difference
-from lerobot_mtdagger.stats import paired_difference
+from lerobot_mtdagger.studies.figures import format_difference
+from lerobot_mtdagger.studies.stats import paired_difference
 
 DEFAULT = Path("docs/results/beyond-plateau-dev/report/results.csv")
 SHOWN = (21, 33, 45, 63)

@@ -24,9 +24,9 @@ import numpy as np
 import torch
 
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.evaluate import PolicyRunner
-from lerobot_mtdagger.shift import ShiftResult, measure_shift
-from lerobot_mtdagger.workers import EnvWorkers
+from lerobot_mtdagger.runner.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.studies.shift import ShiftResult, measure_shift
 
 RUNS = Path("outputs/mt50-state-eval/runs")
 HERE = Path("docs/results/mt50-state-eval")

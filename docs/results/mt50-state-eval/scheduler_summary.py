@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.figures import format_difference
-from lerobot_mtdagger.results import SavedTable, merge_tables, read_results
-from lerobot_mtdagger.stats import Interval, mean_interval, paired_difference
+from lerobot_mtdagger.studies.figures import format_difference
+from lerobot_mtdagger.studies.results import SavedTable, merge_tables, read_results
+from lerobot_mtdagger.studies.stats import Interval, mean_interval, paired_difference
 
 HERE = Path("docs/results/mt50-state-eval")
 MAIN_TABLES = tuple(HERE / "seeds" / f"seed{seed}" for seed in (0, 1, 2))

@@ -18,12 +18,12 @@ from collections import Counter, defaultdict
 
 import numpy as np
 
-from lerobot_mtdagger.collect import EVAL_STREAM, episode_seed
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.drawers import STATE_INDEX
-from lerobot_mtdagger.evaluate import PolicyRunner
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.experts.drawers import BRANCHES
+from lerobot_mtdagger.runner.collect import EVAL_STREAM, episode_seed
+from lerobot_mtdagger.runner.evaluate import PolicyRunner
 
 
 def misalignment(state: np.ndarray) -> tuple[float, float, float]:

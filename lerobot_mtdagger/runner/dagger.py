@@ -48,24 +48,24 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
-from lerobot_mtdagger.collect import (
+from lerobot_mtdagger.datasets.records import RoundRecord
+from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.envs import suite_from_config
+from lerobot_mtdagger.envs.base import TaskSuite
+from lerobot_mtdagger.runner.collect import (
     Episode,
     learner_success_by_task,
     run_episodes,
     success_by_task,
 )
-from lerobot_mtdagger.configs import RunConfig
-from lerobot_mtdagger.envs import suite_from_config
-from lerobot_mtdagger.envs.base import TaskSuite
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.evaluate import EvalResult, PolicyRunner, evaluate, make_runner
-from lerobot_mtdagger.quiet import quiet_third_party
-from lerobot_mtdagger.records import RoundRecord
-from lerobot_mtdagger.rounds import ExperimentDir
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.evaluate import EvalResult, PolicyRunner, evaluate, make_runner
+from lerobot_mtdagger.runner.train import RoundCache, check_heldout, student_config, train_on_rounds
+from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
-from lerobot_mtdagger.seeds import COLLECT_STREAM
-from lerobot_mtdagger.train import RoundCache, check_heldout, student_config, train_on_rounds
-from lerobot_mtdagger.workers import EnvWorkers
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.quiet import quiet_third_party
+from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
 logger = logging.getLogger(__name__)
 

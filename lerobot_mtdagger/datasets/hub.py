@@ -34,11 +34,11 @@ from typing import Any
 
 from huggingface_hub import DatasetCardData, HfApi
 
+from lerobot_mtdagger.datasets.records import PhaseRecord, RoundRecord
+from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, ExperimentDir, round_name
 from lerobot_mtdagger.datasets_cards import card_template
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.markdown import markdown_table
-from lerobot_mtdagger.records import PhaseRecord, RoundRecord
-from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir, round_name
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.markdown import markdown_table
 
 logger = logging.getLogger(__name__)
 

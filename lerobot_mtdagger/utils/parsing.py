@@ -16,7 +16,7 @@ from typing import TypeVar
 import draccus
 import yaml
 
-from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.utils.errors import UserError
 
 T = TypeVar("T")
 

@@ -19,11 +19,11 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from lerobot_mtdagger.checkpoints import load_policy
-from lerobot_mtdagger.errors import CorruptExperimentError, UserError
-from lerobot_mtdagger.records import RoundRecord
-from lerobot_mtdagger.rounds import ExperimentDir, round_name
+from lerobot_mtdagger.datasets.checkpoints import load_policy
+from lerobot_mtdagger.datasets.records import RoundRecord
+from lerobot_mtdagger.datasets.rounds import ExperimentDir, round_name
 from lerobot_mtdagger.scheduler import allocation_mismatches
+from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
 
 
 def stored_tasks(root: Path, num_tasks: int) -> tuple[list[str], list[int], int]:

@@ -38,10 +38,10 @@ from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from lerobot_mtdagger.configs import RunConfig, default_worker_count
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.parsing import parse_options
+from lerobot_mtdagger.runner.configs import RunConfig, default_worker_count
 from lerobot_mtdagger.scheduler import scheduling_methods
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.parsing import parse_options
 
 logger = logging.getLogger(__name__)
 
@@ -147,7 +147,10 @@ def is_finished(folder: Path, last_phase: int) -> bool:
     A DAgger run finished at fewer rounds than asked is not: resuming it with more ``--rounds``
     extends it (``ExperimentDir.check_resumable``).
     """
-    from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir  # LeRobot: loaded only when needed
+    from lerobot_mtdagger.datasets.rounds import (  # LeRobot: loaded only when needed
+        CONFIG_FILE,
+        ExperimentDir,
+    )
 
     if not (folder / CONFIG_FILE).exists():
         return False
@@ -174,7 +177,7 @@ def runs_not_started(compare_dir: Path) -> list[str]:
 
 def job_command(job: Job, folder: Path, threads: int, workers: int) -> tuple[list[str], dict[str, str]]:
     """The command line and environment of one job's ``lerobot-mtdagger run`` (resumed if started)."""
-    from lerobot_mtdagger.rounds import CONFIG_FILE
+    from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
 
     resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []
     command = [
@@ -335,7 +338,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     if unknown:
         raise UserError(f"Unknown method(s) {unknown} in --methods; choose among {list(known)}.")
     from lerobot_mtdagger.envs import suite_from_config
-    from lerobot_mtdagger.results import check_comparable, results_rows, write_results
+    from lerobot_mtdagger.studies.results import check_comparable, results_rows, write_results
 
     task_names = suite_from_config(base_run_config(run_args)).task_names
     jobs = jobs_for(compare_config, run_args, len(task_names))

@@ -23,9 +23,9 @@ from lerobot.datasets.compute_stats import RunningQuantileStats, compute_episode
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import update_chunk_file_indices
 
-from lerobot_mtdagger.lerobot_compat import DEFAULT_FEATURES, unsaved_frames, validate_frame
-from lerobot_mtdagger.quiet import quiet_third_party
-from lerobot_mtdagger.records import EPISODE_SUCCESS, NEXT_SUCCESS
+from lerobot_mtdagger.datasets.records import EPISODE_SUCCESS, NEXT_SUCCESS
+from lerobot_mtdagger.utils.lerobot_compat import DEFAULT_FEATURES, unsaved_frames, validate_frame
+from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 logger = logging.getLogger(__name__)
 
@@ -51,7 +51,7 @@ def write_round_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFram
     the parquet size LeRobot measures). Datasets with image or video features are written through
     ``add_frame`` / ``save_episode``.
 
-    Runs inside :func:`~lerobot_mtdagger.quiet.quiet_third_party`.
+    Runs inside :func:`~lerobot_mtdagger.utils.quiet.quiet_third_party`.
 
     Args:
         dataset: A dataset just created (``LeRobotDataset.create``), without episodes.

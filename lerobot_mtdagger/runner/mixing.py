@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lerobot_mtdagger.sampling import systematic_picks
+from lerobot_mtdagger.utils.sampling import systematic_picks
 
 
 @dataclass(frozen=True)

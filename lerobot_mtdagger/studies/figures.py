@@ -25,11 +25,17 @@ from typing import Any
 
 import numpy as np
 
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.markdown import markdown_table
-from lerobot_mtdagger.report import is_bc
-from lerobot_mtdagger.results import PHASE_TIMINGS
-from lerobot_mtdagger.stats import Interval, correlation, demos_to_reach, mean_interval, paired_difference
+from lerobot_mtdagger.studies.report import is_bc
+from lerobot_mtdagger.studies.results import PHASE_TIMINGS
+from lerobot_mtdagger.studies.stats import (
+    Interval,
+    correlation,
+    demos_to_reach,
+    mean_interval,
+    paired_difference,
+)
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.markdown import markdown_table
 
 LEVELS = (0.5, 0.6, 0.7, 0.8)
 Row = dict[str, Any]

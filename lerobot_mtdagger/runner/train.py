@@ -33,16 +33,16 @@ import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 from tqdm import tqdm
 
-from lerobot_mtdagger.configs import UNSEEN_TASK_DROPOUT, PolicyOptions, RunConfig
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.evaluate import PolicyRunner
-from lerobot_mtdagger.lerobot_compat import dataset_to_policy_features
+from lerobot_mtdagger.datasets.records import PhaseRecord
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE
-from lerobot_mtdagger.records import PhaseRecord
-from lerobot_mtdagger.sampling import systematic_picks
-from lerobot_mtdagger.seeds import HELDOUT_STREAM, TRAINING_STREAM, stream_seed
+from lerobot_mtdagger.runner.configs import UNSEEN_TASK_DROPOUT, PolicyOptions, RunConfig
+from lerobot_mtdagger.runner.evaluate import PolicyRunner
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
+from lerobot_mtdagger.utils.sampling import systematic_picks
+from lerobot_mtdagger.utils.seeds import HELDOUT_STREAM, TRAINING_STREAM, stream_seed
 
 logger = logging.getLogger(__name__)
 
@@ -494,7 +494,7 @@ def phase_ops(policy: Any, data: NormalisedData, options: StepOptions) -> Any:
     """The training seam of ``policy``: ``MTDAggerOps`` or ``students.LeRobotOps``."""
     if isinstance(policy, MTDAggerPolicy):
         return MTDAggerOps(policy, data, options.lr)
-    from lerobot_mtdagger.students import LeRobotOps
+    from lerobot_mtdagger.runner.students import LeRobotOps
 
     return LeRobotOps(policy, data, options.task_dropout, options.seed)
 
@@ -802,7 +802,7 @@ def student_config(
     if isinstance(config.policy, PolicyOptions):
         task_dropout = config.policy.resolved_task_dropout(unseen)
         return policy_config(features, task_names, config.policy, config.policy.device, task_dropout)
-    from lerobot_mtdagger.students import lerobot_student_config
+    from lerobot_mtdagger.runner.students import lerobot_student_config
 
     return lerobot_student_config(config.policy, features, task_names, UNSEEN_TASK_DROPOUT if unseen else 0.0)
 
@@ -811,7 +811,7 @@ def _new_student(policy_cfg: Any, stats: dict[str, dict[str, np.ndarray]]) -> tu
     """A freshly initialised student and its processors for ``stats``."""
     if isinstance(policy_cfg, MTDAggerConfig):
         return MTDAggerPolicy(policy_cfg), *build_processors(policy_cfg, stats)
-    from lerobot_mtdagger.students import make_lerobot_processors, make_lerobot_student
+    from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
 
     return make_lerobot_student(policy_cfg), *make_lerobot_processors(policy_cfg, stats)
 

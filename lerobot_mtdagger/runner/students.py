@@ -32,14 +32,14 @@ import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 
-from lerobot_mtdagger.configs import lerobot_policy_config
-from lerobot_mtdagger.lerobot_compat import dataset_to_policy_features
 from lerobot_mtdagger.policies.task_conditioning import (
     TASK_FEATURE,
     TaskOneHotProcessorStep,
     task_feature,
     task_one_hot,
 )
+from lerobot_mtdagger.runner.configs import lerobot_policy_config
+from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 
 LOSS_CHUNK = 256
 """Frames per forward pass when measuring a LeRobot student's per-task loss."""

@@ -17,12 +17,12 @@ import numpy as np
 import torch
 from lerobot.utils.constants import OBS_IMAGES
 
-from lerobot_mtdagger.checkpoints import load_policy
-from lerobot_mtdagger.collect import PolicyFn, run_episodes, success_by_task
-from lerobot_mtdagger.errors import UserError
+from lerobot_mtdagger.datasets.checkpoints import load_policy
 from lerobot_mtdagger.policies import TASK_FEATURE, MTDAggerPolicy
-from lerobot_mtdagger.seeds import EVAL_STREAM
-from lerobot_mtdagger.workers import EnvWorkers, Episode
+from lerobot_mtdagger.runner.collect import PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.runner.workers import EnvWorkers, Episode
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.seeds import EVAL_STREAM
 
 
 class PolicyRunner:

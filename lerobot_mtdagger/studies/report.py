@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.markdown import markdown_table
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.markdown import markdown_table
 
 
 @dataclass

@@ -29,10 +29,10 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from lerobot_mtdagger.collect import PolicyFn, run_episodes, success_by_task
 from lerobot_mtdagger.envs.base import TaskSuite
-from lerobot_mtdagger.seeds import EVAL_STREAM
-from lerobot_mtdagger.workers import EnvWorkers, Episode
+from lerobot_mtdagger.runner.collect import PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.runner.workers import EnvWorkers, Episode
+from lerobot_mtdagger.utils.seeds import EVAL_STREAM
 
 
 @dataclass

@@ -1,7 +1,7 @@
 """Env workers: the simulators of a run stepped in worker processes, one per core by default.
 
 A ``RolloutWorker`` owns envs and experts and runs each episode of a rollout (reset, the expert's
-label, the env step, recording) by the DAgger mixing rules of ``lerobot_mtdagger.mixing`` (who acts,
+label, the env step, recording) by the DAgger mixing rules of ``lerobot_mtdagger.runner.mixing`` (who acts,
 when an episode ends). The main process
 keeps the policy and talks to the workers (see ``collect.run_episodes``): one message per worker
 per step of a group of episodes, carrying the learner's actions for that worker's episodes and the episodes to
@@ -36,16 +36,16 @@ from typing import Any
 
 import numpy as np
 
+from lerobot_mtdagger.datasets.records import StepOutcome, dagger_columns
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.mixing import (
+from lerobot_mtdagger.runner.mixing import (
     RolloutRules,
     episode_ends,
     expert_acts_now,
     expert_episode_coin,
     step_limit,
 )
-from lerobot_mtdagger.records import StepOutcome, dagger_columns
 
 logger = logging.getLogger(__name__)
 

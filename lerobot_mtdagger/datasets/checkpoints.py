@@ -20,9 +20,9 @@ from lerobot.configs.policies import PreTrainedConfig
 from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 from lerobot.processor.pipeline import ProcessorStepRegistry
 
-from lerobot_mtdagger.errors import UserError
 from lerobot_mtdagger.policies import MTDAggerPolicy
-from lerobot_mtdagger.quiet import quiet_third_party
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 PROCESSOR_FILES = ("policy_preprocessor.json", "policy_postprocessor.json")
 POLICY_TYPE = "mtdagger"

@@ -28,9 +28,9 @@ from typing import Any
 import numpy as np
 import pyarrow.parquet as pq
 
-from lerobot_mtdagger.errors import UserError
-from lerobot_mtdagger.report import CurvePoint, RunPoints, average_runs, curve_name
-from lerobot_mtdagger.rounds import CONFIG_FILE, ExperimentDir
+from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, ExperimentDir
+from lerobot_mtdagger.studies.report import CurvePoint, RunPoints, average_runs, curve_name
+from lerobot_mtdagger.utils.errors import UserError
 
 RESULTS_FILE = "results.json"
 META_FILE = "results_meta.json"

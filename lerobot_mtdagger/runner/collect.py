@@ -28,15 +28,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lerobot_mtdagger.mixing import RolloutRules
-from lerobot_mtdagger.seeds import BETA_STREAM, EVAL_STREAM, stream_seed
-from lerobot_mtdagger.workers import (
+from lerobot_mtdagger.runner.mixing import RolloutRules
+from lerobot_mtdagger.runner.workers import (
     EnvWorkers,
     Episode,
     EpisodeSpec,
     Ticket,
     limited_torch_threads,
 )
+from lerobot_mtdagger.utils.seeds import BETA_STREAM, EVAL_STREAM, stream_seed
 
 logger = logging.getLogger(__name__)
 

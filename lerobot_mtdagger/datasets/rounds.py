@@ -23,7 +23,7 @@ complete. Every round dataset carries the experiment's full task vocabulary in t
 every round and in merged datasets.
 
 A round is written in one go by :meth:`ExperimentDir.write_round` with the fast writer of
-``lerobot_mtdagger.round_writer``.
+``lerobot_mtdagger.datasets.round_writer``.
 """
 
 from __future__ import annotations
@@ -44,10 +44,8 @@ import pyarrow.parquet as pq
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import update_chunk_file_indices
 
-from lerobot_mtdagger.errors import CorruptExperimentError, NotAnExperimentError, UserError
-from lerobot_mtdagger.integrity import digest_mismatches, folder_digests
-from lerobot_mtdagger.quiet import quiet_third_party
-from lerobot_mtdagger.records import (
+from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
+from lerobot_mtdagger.datasets.records import (
     FORMAT_VERSION,
     RECORD_KEY,
     PhaseRecord,
@@ -55,7 +53,9 @@ from lerobot_mtdagger.records import (
     has_provenance,
     round_features,
 )
-from lerobot_mtdagger.round_writer import EpisodeFrames, write_round_episodes
+from lerobot_mtdagger.datasets.round_writer import EpisodeFrames, write_round_episodes
+from lerobot_mtdagger.utils.errors import CorruptExperimentError, NotAnExperimentError, UserError
+from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 logger = logging.getLogger(__name__)
 

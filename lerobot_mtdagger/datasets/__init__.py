@@ -1,0 +1,1 @@
+"""Round datasets: the experiment folder, the writer, records, checksums, verify, Hub, policies."""

@@ -1,0 +1,1 @@
+"""The runner: the DAgger loop, collection, env workers, mixing, training, evaluation, students."""

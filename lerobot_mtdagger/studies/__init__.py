@@ -1,0 +1,1 @@
+"""Studies: grids of runs (``compare``), results tables, reports, figures, statistics, shift."""
