@@ -362,3 +362,15 @@ def test_a_lerobot_student_runs_on_a_metaworld_state_subset(tmp_path, student):
     assert verify_experiment(ExperimentDir(root))[2] == []
     runner = PolicyRunner.from_pretrained(ExperimentDir(root).policy_root(1))
     assert isinstance(runner, ChunkRunner) and runner.input_keys == ["observation.state"]
+
+
+def test_predict_gives_each_row_the_first_action_of_a_fresh_chunk(suite):
+    """No queue carries over between calls (LeRobot's select_action would keep one)."""
+    policy, preprocessor, postprocessor = tiny_act_policy(suite, n_action_steps=3)
+    runner = ChunkRunner(policy, preprocessor, postprocessor)
+    state = torch.zeros(2, suite.features["observation.state"]["shape"][0])
+    first = runner.predict({"observation.state": state}, ["toy-left", "toy-right"])
+    again = runner.predict({"observation.state": state}, ["toy-left", "toy-right"])
+    torch.testing.assert_close(first, again)
+    fresh = runner([{"observation.state": row.numpy()} for row in state], ["toy-left", "toy-right"])
+    np.testing.assert_allclose(first.numpy(), fresh, atol=1e-6)

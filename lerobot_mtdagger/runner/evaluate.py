@@ -171,6 +171,23 @@ class ChunkRunner(PolicyRunner):
         self._refill([lane for lane in lanes if not self.queues[lane]])
         return np.stack([self.queues[lane].popleft().numpy() for lane in lanes])
 
+    def predict(self, inputs: dict[str, torch.Tensor], tasks: Sequence[str]) -> torch.Tensor:
+        """Unnormalised actions (B, action_dim): each row a fresh episode (its chunk's first action).
+
+        LeRobot's ``select_action`` would carry one action queue over calls; here nothing carries over.
+        """
+        batch = self.preprocess(inputs, tasks)
+        keys = [key for key in batch if key.startswith("observation.")]
+        if self.history_length > 1:  # a fresh episode's history repeats its first observation
+            batch = {
+                key: batch[key][:, None].expand(-1, self.history_length, *batch[key].shape[1:])
+                for key in keys
+            }
+        else:
+            batch = {key: batch[key] for key in keys}
+        with torch.inference_mode():
+            return self.postprocessor(self._predict_chunk(batch)[:, 0]).cpu()
+
     def reset(self) -> None:
         """Forgets every episode's history and queue."""
         self.histories.clear()
