@@ -24,7 +24,12 @@ from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import update_chunk_file_indices
 
 from lerobot_mtdagger.datasets.records import EPISODE_SUCCESS, NEXT_SUCCESS
-from lerobot_mtdagger.utils.lerobot_compat import DEFAULT_FEATURES, unsaved_frames, validate_frame
+from lerobot_mtdagger.utils.lerobot_compat import (
+    DEFAULT_FEATURES,
+    dataset_hf_features,
+    unsaved_frames,
+    validate_frame,
+)
 from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 logger = logging.getLogger(__name__)
@@ -257,7 +262,7 @@ def _checked_fast_stats(
 
 def _write_vector_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFrames]) -> None:
     """The fast path of :func:`write_round_episodes` (no image or video feature)."""
-    hf_features = dataset.hf_features
+    hf_features = dataset_hf_features(dataset)
     limit_bytes = dataset.meta.data_files_size_in_mb * 1024 * 1024
     # Per file: the episodes' buffers; a new file when the next episode would pass the size limit.
     files: list[list[tuple[str, dict[str, np.ndarray]]]] = [[]]

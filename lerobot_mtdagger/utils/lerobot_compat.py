@@ -6,6 +6,8 @@ checked by reading its sources with ``scripts/check_lerobot_names.py``, not run)
 - ``dataset_to_policy_features``: ``lerobot.datasets.utils`` -> ``lerobot.utils.feature_utils``;
 - ``validate_frame``: ``lerobot.datasets.utils`` -> ``lerobot.datasets.feature_utils``;
 - ``DEFAULT_FEATURES``: ``lerobot.datasets.utils`` -> ``lerobot.utils.constants``;
+- ``get_hf_features_from_features``: ``lerobot.datasets.utils`` -> ``lerobot.datasets.feature_utils``,
+  and a dataset no longer keeps ``hf_features`` (``dataset_hf_features`` builds them from its features);
 - a dataset's unsaved frames: ``dataset.episode_buffer`` -> ``dataset.writer.episode_buffer`` (0.5.1).
 
 Everything else the package imports from LeRobot has one spelling in both lines (the script checks
@@ -31,7 +33,23 @@ try:  # LeRobot >= 0.5
 except ImportError:  # LeRobot 0.4
     from lerobot.datasets.utils import DEFAULT_FEATURES
 
-__all__ = ["DEFAULT_FEATURES", "dataset_to_policy_features", "unsaved_frames", "validate_frame"]
+try:  # LeRobot >= 0.5
+    from lerobot.datasets.feature_utils import get_hf_features_from_features
+except ImportError:  # LeRobot 0.4
+    from lerobot.datasets.utils import get_hf_features_from_features
+
+__all__ = [
+    "DEFAULT_FEATURES",
+    "dataset_hf_features",
+    "dataset_to_policy_features",
+    "unsaved_frames",
+    "validate_frame",
+]
+
+
+def dataset_hf_features(dataset: Any) -> Any:
+    """The ``datasets.Features`` of a ``LeRobotDataset``'s frames (0.4 kept them as ``hf_features``)."""
+    return get_hf_features_from_features(dataset.meta.features)
 
 
 def unsaved_frames(dataset: Any) -> int:
