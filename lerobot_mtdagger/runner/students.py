@@ -208,7 +208,8 @@ class LeRobotOps:
         sums = torch.zeros(num_tasks, dtype=torch.float64)
         counts = torch.zeros(num_tasks, dtype=torch.float64)
         task_of = self.data.data.task_index
-        with torch.random.fork_rng(devices=[]):
+        device = next(self.policy.parameters()).device
+        with torch.random.fork_rng(devices=[device] if device.type == "cuda" else []):
             torch.manual_seed(self.seed)
             for task in torch.unique(task_of[index.cpu()]).tolist():
                 frames = index.cpu()[task_of[index.cpu()] == task]

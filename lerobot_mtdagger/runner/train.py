@@ -613,15 +613,18 @@ def train_phase(
 
     Each step samples ``batch_size`` frames of ``train_index`` with replacement (uniformly, or with
     ``sampling="balanced"`` a task uniformly and then one of its frames uniformly) and takes
-    one AdamW step on ``policy.imitation_loss`` with the gradient norm clipped to
-    ``config.optimizer_grad_clip_norm``. The losses stay on the device: they are read back only every
-    ``log_interval`` steps and after the last one, where they are checked for NaN/inf and reported.
-    The first step of each interval calls the full ``policy.forward`` (same loss and gradient) and
-    logs its per-task losses at debug level. The result depends only on the inputs and ``seed``
-    (not on ``log_interval``).
+    one optimiser step on the student's loss through its seam (``phase_ops``): for ``mtdagger`` an
+    AdamW step on ``policy.imitation_loss`` with the gradient norm clipped to
+    ``config.optimizer_grad_clip_norm`` (the first step of each interval calls the full
+    ``policy.forward``, same loss and gradient, and logs its per-task losses at debug level); for a
+    LeRobot student its ``forward`` loss with its config's optimiser and scheduler presets. The losses
+    stay on the device: they are read back only every ``log_interval`` steps and after the last one,
+    where they are checked for NaN/inf and reported. The result depends only on the inputs and
+    ``seed`` (not on ``log_interval``).
 
     Args:
-        policy: The policy to train, in place; its ``task_names`` must be ``data.task_names``.
+        policy: The policy to train, in place: ``mtdagger`` (its ``task_names`` must be
+            ``data.task_names``) or a LeRobot student reading a one-hot vector over them.
         data: The normalised frames.
         train_index: Frames to train on.
         loss_index: Frames the per-task loss is measured on, before and after.
