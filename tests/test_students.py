@@ -8,6 +8,7 @@ per-episode action queues and the per-task loss on their own; bad options refuse
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import signal
 import subprocess
@@ -150,7 +151,9 @@ def test_eval_of_a_lerobot_student_reports_every_task(act_run, tmp_path):
         )
         == 0
     )
-    assert output.is_file()
+    result = json.loads(output.read_text())
+    assert result["task_names"] == ["toy-left", "toy-right", "toy-up-windy"]
+    assert result["episodes"] == [2, 2, 2] and len(result["success"]) == 3
 
 
 def test_a_lerobot_student_resumes_after_kill_9_to_the_same_result(act_run, tmp_path):
@@ -279,13 +282,40 @@ def test_a_new_episode_on_a_lane_restarts_its_queue(suite):
     np.testing.assert_allclose(restarted, fresh, atol=1e-6)
 
 
-def test_rollouts_tell_a_chunking_student_its_lanes(suite):
+def test_a_chunking_student_runs_an_evaluation_with_queues_keyed_by_lane(suite):
     policy, preprocessor, postprocessor = tiny_act_policy(suite)
     runner = ChunkRunner(policy, preprocessor, postprocessor)
     with EnvWorkers(suite, 0) as workers:
         result, episodes = evaluate(workers, runner, episodes_per_task=2, seed=0)
     assert len(episodes) == 6 and len(result.success) == 3
     assert set(runner.queues) <= set(range(len(suite.task_names)))  # keyed by rollout lane
+
+
+def test_rollouts_say_each_rows_lane_and_each_episodes_first_step(suite):
+    policy, preprocessor, postprocessor = tiny_act_policy(suite)
+    runner = ChunkRunner(policy, preprocessor, postprocessor)
+    calls = []
+
+    def spy(observations, tasks, lanes=None, starts=None):
+        calls.append((lanes, starts))
+        return runner(observations, tasks, lanes=lanes, starts=starts)
+
+    with EnvWorkers(suite, 0) as workers:
+        _, episodes = evaluate(workers, _Forward(spy), episodes_per_task=2, seed=0)
+    assert calls and all(lanes is not None and starts is not None for lanes, starts in calls)
+    assert sum(sum(starts) for _, starts in calls) == len(episodes) == 6  # one first step per episode
+
+
+class _Forward:
+    """A policy object that forwards to ``spy`` and says it tracks episodes."""
+
+    tracks_episodes = True
+
+    def __init__(self, spy):
+        self.spy = spy
+
+    def __call__(self, observations, tasks, lanes=None, starts=None):
+        return self.spy(observations, tasks, lanes=lanes, starts=starts)
 
 
 def test_the_per_task_loss_of_a_lerobot_student_is_reproducible(act_run):

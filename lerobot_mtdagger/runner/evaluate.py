@@ -155,13 +155,12 @@ class ChunkRunner(PolicyRunner):
             lanes: The running episode (rollout lane) of each row (None: every row a fresh episode).
             starts: Whether the row is its episode's first observation (its lane's queue restarts).
         """
-        if lanes is None:
-            self.reset()
-            lanes, starts = range(len(observations)), [True] * len(observations)
         inputs = {
             key: torch.from_numpy(np.stack([observation[key] for observation in observations]))
             for key in self.input_keys
         }
+        if lanes is None:
+            return self.predict(inputs, tasks).numpy()
         batch = self.preprocess(inputs, tasks)
         keys = [key for key in batch if key.startswith("observation.")]
         for row, (lane, start) in enumerate(

@@ -207,12 +207,13 @@ class LeRobotOps:
         self.policy.train()  # ACT's loss needs its VAE encoder, which runs in training mode only
         sums = torch.zeros(num_tasks, dtype=torch.float64)
         counts = torch.zeros(num_tasks, dtype=torch.float64)
-        task_of = self.data.data.task_index
+        index = index.cpu()
+        task_of = self.data.data.task_index[index]
         device = next(self.policy.parameters()).device
         with torch.random.fork_rng(devices=[device] if device.type == "cuda" else []):
             torch.manual_seed(self.seed)
-            for task in torch.unique(task_of[index.cpu()]).tolist():
-                frames = index.cpu()[task_of[index.cpu()] == task]
+            for task in torch.unique(task_of).tolist():
+                frames = index[task_of == task]
                 for chunk in torch.split(frames, LOSS_CHUNK):
                     loss, _ = self.policy.forward(self.batch(chunk, dropout=False))
                     sums[task] += float(loss) * len(chunk)
