@@ -458,8 +458,10 @@ class ExperimentDir:
             ValueError: If a frame does not match the features or an episode has no frame.
         """
         dataset = self.create_round(round_index, features, task_names)
-        kept = [(task, [_only(frame, features) for frame in frames]) for task, frames in episodes]
-        write_round_episodes(dataset, kept)
+        extra = {key for _, frames in episodes[:1] for key in (frames[0] if frames else ())} - set(features)
+        if extra:  # an experiment without the provenance columns: drop them from every frame
+            episodes = [(task, [_only(frame, features) for frame in frames]) for task, frames in episodes]
+        write_round_episodes(dataset, episodes)
         return dataset
 
     def round_features(self, suite_features: dict[str, Any]) -> dict[str, Any]:
