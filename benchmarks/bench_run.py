@@ -2,7 +2,7 @@
 
 Run: ``.venv/bin/python benchmarks/bench_run.py`` (the README's main command: preset ``small``, MT10
 state) or, for example, ``.venv/bin/python benchmarks/bench_run.py --preset=metaworld-state
---rounds=3`` (MT50). Every argument is passed to ``lerobot-mtdagger run``; the output goes to a
+--dagger.rounds=3`` (MT50). Every argument is passed to ``lerobot-mtdagger run``; the output goes to a
 temporary folder unless ``--output_dir`` is given.
 
 Printed:

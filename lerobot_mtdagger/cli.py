@@ -4,10 +4,10 @@ Usage: ``lerobot-mtdagger <command> [--option=value ...]``. Options are parsed b
 configs are set with dots, for example ``--scheduler.type=need --scheduler.temperature=0.5``.
 
 Commands:
-    run: one Multitask DAgger experiment (``--preset``, ``--suite``, ``--tasks``, ``--scheduler.type``,
-        ``--rounds``, ``--budget``, ``--output_dir``, ``--resume``, ...; see ``RunConfig``), or the
-        one-round behaviour-cloning baseline with ``--mode=bc``.
-    eval: success per task of a pretrained policy (``--policy_path``, ``--suite``, ``--episodes``).
+    run: one Multitask DAgger experiment (``--preset``, ``--suite.name``, ``--suite.tasks``,
+        ``--scheduler.type``, ``--dagger.rounds``, ``--dagger.budget``, ``--output_dir``, ``--resume``,
+        ...; see ``RunConfig``), or the one-round behaviour-cloning baseline with ``--mode=bc``.
+    eval: success per task of a pretrained policy (``--policy_path``, ``--suite.name``, ``--episodes``).
     shift: covariate shift of a pretrained policy: its action error on the states of its own rollouts
         against on the expert's, per task (the options of ``eval``); tells whether DAgger's
         relabelled rollouts have much to add over more demonstrations.
@@ -39,7 +39,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from lerobot_mtdagger.datasets.hub import PushConfig, push_command
-from lerobot_mtdagger.runner.configs import RunConfig, renamed_option_error, resolve_workers
+from lerobot_mtdagger.envs.config import DEFAULT_IMAGE_SIZE, DEFAULT_NUM_POINTS, SuiteConfig
+from lerobot_mtdagger.runner.configs import (
+    RUN_OPTION_RENAMES,
+    SUITE_OPTION_RENAMES,
+    RunConfig,
+    renamed_option_error,
+    resolve_workers,
+)
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
 from lerobot_mtdagger.studies.compare import CompareConfig, follow_parent, split_arguments
 from lerobot_mtdagger.studies.simulate import SyntheticTasks, simulate
@@ -47,7 +54,7 @@ from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
 
 HELDOUT_TASKS = "heldout"
-"""``--tasks=heldout``: the suite's unseen tasks (``eval``, ``shift``)."""
+"""``--suite.tasks='[heldout]'``: the suite's unseen tasks (``eval``, ``shift``)."""
 
 if TYPE_CHECKING:
     from lerobot_mtdagger.envs.base import TaskSuite
@@ -197,25 +204,23 @@ def merge_command(config: MergeConfig) -> Path:
     return output
 
 
+def _eval_suite() -> SuiteConfig:
+    """``eval``'s default suite: MT10, its observations those the policy was trained on."""
+    return SuiteConfig(name="metaworld-mt10")
+
+
 @dataclass
 class EvalConfig:
     """Options of ``lerobot-mtdagger eval``: success per task of a policy (mtdagger, ACT, Diffusion).
 
     Attributes:
         policy_path: Pretrained model folder or Hub id (with its processors).
-        suite: Task suite.
-        tasks: Tasks to evaluate (all the suite's when empty; ``heldout``: the suite's unseen tasks,
-            which a policy trained with ``task_dropout > 0`` acts on with its shared embedding).
-        obs_mode: Observation mode the policy was trained on (None: read from the policy's inputs).
+        suite: The suite (``SuiteConfig``, spelt as for ``run``: ``--suite.name=drawers``).
+            ``--suite.tasks='[heldout]'`` evaluates the suite's unseen tasks, which a policy trained
+            with ``task_dropout > 0`` acts on with its shared embedding. ``suite.obs_mode``,
+            ``suite.num_points`` and ``suite.image_size`` default to what the policy was trained on.
         episodes: Episodes per task.
         seed: Seed of the evaluation episodes.
-        num_points: Points per cloud (None: the policy's).
-        image_size: Image side (None: the policy's).
-        mesh_detail: Share of the faces of the arm's meshes the observation renderer keeps, in (0, 1]
-            (rgb and pointcloud modes; 1: the exact model). 0.2 renders about twice as fast on a CPU
-            and changes only the arm's silhouette by millimetres (``docs/benchmarks.md``).
-        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when
-            None, or ``narrow``).
         output: Optional JSON file for the results.
         workers: Env worker processes (None: one per core; 0: in this process).
         trust_checkpoint: Let the policy's processor configs name Python classes, which LeRobot's
@@ -223,15 +228,9 @@ class EvalConfig:
     """
 
     policy_path: str | None = None
-    suite: str = "metaworld-mt10"
-    tasks: list[str] = field(default_factory=list)
-    obs_mode: str | None = None
+    suite: SuiteConfig = field(default_factory=_eval_suite)
     episodes: int = 10
     seed: int = 0
-    num_points: int | None = None
-    image_size: int | None = None
-    mesh_detail: float = 1.0
-    placement: str | None = None
     output: Path | None = None
     workers: int | None = None
     trust_checkpoint: bool = False
@@ -247,6 +246,9 @@ class EvalConfig:
             raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
         if self.episodes <= 0:
             raise ValueError(f"episodes must be > 0, got {self.episodes}.")
+        if self.suite.name is None:  # draccus builds a SuiteConfig of class defaults when one field is given
+            self.suite.name = _eval_suite().name
+        self.suite.check()
 
 
 def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
@@ -255,25 +257,22 @@ def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
     from lerobot_mtdagger.runner.evaluate import PolicyRunner
 
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
-    config = dataclasses.replace(config, **observation_options(runner, config))
-    if list(config.tasks) == [HELDOUT_TASKS]:
-        suite = suite_from_config(config, tasks=None).heldout_suite()
+    suite_config = dataclasses.replace(config.suite, **observation_options(runner, config.suite))
+    if list(suite_config.tasks) == [HELDOUT_TASKS]:
+        suite = suite_from_config(suite_config, tasks=None).heldout_suite()
         if suite is None:
             raise UserError(
-                f"Suite {config.suite!r} has no held-out tasks: --tasks=heldout is for the drawers."
+                f"Suite {suite_config.name!r} has no held-out tasks: --suite.tasks='[heldout]' is for the "
+                "drawers."
             )
     else:
-        suite = suite_from_config(config)
-    runner.check_inputs(suite.features, config.obs_mode)
+        suite = suite_from_config(suite_config)
+    runner.check_inputs(suite.features, suite_config.obs_mode)
     return suite, runner
 
 
-DEFAULT_NUM_POINTS = 1024
-DEFAULT_IMAGE_SIZE = 84
-
-
-def observation_options(runner: PolicyRunner, config: EvalConfig) -> dict[str, Any]:
-    """``obs_mode``, ``num_points`` and ``image_size``: the config's, else what the policy was trained on.
+def observation_options(runner: PolicyRunner, suite: SuiteConfig) -> dict[str, Any]:
+    """``obs_mode``, ``num_points`` and ``image_size``: the suite config's, else the policy's.
 
     A policy with a point-cloud input was trained on clouds of its input's point count, one with an
     image input on images of its side, any other on state.
@@ -285,9 +284,9 @@ def observation_options(runner: PolicyRunner, config: EvalConfig) -> dict[str, A
     images = [f for key, f in features.items() if key.startswith("observation.image")]
     trained = "pointcloud" if clouds else "rgb" if images else "state"
     return {
-        "obs_mode": config.obs_mode or trained,
-        "num_points": config.num_points or (clouds[0].shape[0] if clouds else DEFAULT_NUM_POINTS),
-        "image_size": config.image_size or (images[0].shape[-1] if images else DEFAULT_IMAGE_SIZE),
+        "obs_mode": suite.obs_mode or trained,
+        "num_points": suite.num_points or (clouds[0].shape[0] if clouds else DEFAULT_NUM_POINTS),
+        "image_size": suite.image_size or (images[0].shape[-1] if images else DEFAULT_IMAGE_SIZE),
     }
 
 
@@ -576,6 +575,14 @@ def configure_console_logging() -> None:
     logging.getLogger(HUB_LOGGER).setLevel(logging.ERROR)
 
 
+OPTION_RENAMES: dict[str, dict[str, str]] = {
+    "run": RUN_OPTION_RENAMES,
+    "compare": RUN_OPTION_RENAMES,
+    "eval": SUITE_OPTION_RENAMES,
+    "shift": SUITE_OPTION_RENAMES,
+}
+"""Each command's options that moved into a group (refused with the new spelling named)."""
+
 DEBUG_FLAG = "--debug"
 """Shows the traceback of a user error (for reporting a problem)."""
 
@@ -633,6 +640,9 @@ def run_command(command: str, options: list[str]) -> None:
     passed: list[str] = []
     if command == "compare":  # compare's own options; every other option goes to each run
         options, passed = split_arguments(options)
+    renamed = renamed_option_error(passed if command == "compare" else options, OPTION_RENAMES.get(command))
+    if renamed is not None:
+        raise UserError(renamed)
     config = parse_options(config_class, options, f"lerobot-mtdagger {command}")
     function(config, passed) if command == "compare" else function(config)
 

@@ -23,6 +23,8 @@ from pathlib import Path
 import pyarrow.parquet as pq
 from safetensors.numpy import load_file
 
+from lerobot_mtdagger.datasets.config_layout import flatten, migrate_run_config
+
 
 def round_record(root: Path) -> dict:
     """A round's record: ``meta/mtdagger.json``, or ``meta/info.json``'s mirror in older rounds."""
@@ -48,7 +50,8 @@ def compare_round(old: Path, new: Path, ignore_config: set[str]) -> list[str]:
     """Differences of one round's record and data."""
     records = [round_record(p) for p in (old, new)]
     problems = compare_dicts(records[0], records[1], old.name, {"config"})
-    configs = [r["config"] for r in records]
+    # Configs compared option by option, in today's layout (a flat stored config is migrated).
+    configs = [flatten(migrate_run_config(r["config"])) for r in records]
     problems += compare_dicts(configs[0], configs[1], f"{old.name}.config", {"output_dir", *ignore_config})
     files = [sorted(p.relative_to(root) for p in (root / "data").rglob("*.parquet")) for root in (old, new)]
     if files[0] != files[1]:

@@ -106,17 +106,18 @@ def test_dataset_card_template_ships_with_the_package(tmp_path):
     ],
 )
 def test_eval_takes_the_observation_options_the_policy_was_trained_with(inputs, given, expected):
-    """A point-cloud policy evaluates without --obs_mode / --num_points; what is given still wins."""
+    """A point-cloud policy evaluates without --suite.obs_mode / --suite.num_points; what is given wins."""
     from types import SimpleNamespace
 
     from lerobot.configs.types import FeatureType, PolicyFeature
 
     from lerobot_mtdagger.cli import EvalConfig, observation_options
+    from lerobot_mtdagger.envs import SuiteConfig
 
     features = {
         key: PolicyFeature(FeatureType.VISUAL if "image" in key else FeatureType.STATE, shape)
         for key, shape in inputs.items()
     }
     runner = SimpleNamespace(policy=SimpleNamespace(config=SimpleNamespace(input_features=features)))
-    options = observation_options(runner, EvalConfig(policy_path="p", **given))
+    options = observation_options(runner, EvalConfig(policy_path="p", suite=SuiteConfig(**given)).suite)
     assert (options["obs_mode"], options["num_points"], options["image_size"]) == expected

@@ -17,26 +17,28 @@ from pathlib import Path
 import pytest
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
+from lerobot_mtdagger.envs import SuiteConfig
+from lerobot_mtdagger.runner.configs import DAggerConfig, RunConfig
 from lerobot_mtdagger.studies.compare import (
     PARENT_PID_ENV,
     CompareConfig,
     bc_rounds_for,
     follow_parent,
-    is_finished,
     jobs_for,
     split_arguments,
 )
 from lerobot_mtdagger.studies.figures import hardest_tasks, seed_reach
+from lerobot_mtdagger.studies.launchers import is_finished
 from tests.test_dagger import _children, _running
 
 TINY = [
-    "--suite=toy",
-    "--rounds=2",
-    "--initial_demos=1",
-    "--budget_per_task=2",
-    "--steps_per_round=20",
-    "--eval_episodes=2",
+    "--suite.name=toy",
+    "--dagger.rounds=2",
+    "--dagger.initial_demos=1",
+    "--dagger.budget_per_task=2",
+    "--training.steps_per_round=20",
+    "--rollout.eval_episodes=2",
     "--policy.batch_size=32",
     "--policy.state_hidden_dims=[32]",
     "--policy.head_hidden_dims=[32]",
@@ -97,7 +99,10 @@ def test_a_second_compare_skips_finished_runs(compared, monkeypatch):
 def _compare_in_its_first_run(folder: Path, seeds: str) -> tuple[subprocess.Popen, list[str], list[int]]:
     """Starts ``compare`` (need, 1 500 steps per phase) in a process and returns once its first run has
     committed round 0, with 3 phases to go: (compare, its arguments, the run processes it started)."""
-    longer = [*(o for o in TINY if not o.startswith("--steps_per_round")), "--steps_per_round=1500"]
+    longer = [
+        *(o for o in TINY if not o.startswith("--training.steps_per_round")),
+        "--training.steps_per_round=1500",
+    ]
     args = ["compare", "--methods=[need]", f"--seeds={seeds}", f"--output_dir={folder}", "--jobs=1", *longer]
     cli = str(Path(sys.executable).parent / "lerobot-mtdagger")
     process = subprocess.Popen([cli, *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -233,7 +238,7 @@ def test_report_redrawn_from_the_saved_table_alone_equals_the_report_of_the_runs
     meta = json.loads((folder / "results_meta.json").read_text())  # compare's own table has it too
     assert meta["task_names"] == ["toy-left", "toy-right", "toy-up-windy"] and meta["unfinished"] == []
     assert sorted(meta["configs"]) == ["bc", "gain", "need", "need_raw", "uniform"]
-    assert meta["configs"]["need"]["eval_episodes"] == 2 and "seed" not in meta["configs"]["need"]
+    assert meta["configs"]["need"]["rollout.eval_episodes"] == 2 and "seed" not in meta["configs"]["need"]
 
 
 def test_a_table_written_before_the_unseen_columns_joins_a_new_one(compared, tmp_path):
@@ -350,6 +355,36 @@ def test_tables_of_seeds_run_apart_join_into_the_report_of_all_runs(compared, se
     ]
 
 
+def _as_flat_config(shared: dict) -> dict:
+    """A method's shared options as a table written before the options were grouped stored them."""
+    old_names = {new: old for old, new in FLAT_OPTION_PATHS.items()}
+    flat: dict = {}
+    for path, value in shared.items():
+        if path in old_names:
+            flat[old_names[path]] = value
+        elif "." in path:
+            group, name = path.split(".", 1)
+            if group in ("policy", "scheduler"):  # nested then too; other new options did not exist
+                flat.setdefault(group, {})[name] = value
+        else:
+            flat[path] = value
+    return flat
+
+
+def test_a_table_saved_before_the_options_were_grouped_joins_a_new_one(seed_tables, tmp_path):
+    def to_old_layout(meta):
+        meta["configs"] = {method: _as_flat_config(shared) for method, shared in meta["configs"].items()}
+
+    old = _with_meta(seed_tables / "seed1", tmp_path / "old", to_old_layout)
+    assert "eval_episodes" in json.loads((old / "results_meta.json").read_text())["configs"]["need"]
+    out = tmp_path / "joined"
+    assert main(["report", f"--results=[{seed_tables / 'seed0'},{old}]", f"--output_dir={out}"]) == 0
+    changed = _with_meta(
+        old, tmp_path / "changed", lambda meta: meta["configs"]["need"].update(eval_episodes=20)
+    )
+    assert main(["report", f"--results=[{seed_tables / 'seed0'},{changed}]", f"--output_dir={out}-2"]) == 2
+
+
 def _with_meta(table: Path, folder: Path, change) -> Path:
     """A copy of a saved table whose results_meta.json is changed by ``change(meta)``."""
     shutil.copytree(table, folder)
@@ -368,9 +403,11 @@ def _with_meta(table: Path, folder: Path, change) -> Path:
         ),
         (
             lambda tables, copy: _with_meta(
-                tables / "seed1", copy, lambda meta: meta["configs"]["need"].update(eval_episodes=20)
+                tables / "seed1",
+                copy,
+                lambda meta: meta["configs"]["need"].update({"rollout.eval_episodes": 20}),
             ),
-            r"Refusing to join need runs with different configs \(eval_episodes: 2 vs 20\)",
+            r"Refusing to join need runs with different configs \(rollout.eval_episodes: 2 vs 20\)",
         ),
         (
             lambda tables, copy: _with_meta(tables / "seed1", copy, lambda meta: meta.pop("configs")),
@@ -393,7 +430,9 @@ def test_tables_that_would_mislead_are_not_joined(seed_tables, tmp_path, capsys,
 
 
 def test_bc_budgets_map_to_rounds_and_bad_ones_are_refused():
-    config = RunConfig(suite="toy", rounds=2, initial_demos=1, budget_per_task=2)
+    config = RunConfig(
+        suite=SuiteConfig(name="toy"), dagger=DAggerConfig(rounds=2, initial_demos=1, budget_per_task=2)
+    )
     assert bc_rounds_for(config, [], 3) == {1: 0, 3: 1, 5: 2}
     assert bc_rounds_for(config, [7], 3) == {7: 3}
     with pytest.raises(ValueError, match="not initial_demos \\+ k"):
@@ -414,8 +453,8 @@ def test_every_method_gets_the_same_seeds_and_run_options():
 def test_compare_with_more_rounds_extends_dagger_runs_and_adds_bc_budgets(tmp_path):
     folder = tmp_path / "cmp"
     args = ["compare", "--methods=[bc,uniform]", "--seeds=[0]", f"--output_dir={folder}", "--jobs=1"]
-    short = [arg for arg in TINY if not arg.startswith("--rounds")]
-    assert main([*args, *short, "--rounds=1"]) == 0
+    short = [arg for arg in TINY if not arg.startswith("--dagger.rounds")]
+    assert main([*args, *short, "--dagger.rounds=1"]) == 0
     policies = folder / "runs" / "uniform-seed0" / "policies"
 
     def weights_written() -> dict[str, int]:
@@ -423,7 +462,7 @@ def test_compare_with_more_rounds_extends_dagger_runs_and_adds_bc_budgets(tmp_pa
 
     before = weights_written()
     assert sorted(before) == ["round-000", "round-001"]
-    assert main([*args, *short, "--rounds=2"]) == 0
+    assert main([*args, *short, "--dagger.rounds=2"]) == 0
     after = weights_written()
     assert sorted(after) == ["round-000", "round-001", "round-002"]
     assert {name: after[name] for name in before} == before  # the rounds made are kept as they were
@@ -454,7 +493,7 @@ def test_report_shows_a_labelled_bc_variant_as_a_second_baseline(compared, tmp_p
     folder, _ = compared
     balanced = tmp_path / "bc-balanced"
     args = ["compare", "--methods=[bc]", "--seeds=[0,1]", "--bc_budgets=[1,3]", f"--output_dir={balanced}"]
-    assert main([*args, "--jobs=2", *TINY, "--sampling=balanced"]) == 0
+    assert main([*args, "--jobs=2", *TINY, "--training.sampling=balanced"]) == 0
     capsys.readouterr()
     runs = sorted((balanced / "runs").glob("bc-*"))
     runs = [run for run in runs if run.is_dir()]

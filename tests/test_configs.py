@@ -2,11 +2,28 @@
 
 from __future__ import annotations
 
+import dataclasses
+import json
+import shutil
+from pathlib import Path
+
 import draccus
 import pytest
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.runner.configs import PRESET_FIELDS, PRESETS, RunConfig
+from lerobot_mtdagger.datasets.config_layout import (
+    FLAT_OPTION_PATHS,
+    flatten,
+    is_flat,
+    migrate_run_config,
+    option,
+)
+from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.verify import verify_experiment
+from lerobot_mtdagger.runner.configs import PRESET_FIELDS, PRESETS, DAggerConfig, RunConfig
+from lerobot_mtdagger.runner.dagger import run
+from lerobot_mtdagger.studies.results import results_rows
+from lerobot_mtdagger.utils.errors import UserError
 
 
 def parse(*args: str) -> RunConfig:
@@ -22,9 +39,9 @@ def value_of(config: RunConfig, path: str):
 
 def another_value(path: str, value):
     """A valid command-line value that differs from the preset's ``value``."""
-    if path == "suite":
+    if path == "suite.name":
         return "drawers" if value != "drawers" else "metaworld-mt25"
-    if path == "obs_mode":
+    if path == "suite.obs_mode":
         return "rgb" if value != "rgb" else "state"
     if isinstance(value, float):
         return value * 3
@@ -61,14 +78,15 @@ def test_every_preset_option_set_at_once_wins(preset):
 
 def test_scheduler_n_min_typed_by_the_user_is_kept_whatever_the_method():
     for method in ("uniform", "gain"):
-        config = parse("--scheduler.n_min=5", f"--scheduler.type={method}", "--budget_per_task=5")
+        config = parse("--scheduler.n_min=5", f"--scheduler.type={method}", "--dagger.budget_per_task=5")
         assert config.scheduler.n_min == 5 and config.to_dict()["scheduler"]["n_min"] == 5
     assert parse("--preset=drawers-pointcloud", "--scheduler.n_min=2").scheduler.n_min == 2
 
 
 def test_python_construction_applies_presets_the_same_way():
-    config = RunConfig(preset="drawers-pointcloud", rounds=1)
-    assert config.rounds == 1 and config.scheduler.n_min == 5 and config.policy.lr == 1e-4
+    config = RunConfig(preset="drawers-pointcloud", dagger=DAggerConfig(rounds=1))
+    assert config.dagger.rounds == 1 and config.scheduler.n_min == 5 and config.policy.lr == 1e-4
+    assert config.dagger.initial_demos == 30 and config.suite.name == "drawers"
 
 
 def test_bc_is_a_run_mode():
@@ -86,3 +104,100 @@ def test_old_spellings_fail_naming_the_new_one(capsys, tmp_path, old, new):
     assert main(["run", old, f"--output_dir={tmp_path / 'out'}"]) == 2
     assert new in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+# -------------------------------------------------------------------------------------------------
+# Composed options: groups, renames, the migration of experiments stored with the flat layout
+# -------------------------------------------------------------------------------------------------
+
+OLD_EXPERIMENT = Path(__file__).parent / "data" / "experiment-flat-config-v1"
+"""A toy run written with the flat config (``HOW.md`` there has its command)."""
+
+OLD_RUN_OPTIONS = [
+    "--suite.name=toy",
+    "--dagger.initial_demos=1",
+    "--dagger.budget_per_task=1",
+    "--training.steps_per_round=5",
+    "--rollout.eval_episodes=1",
+    "--rollout.workers=0",
+    "--seed=3",
+    "--progress=false",
+    "--policy.batch_size=8",
+    "--policy.state_hidden_dims=[16]",
+    "--policy.head_hidden_dims=[16]",
+    "--policy.task_embedding_dim=4",
+]
+"""``OLD_EXPERIMENT``'s options in today's spelling (its --rounds=1 aside)."""
+
+
+def test_the_run_config_has_at_most_twelve_top_level_options():
+    assert len(dataclasses.fields(RunConfig)) <= 12
+
+
+@pytest.mark.parametrize("old", sorted(FLAT_OPTION_PATHS))
+def test_every_flat_option_names_its_grouped_spelling_and_writes_nothing(capsys, tmp_path, old):
+    new = FLAT_OPTION_PATHS[old]
+    assert value_of(parse(), new) == value_of(RunConfig(), new)  # the new path exists
+    assert main(["run", f"--{old}=1", f"--output_dir={tmp_path / 'out'}"]) == 2
+    error = capsys.readouterr().err
+    assert f"--{new}=1" in error and len(error.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("command", ["eval", "shift"])
+def test_eval_and_shift_name_the_grouped_suite_options(capsys, command):
+    assert main([command, "--policy_path=unused", "--obs_mode=rgb"]) == 2
+    assert "--suite.obs_mode=rgb" in capsys.readouterr().err
+    assert main([command, "--policy_path=unused", "--suite=toy"]) == 2
+    assert "--suite.name=toy" in capsys.readouterr().err
+
+
+def test_compare_names_the_grouped_spelling_of_the_run_options_it_passes_on(capsys, tmp_path):
+    assert main(["compare", "--methods=[need]", f"--output_dir={tmp_path / 'c'}", "--rounds=2"]) == 2
+    assert "--dagger.rounds=2" in capsys.readouterr().err
+    assert not (tmp_path / "c").exists()
+
+
+def test_a_flat_config_migrates_into_the_groups():
+    flat = json.loads((OLD_EXPERIMENT / "config.json").read_text())
+    migrated = migrate_run_config(flat)
+    assert not is_flat(migrated) and migrate_run_config(migrated) == migrated
+    assert migrated["suite"]["name"] == "toy" and migrated["dagger"]["rounds"] == 1
+    assert migrated["rollout"]["max_steps"] is None and migrated["training"]["steps_per_round"] == 5
+    assert migrated["policy"] == flat["policy"] and migrated["scheduler"] == flat["scheduler"]
+    leaves = flatten(migrated)
+    assert {path for old, path in FLAT_OPTION_PATHS.items() if old in flat} <= set(leaves)
+    assert option(flat, "training.sampling") == option(migrated, "training.sampling") == "uniform"
+    # Every option of today's config is either a migrated one or one added since (with its default).
+    today = flatten(parse("--suite.name=toy").to_dict())
+    added = set(today) - set(leaves)
+    assert added == {"suite.episode_length", "rollout.worker_backend", "rollout.ray_address"}, added
+    assert all(today[path] == RunConfig.option_defaults()[path] for path in added)
+
+
+def test_an_experiment_stored_with_the_flat_config_resumes_and_grows(tmp_path):
+    root = tmp_path / "old"
+    shutil.copytree(OLD_EXPERIMENT, root)
+    before = {p.relative_to(root): p.read_bytes() for p in (root / "rounds").rglob("*") if p.is_file()}
+    args = [*OLD_RUN_OPTIONS, f"--output_dir={root}", "--resume=true"]
+    lines = run(parse(*args, "--dagger.rounds=2"))
+    assert [line.split(":")[0] for line in lines] == ["round 0", "round 1", "round 2"]
+    assert verify_experiment(ExperimentDir(root)) == (3, 3, [])
+    for path, content in before.items():  # the rounds written before are kept as they were
+        assert (root / path).read_bytes() == content, path
+    stored = json.loads((root / "config.json").read_text())
+    assert stored["dagger"]["rounds"] == 2 and stored["suite"]["name"] == "toy"  # rewritten grouped
+    rows = results_rows([root])
+    assert [row["round"] for row in rows] == [0, 1, 2]
+    assert {row["eval_episodes_per_task"] for row in rows} == {1}  # read from old and new records
+
+
+def test_a_result_changing_option_differing_from_a_flat_stored_config_is_refused(tmp_path):
+    root = tmp_path / "old"
+    shutil.copytree(OLD_EXPERIMENT, root)
+    args = [*OLD_RUN_OPTIONS, f"--output_dir={root}", "--resume=true", "--dagger.rounds=1"]
+    with pytest.raises(UserError, match=r"training.sampling: 'uniform' -> 'balanced'"):
+        run(parse(*args, "--training.sampling=balanced"))
+    assert json.loads((root / "config.json").read_text()) == json.loads(
+        (OLD_EXPERIMENT / "config.json").read_text()
+    )

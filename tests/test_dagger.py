@@ -29,11 +29,11 @@ from tests.helpers import edit_round_record
 
 TASKS = ["reach-v3", "button-press-topdown-v3", "push-v3"]
 TINY = [
-    "--tasks=[reach-v3,button-press-topdown-v3,push-v3]",
-    "--rounds=2",
-    "--steps_per_round=60",
-    "--eval_episodes=1",
-    "--max_rollout_steps=60",
+    "--suite.tasks=[reach-v3,button-press-topdown-v3,push-v3]",
+    "--dagger.rounds=2",
+    "--training.steps_per_round=60",
+    "--rollout.eval_episodes=1",
+    "--rollout.max_steps=60",
     "--policy.batch_size=64",
     "--progress=false",
 ]
@@ -148,9 +148,9 @@ def test_report_refuses_to_average_runs_of_different_configs(experiment, tmp_pat
     other = tmp_path / "need-longer"
     shutil.copytree(experiment.root, other)
     config = json.loads((other / "config.json").read_text())
-    config |= {"seed": 1, "steps_per_round": 999, "workers": 0}
+    config["seed"], config["rollout"]["workers"], config["training"]["steps_per_round"] = 1, 0, 999
     (other / "config.json").write_text(json.dumps(config))
-    with pytest.raises(ValueError, match=r"different configs \(steps_per_round: 60 vs 999\)"):
+    with pytest.raises(ValueError, match=r"different configs \(training.steps_per_round: 60 vs 999\)"):
         learning_curves([experiment.root, other])
 
 
@@ -158,7 +158,7 @@ def test_report_refuses_runs_without_evaluation(tmp_path):
     from lerobot_mtdagger.studies.results import learning_curves
     from tests.test_toy import toy_config
 
-    run(toy_config(tmp_path / "blind", "--rounds=0", "--eval_episodes=0"))
+    run(toy_config(tmp_path / "blind", "--dagger.rounds=0", "--rollout.eval_episodes=0"))
     with pytest.raises(ValueError, match="no evaluated phase|has an evaluated phase"):
         learning_curves([tmp_path / "blind"])
 
@@ -197,9 +197,9 @@ def test_resume_with_another_config_is_refused(experiment):
 @pytest.mark.parametrize(
     ("args", "error", "match"),
     [
-        (["--suite=robosuite"], ValueError, "Unknown suite"),
-        (["--tasks=[reach-v3,jump-v3]"], ValueError, "not in metaworld-mt10"),
-        (["--budget=2"], ValueError, r"budget=2 is smaller than n_min \* num_tasks = 1 \* 3 = 3"),
+        (["--suite.name=robosuite"], ValueError, "Unknown suite"),
+        (["--suite.tasks=[reach-v3,jump-v3]"], ValueError, "not in metaworld-mt10"),
+        (["--dagger.budget=2"], ValueError, r"budget=2 is smaller than n_min \* num_tasks = 1 \* 3 = 3"),
     ],
 )
 def test_bad_runs_are_refused_before_anything_is_written(tmp_path, args, error, match):
@@ -212,7 +212,7 @@ def test_unknown_method_and_missing_output_dir_are_clear_cli_errors(capsys, tmp_
     assert main(["run", "--scheduler.type=greedy", f"--output_dir={tmp_path}"]) == 2
     err = capsys.readouterr().err.strip().splitlines()  # argparse's message only, without its usage
     assert len(err) == 1 and "invalid choice: 'greedy'" in err[0] and "run --help" in err[0]
-    assert main(["run", "--rounds=-1"]) == 2
+    assert main(["run", "--dagger.rounds=-1"]) == 2
     assert "rounds must be >= 0, got -1" in capsys.readouterr().err
 
 
@@ -234,15 +234,15 @@ def test_drawer_suite_runs_with_point_clouds_and_evaluates_the_unseen_drawers(tm
 
     args = [
         "--preset=drawers-pointcloud",
-        "--tasks=[drawer-bar-wide,drawer-lip-shallow]",
-        "--rounds=1",
-        "--initial_demos=1",
-        "--budget_per_task=1",
+        "--suite.tasks=[drawer-bar-wide,drawer-lip-shallow]",
+        "--dagger.rounds=1",
+        "--dagger.initial_demos=1",
+        "--dagger.budget_per_task=1",
         "--scheduler.n_min=1",
-        "--steps_per_round=20",
-        "--eval_episodes=1",
-        "--num_points=128",
-        "--max_rollout_steps=80",
+        "--training.steps_per_round=20",
+        "--rollout.eval_episodes=1",
+        "--suite.num_points=128",
+        "--rollout.max_steps=80",
         "--progress=false",
         f"--output_dir={tmp_path / 'drawers'}",
     ]
@@ -269,8 +269,13 @@ def test_drawer_suite_runs_with_point_clouds_and_evaluates_the_unseen_drawers(tm
     from lerobot_mtdagger.cli import EvalConfig, eval_command
 
     policy = experiment.policy_root(1)
-    # No --obs_mode / --num_points: eval reads them from the policy's inputs (a 128-point cloud).
-    args = [f"--policy_path={policy}", "--suite=drawers", "--tasks=[heldout]", "--placement=kitchen"]
+    # No --suite.obs_mode / --suite.num_points: eval reads them from the policy's inputs (a 128-point cloud).
+    args = [
+        f"--policy_path={policy}",
+        "--suite.name=drawers",
+        "--suite.tasks=[heldout]",
+        "--suite.placement=kitchen",
+    ]
     result = eval_command(draccus.parse(EvalConfig, args=[*args, "--episodes=1", "--workers=0"]))
     assert result["task_names"] == list(HELDOUT_TASKS) and len(result["progress"]) == len(HELDOUT_TASKS)
 
@@ -291,7 +296,7 @@ def _cli(output_dir: Path, *extra: str) -> list[str]:
         str(Path(sys.executable).parent / "lerobot-mtdagger"),
         "run",
         *TINY,
-        "--workers=2",
+        "--rollout.workers=2",
         f"--output_dir={output_dir}",
         *extra,
     ]
@@ -375,12 +380,12 @@ def test_dagger_improves_a_weak_bc_policy(tmp_path):
     config = draccus.parse(
         RunConfig,
         args=[
-            "--tasks=[reach-v3,push-v3,pick-place-v3,peg-insert-side-v3]",
-            "--initial_demos=1",
-            "--rounds=3",
-            "--budget_per_task=5",
-            "--steps_per_round=2000",
-            "--eval_episodes=10",
+            "--suite.tasks=[reach-v3,push-v3,pick-place-v3,peg-insert-side-v3]",
+            "--dagger.initial_demos=1",
+            "--dagger.rounds=3",
+            "--dagger.budget_per_task=5",
+            "--training.steps_per_round=2000",
+            "--rollout.eval_episodes=10",
             "--progress=false",
             f"--output_dir={tmp_path / 'run'}",
         ],

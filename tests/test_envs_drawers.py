@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 
 from lerobot_mtdagger.cli import EvalConfig
-from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, make_suite, suite_from_config
+from lerobot_mtdagger.envs import (
+    IMAGE_KEY,
+    POINTCLOUD_KEY,
+    STATE_KEY,
+    SuiteConfig,
+    make_suite,
+    suite_from_config,
+)
 from lerobot_mtdagger.envs.drawers.catalogue import (
     DRAWER_TASKS,
     HELDOUT_DRAWERS,
@@ -383,7 +390,7 @@ def test_vector_env_steps_drawers_in_worker_processes():
 
 
 def test_lerobot_env_plugin_builds_a_drawer():
-    env = LeRobotSuiteEnv(suite="drawers", task="drawer-kitchen", obs_mode="state")
+    env = LeRobotSuiteEnv(suite={"name": "drawers", "obs_mode": "state"}, task="drawer-kitchen")
     try:
         observation, _ = env.reset(seed=0)
         assert observation["agent_pos"].shape == (len(DRAWER_STATE_NAMES),)
@@ -394,9 +401,11 @@ def test_lerobot_env_plugin_builds_a_drawer():
 
 @pytest.mark.parametrize("placement", [None, "narrow"])
 def test_the_lerobot_env_plugin_and_eval_take_the_placement(placement):
-    """``--env.placement`` (lerobot-eval) and ``eval --placement`` reach the drawers; default kitchen."""
-    config = MTDAggerSuiteEnvConfig(suite="drawers", task="drawer-kitchen", placement=placement)
-    assert config.gym_kwargs["placement"] == placement
+    """``--env.suite.placement`` (lerobot-eval) and ``eval --suite.placement`` reach the drawers (kitchen)."""
+    config = MTDAggerSuiteEnvConfig(
+        suite=SuiteConfig(name="drawers", placement=placement), task="drawer-kitchen"
+    )
+    assert config.gym_kwargs["suite"]["placement"] == placement
     env = LeRobotSuiteEnv(**config.gym_kwargs)
     try:
         assert env._suite.placement.name == (placement or "kitchen")
@@ -404,13 +413,11 @@ def test_the_lerobot_env_plugin_and_eval_take_the_placement(placement):
         env.close()
     eval_config = EvalConfig(
         policy_path="unused",
-        suite="drawers",
-        obs_mode="state",
-        num_points=512,
-        image_size=84,
-        placement=placement,
+        suite=SuiteConfig(
+            name="drawers", obs_mode="state", num_points=512, image_size=84, placement=placement
+        ),
     )
-    assert suite_from_config(eval_config).placement.name == (placement or "kitchen")
+    assert suite_from_config(eval_config.suite).placement.name == (placement or "kitchen")
 
 
 def test_pictures_show_the_drawer():

@@ -35,12 +35,12 @@ def lerobot_eval(
         "--policy.device=cpu",
         "--env.discover_packages_path=lerobot_mtdagger.envs",
         "--env.type=mtdagger_suite",
-        f"--env.suite={suite}",
+        f"--env.suite.name={suite}",
         f"--env.task={task}",
-        f"--env.obs_mode={obs_mode}",
-        "--env.num_points=128",
-        "--env.image_size=32",
-        "--env.episode_length=30",
+        f"--env.suite.obs_mode={obs_mode}",
+        "--env.suite.num_points=128",
+        "--env.suite.image_size=32",
+        "--env.suite.episode_length=30",
         "--eval.n_episodes=1",
         "--eval.batch_size=1",
         f"--output_dir={output_dir}",
@@ -116,18 +116,18 @@ def test_stock_lerobot_train_and_eval_on_a_merged_point_cloud_experiment(tmp_pat
 
     drawers = ["drawer-bar-wide", "drawer-knob-small"]
     args = [
-        "--suite=drawers",
-        "--obs_mode=pointcloud",
-        f"--tasks=[{','.join(drawers)}]",
-        "--rounds=1",
-        "--initial_demos=1",
-        "--budget_per_task=1",
+        "--suite.name=drawers",
+        "--suite.obs_mode=pointcloud",
+        f"--suite.tasks=[{','.join(drawers)}]",
+        "--dagger.rounds=1",
+        "--dagger.initial_demos=1",
+        "--dagger.budget_per_task=1",
         "--scheduler.n_min=1",
-        "--steps_per_round=5",
-        "--eval_episodes=1",
-        "--num_points=64",
-        "--max_rollout_steps=30",
-        "--workers=0",
+        "--training.steps_per_round=5",
+        "--rollout.eval_episodes=1",
+        "--suite.num_points=64",
+        "--rollout.max_steps=30",
+        "--rollout.workers=0",
         "--progress=false",
         f"--output_dir={tmp_path / 'run'}",
     ]
@@ -149,7 +149,7 @@ def test_stock_lerobot_train_and_eval_on_a_merged_point_cloud_experiment(tmp_pat
     assert config["input_features"]["observation.pointcloud"]["shape"] == [64, 3]
     assert config["task_names"] == drawers
     rename = '--rename_map={"observation.environment_state": "observation.pointcloud"}'
-    extra = [rename, "--env.num_points=64"]
+    extra = [rename, "--env.suite.num_points=64"]
     info = lerobot_eval(checkpoint, tmp_path / "eval", "pointcloud", extra, suite="drawers", task=drawers[1])
     assert info["overall"]["n_episodes"] == 1
     assert np.isfinite(info["overall"]["avg_sum_reward"])

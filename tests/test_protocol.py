@@ -24,7 +24,7 @@ import torch
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.runner.collect import learner_success_by_task, run_episodes, success_by_task
-from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.configs import RolloutConfig, RunConfig, TrainingConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.mixing import expert_episode_coin
@@ -92,7 +92,7 @@ def test_a_zero_action_learner_measures_zero_task_success(metaworld_rollouts):
 
 def test_default_rollouts_run_to_the_evaluation_horizon(metaworld_rollouts):
     """Defect 4: a learner rollout is not cut before evaluation's horizon (the env's own, 500)."""
-    assert RunConfig().max_rollout_steps is None
+    assert RunConfig().rollout.max_steps is None
     learner = [e for e in metaworld_rollouts["episode"] if e.learner_only]
     assert {e.steps for e in learner} == {500}
 
@@ -135,8 +135,8 @@ def test_rollouts_can_end_at_a_multiple_of_the_experts_length_on_the_same_seed()
     for episode in experts:
         expert_steps = expert_steps_to_success(suite, REACH_PUSH_PICK[episode.task_index], episode.seed)
         assert episode.success and episode.steps == expert_steps + 10
-    with pytest.raises(ValueError, match="rollout_expert_multiple must be > 0"):
-        RunConfig(rollout_expert_multiple=0.0)
+    with pytest.raises(ValueError, match="rollout.expert_multiple must be > 0"):
+        RunConfig(rollout=RolloutConfig(expert_multiple=0.0))
 
 
 def test_episode_mixing_gives_each_task_its_share_of_expert_episodes():
@@ -272,24 +272,39 @@ def phase_steps(*args: str) -> int:
 
 def test_bc_and_dagger_phases_train_by_one_rule():
     """Defect 6: at every budget BC trains like a DAgger phase."""
-    assert phase_steps("--mode=bc", "--warm_start=false") == phase_steps("--warm_start=false") == 1500
+    assert (
+        phase_steps("--mode=bc", "--training.warm_start=false")
+        == phase_steps("--training.warm_start=false")
+        == 1500
+    )
     assert phase_steps("--mode=bc") == 4 * 1500, "warm start: BC gets the final DAgger policy's steps in all"
-    epochs = ["--steps_rule=epochs", "--epochs=10"]
+    epochs = ["--training.steps_rule=epochs", "--training.epochs=10"]
     assert phase_steps("--mode=bc", *epochs) == phase_steps(*epochs) == int(np.ceil(10 * 12_000 / 256))
-    plateau = ["--steps_rule=plateau", "--plateau_max_steps=9000"]
+    plateau = ["--training.steps_rule=plateau", "--training.plateau_max_steps=9000"]
     assert phase_steps("--mode=bc", *plateau) == phase_steps(*plateau) == 9000, "the cap"
-    with pytest.raises(ValueError, match="steps_rule"):
-        RunConfig(steps_rule="until-bored")
-    with pytest.raises(ValueError, match="plateau_patience must be > 0"):
-        RunConfig(steps_rule="plateau", plateau_patience=0)
+    with pytest.raises(ValueError, match="training.steps_rule"):
+        RunConfig(training=TrainingConfig(steps_rule="until-bored"))
+    with pytest.raises(ValueError, match="training.plateau_patience must be > 0"):
+        RunConfig(training=TrainingConfig(steps_rule="plateau", plateau_patience=0))
 
 
 def test_a_plateau_run_stops_each_phase_on_held_out_episodes_and_records_where(tmp_path):
     root = tmp_path / "plateau"
-    plateau = ["--steps_rule=plateau", "--plateau_every=5", "--plateau_patience=2", "--plateau_max_steps=60"]
+    plateau = [
+        "--training.steps_rule=plateau",
+        "--training.plateau_every=5",
+        "--training.plateau_patience=2",
+        "--training.plateau_max_steps=60",
+    ]
     config = draccus.parse(
         RunConfig,
-        args=[*TOY_RUN, "--rounds=1", "--initial_demos=4", "--heldout_fraction=0.5", *plateau]
+        args=[
+            *TOY_RUN,
+            "--dagger.rounds=1",
+            "--dagger.initial_demos=4",
+            "--training.heldout_fraction=0.5",
+            *plateau,
+        ]
         + [f"--output_dir={root}"],
     )
     run(config)
@@ -304,8 +319,12 @@ def test_a_plateau_run_stops_each_phase_on_held_out_episodes_and_records_where(t
 
 def test_a_plateau_run_without_held_out_episodes_is_refused_before_anything_runs(tmp_path):
     root = tmp_path / "plateau"
-    config = draccus.parse(RunConfig, args=[*TOY_RUN, "--steps_rule=plateau", f"--output_dir={root}"])
-    with pytest.raises(UserError, match="would hold none out.*Raise --heldout_fraction or --initial_demos"):
+    config = draccus.parse(
+        RunConfig, args=[*TOY_RUN, "--training.steps_rule=plateau", f"--output_dir={root}"]
+    )
+    with pytest.raises(
+        UserError, match="would hold none out.*Raise --training.heldout_fraction or --dagger.initial_demos"
+    ):
         run(config)
     assert not root.exists()
 
@@ -319,7 +338,13 @@ def normaliser_stats(policy_root: Path) -> bytes:
 def test_normalisation_is_fixed_after_round_0_unless_asked(tmp_path, normalisation):
     root = tmp_path / normalisation
     config = draccus.parse(
-        RunConfig, args=[*TOY_RUN, "--rounds=1", f"--normalisation={normalisation}", f"--output_dir={root}"]
+        RunConfig,
+        args=[
+            *TOY_RUN,
+            "--dagger.rounds=1",
+            f"--training.normalisation={normalisation}",
+            f"--output_dir={root}",
+        ],
     )
     run(config)
     experiment = ExperimentDir(root)

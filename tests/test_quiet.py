@@ -568,10 +568,10 @@ def test_a_toy_run_without_progress_prints_only_its_summary_lines(tmp_path):
         "-m",
         "lerobot_mtdagger.cli",
         "run",
-        "--suite=toy",
+        "--suite.name=toy",
         f"--output_dir={tmp_path / 'run'}",
-        "--steps_per_round=20",
-        "--rounds=2",
+        "--training.steps_per_round=20",
+        "--dagger.rounds=2",
         "--progress=false",
     ]
     result = subprocess.run(command, capture_output=True, text=True, env=env, timeout=600, check=True)

@@ -29,3 +29,17 @@ def test_the_readme_is_short_and_its_links_resolve():
     assert len(text.splitlines()) <= 160
     for target in re.findall(r"\]\(((?!http)[^)#]+)\)", text):
         assert (README.parent / target).exists(), target
+
+
+def test_the_changelog_lists_every_renamed_run_option():
+    """Each option that moved into a group: its group, its name today and (if renamed) its old name."""
+    from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
+
+    changelog = README.read_text().split("## Changelog", 1)[1]
+    words = set(re.findall(r"\w+", changelog))
+    for old, new in FLAT_OPTION_PATHS.items():
+        group, name = new.split(".")
+        assert f"`--{group}.`" in changelog or f"`--{new}`" in changelog, new
+        assert name in words, new
+        if name != old:
+            assert f"`--{old}`" in changelog, old

@@ -3,6 +3,7 @@ verify that reads the data, options checked before anything is written, one-line
 
 from __future__ import annotations
 
+import copy
 import json
 import os
 import shutil
@@ -32,7 +33,7 @@ from tests.test_toy import TOY_RUN, toy_config
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
     root = tmp_path_factory.mktemp("lock") / "toy"
-    run(toy_config(root, "--rounds=1"))
+    run(toy_config(root, "--dagger.rounds=1"))
     return root
 
 
@@ -40,9 +41,9 @@ def test_a_second_writer_is_refused_at_once_naming_the_folder_and_the_process(fi
     before = sorted(p.relative_to(finished) for p in finished.rglob("*"))
     expected = rf"{finished} is being written by .*pid {os.getpid()}"
     with ExperimentDir(finished).writer_lock(), pytest.raises(ExperimentLockedError, match=expected):
-        run(toy_config(finished, "--rounds=1", "--resume=true"))
+        run(toy_config(finished, "--dagger.rounds=1", "--resume=true"))
     assert sorted(p.relative_to(finished) for p in finished.rglob("*")) == before
-    assert run(toy_config(finished, "--rounds=1", "--resume=true")), "the lock is released on exit"
+    assert run(toy_config(finished, "--dagger.rounds=1", "--resume=true")), "the lock is released on exit"
 
 
 def test_a_killed_writer_leaves_no_stale_lock(finished):
@@ -169,7 +170,7 @@ def test_the_round_record_survives_lerobot_rewriting_info_json(finished, tmp_pat
     copy = damaged_copy(finished, tmp_path, drop_info_records)
     experiment = ExperimentDir(copy)
     assert verify_experiment(experiment) == (2, 2, [])
-    assert run(toy_config(copy, "--rounds=2", "--resume=true"))[-1].startswith("round 2")
+    assert run(toy_config(copy, "--dagger.rounds=2", "--resume=true"))[-1].startswith("round 2")
     assert verify_experiment(experiment) == (3, 3, [])
     merged = merge_rounds(experiment, [0, 1, 2], tmp_path / "merged")
     assert json.loads((merged / "meta" / "mtdagger.json").read_text())["merged_rounds"] == [0, 1, 2]
@@ -240,7 +241,7 @@ def test_verify_of_a_folder_that_is_not_an_experiment_is_an_error(tmp_path, caps
 BAD_RUN_OPTIONS = {
     "--policy.lr=nan": "policy.lr must be finite and > 0",
     "--seed=-1": "seed must be >= 0",
-    "--budget=-3": "budget must be > 0",
+    "--dagger.budget=-3": "budget must be > 0",
     "--policy.device=cuda:99": "policy.device='cuda:99' is not available here",
     "--policy.device=nonsense": "is not a torch device",
 }
@@ -276,61 +277,71 @@ def test_a_start_that_fails_after_creation_leaves_a_resumable_folder(tmp_path, m
 
     monkeypatch.setattr(dagger_module, "train_on_rounds", diverge)
     with pytest.raises(FloatingPointError):
-        run(toy_config(output, "--rounds=1"))
+        run(toy_config(output, "--dagger.rounds=1"))
     assert (output / "config.json").is_file() and ExperimentDir(output).committed_phases() == []
     monkeypatch.undo()
-    assert len(run(toy_config(output, "--rounds=1", "--resume=true"))) == 2
+    assert len(run(toy_config(output, "--dagger.rounds=1", "--resume=true"))) == 2
 
 
 def test_options_that_do_not_change_results_may_differ_on_resume(finished):
     experiment = ExperimentDir(finished)
     stored = json.loads((finished / "config.json").read_text())
-    neutral = {**stored, "workers": 0, "progress": True, "policy": {**stored["policy"], "device": "cuda"}}
+    neutral = copy.deepcopy(stored) | {"progress": True}
+    neutral["rollout"] |= {"workers": 0, "worker_backend": "ray", "ray_address": "auto"}
+    neutral["policy"]["device"] = "cuda"
     experiment.check_resumable(neutral)
-    changed = {**stored, "policy": {**stored["policy"], "lr": 1.0}}
-    with pytest.raises(UserError, match=r"different config \(policy: .*start a new --output_dir"):
+    changed = copy.deepcopy(stored)
+    changed["policy"]["lr"] = 1.0
+    with pytest.raises(
+        UserError, match=r"different config \(policy.lr: 0.0003 -> 1.0\): .*start a new --output_dir"
+    ):
         experiment.check_resumable(changed)
 
 
 def test_a_run_made_before_an_option_existed_resumes_with_its_default(finished, tmp_path):
-    copy = tmp_path / "older"
-    shutil.copytree(finished, copy)
-    stored = json.loads((copy / "config.json").read_text())
-    older = {k: v for k, v in stored.items() if not k.startswith("plateau_")}  # options added later
-    older["policy"] = {k: v for k, v in stored["policy"].items() if not k.startswith("pointnet_layer")}
-    (copy / "config.json").write_text(json.dumps(older))
-    assert run(toy_config(copy, "--rounds=1", "--resume=true")), "resumed: nothing to do"
-    with pytest.raises(UserError, match=r"different config \(plateau_every: None -> 7\)"):
-        run(toy_config(copy, "--rounds=1", "--resume=true", "--plateau_every=7"))
-    with pytest.raises(UserError, match=r"different config \(policy: .*'pointnet_layer_norm': True"):
-        run(toy_config(copy, "--rounds=1", "--resume=true", "--policy.pointnet_layer_norm=true"))
+    older_root = tmp_path / "older"
+    shutil.copytree(finished, older_root)
+    older = json.loads((older_root / "config.json").read_text())
+    for name in [name for name in older["training"] if name.startswith("plateau_")]:  # added later
+        del older["training"][name]
+    del older["policy"]["pointnet_layer_norm"]
+    (older_root / "config.json").write_text(json.dumps(older))
+    assert run(toy_config(older_root, "--dagger.rounds=1", "--resume=true")), "resumed: nothing to do"
+    with pytest.raises(UserError, match=r"different config \(training.plateau_every: None -> 7\)"):
+        run(toy_config(older_root, "--dagger.rounds=1", "--resume=true", "--training.plateau_every=7"))
+    with pytest.raises(UserError, match=r"different config \(policy.pointnet_layer_norm: None -> True\)"):
+        run(toy_config(older_root, "--dagger.rounds=1", "--resume=true", "--policy.pointnet_layer_norm=true"))
 
 
 def test_a_drawer_run_made_before_placements_existed_resumes_only_with_the_narrow_one(finished, tmp_path):
     """Those runs used today's ``narrow`` ranges; resuming them with the new default would mix settings."""
-    copy = tmp_path / "older-drawers"
-    shutil.copytree(finished, copy)
-    stored = json.loads((copy / "config.json").read_text())
-    older = {k: v for k, v in stored.items() if k != "placement"} | {"suite": "drawers"}
-    (copy / "config.json").write_text(json.dumps(older))
-    experiment = ExperimentDir(copy)
+    older_root = tmp_path / "older-drawers"
+    shutil.copytree(finished, older_root)
+    older = json.loads((older_root / "config.json").read_text())
+    older["suite"]["name"] = "drawers"
+    del older["suite"]["placement"]
+    (older_root / "config.json").write_text(json.dumps(older))
+    experiment = ExperimentDir(older_root)
     defaults = RunConfig.option_defaults()
-    experiment.check_resumable({**older, "placement": "narrow"}, added_defaults=defaults)
-    with pytest.raises(UserError, match=r"placement: None -> 'kitchen'\) \(drawer runs made before"):
-        experiment.check_resumable({**older, "placement": "kitchen"}, added_defaults=defaults)
+    given = copy.deepcopy(older)
+    given["suite"]["placement"] = "narrow"
+    experiment.check_resumable(given, added_defaults=defaults)
+    given["suite"]["placement"] = "kitchen"
+    with pytest.raises(UserError, match=r"suite.placement: None -> 'kitchen'\) \(drawer runs made before"):
+        experiment.check_resumable(given, added_defaults=defaults)
 
 
 def test_resume_refuses_a_policy_changed_after_commit_that_still_loads(finished, tmp_path):
     copy = damaged_copy(finished, tmp_path, nudge_weights)
     with pytest.raises(CorruptExperimentError, match=r"policies/round-001.*model.safetensors"):
-        run(toy_config(copy, "--rounds=1", "--resume=true"))
+        run(toy_config(copy, "--dagger.rounds=1", "--resume=true"))
 
 
 def test_resume_refuses_a_round_changed_after_commit_before_running(finished, tmp_path):
     copy = damaged_copy(finished, tmp_path, lambda root: truncate(round_parquet(root)))
     before = sorted(p.relative_to(copy) for p in copy.rglob("*") if p.name != LOCK_FILE)
     with pytest.raises(CorruptExperimentError, match=rf"{round_parquet(copy)} changed after commit"):
-        run(toy_config(copy, "--rounds=1", "--resume=true"))
+        run(toy_config(copy, "--dagger.rounds=1", "--resume=true"))
     assert sorted(p.relative_to(copy) for p in copy.rglob("*") if p.name != LOCK_FILE) == before
 
 
@@ -373,15 +384,15 @@ def bad_inputs(finished: Path, tmp_path: Path) -> dict[str, tuple[list[str], str
             f"{truncated / 'model.safetensors'} is not a readable safetensors file",
         ),
         "eval on other observations": (
-            ["eval", f"--policy_path={policy}", "--tasks=[reach-v3]", "--workers=0"],
+            ["eval", f"--policy_path={policy}", "--suite.tasks=[reach-v3]", "--workers=0"],
             "The policy takes 'observation.state' of shape",
         ),
         "unclosed list": (
-            ["run", "--tasks=[reach-v3,push-v3"],
-            "--tasks='[reach-v3,push-v3' is not a valid value",
+            ["run", "--suite.tasks=[reach-v3,push-v3"],
+            "--suite.tasks='[reach-v3,push-v3' is not a valid value",
         ),
         "unknown option": (["run", "--roundz=3"], "unrecognized arguments: --roundz=3"),
-        "not an int": (["run", "--rounds=three"], "Couldn't parse 'three' into an int"),
+        "not an int": (["run", "--dagger.rounds=three"], "Couldn't parse 'three' into an int"),
         "resume of nothing": (
             ["run", f"--output_dir={tmp_path / 'none'}", "--resume=true"],
             "Nothing to resume",
@@ -392,40 +403,40 @@ def bad_inputs(finished: Path, tmp_path: Path) -> dict[str, tuple[list[str], str
             "Unknown method(s) ['foo'] in --methods",
         ),
         "compare with a bad run option": (
-            ["compare", "--rounds=-1", f"--output_dir={tmp_path / 'cmp'}"],
+            ["compare", "--dagger.rounds=-1", f"--output_dir={tmp_path / 'cmp'}"],
             "rounds must be >= 0",
         ),
         "run of an unknown drawer": (
-            ["run", "--suite=drawers", "--tasks=[drawer-nope]", f"--output_dir={tmp_path / 'r1'}"],
+            ["run", "--suite.name=drawers", "--suite.tasks=[drawer-nope]", f"--output_dir={tmp_path / 'r1'}"],
             "Unknown drawer(s) ['drawer-nope']",
         ),
         "run with an unknown observation mode": (
-            ["run", "--obs_mode=depth", f"--output_dir={tmp_path / 'r2'}"],
+            ["run", "--suite.obs_mode=depth", f"--output_dir={tmp_path / 'r2'}"],
             "Unknown obs_mode 'depth'",
         ),
         "run of the toy suite on point clouds": (
-            ["run", "--suite=toy", "--obs_mode=pointcloud", f"--output_dir={tmp_path / 'r3'}"],
+            ["run", "--suite.name=toy", "--suite.obs_mode=pointcloud", f"--output_dir={tmp_path / 'r3'}"],
             "The toy suite has state observations only",
         ),
         "run with a placement outside the drawers": (
-            ["run", "--suite=toy", "--placement=kitchen", f"--output_dir={tmp_path / 'r4'}"],
+            ["run", "--suite.name=toy", "--suite.placement=kitchen", f"--output_dir={tmp_path / 'r4'}"],
             "placement applies to the drawers suite only",
         ),
         "run with no mesh left to render": (
-            ["run", "--obs_mode=rgb", "--mesh_detail=0", f"--output_dir={tmp_path / 'r6'}"],
+            ["run", "--suite.obs_mode=rgb", "--suite.mesh_detail=0", f"--output_dir={tmp_path / 'r6'}"],
             "mesh_detail must be in (0, 1]",
         ),
         "eval with too much mesh detail": (
             [
                 "eval",
                 f"--policy_path={finished / 'policies' / 'round-001'}",
-                "--suite=toy",
-                "--mesh_detail=2",
+                "--suite.name=toy",
+                "--suite.mesh_detail=2",
             ],
             "mesh_detail must be in (0, 1]",
         ),
         "run with an unknown placement": (
-            ["run", "--suite=drawers", "--placement=office", f"--output_dir={tmp_path / 'r5'}"],
+            ["run", "--suite.name=drawers", "--suite.placement=office", f"--output_dir={tmp_path / 'r5'}"],
             "Unknown drawer placement 'office'",
         ),
         "merge of a non-experiment": (

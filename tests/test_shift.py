@@ -127,14 +127,14 @@ def test_zero_episodes_is_refused(suite):
 def test_the_shift_command_measures_a_trained_policy_and_writes_json(tmp_path, capsys):
     run_dir = tmp_path / "run"
     small = [
-        "--rounds=1",
-        "--initial_demos=2",
-        "--budget_per_task=1",
-        "--steps_per_round=30",
-        "--eval_episodes=2",
+        "--dagger.rounds=1",
+        "--dagger.initial_demos=2",
+        "--dagger.budget_per_task=1",
+        "--training.steps_per_round=30",
+        "--rollout.eval_episodes=2",
     ]
     network = ["--policy.batch_size=32", "--policy.state_hidden_dims=[32]", "--policy.head_hidden_dims=[32]"]
-    options = ["--suite=toy", "--mode=bc", *small, *network, "--workers=0", "--progress=false"]
+    options = ["--suite.name=toy", "--mode=bc", *small, *network, "--rollout.workers=0", "--progress=false"]
     assert main(["run", *options, f"--output_dir={run_dir}"]) == 0
     capsys.readouterr()
     output = tmp_path / "shift.json"
@@ -144,7 +144,7 @@ def test_the_shift_command_measures_a_trained_policy_and_writes_json(tmp_path, c
             [
                 "shift",
                 f"--policy_path={policy}",
-                "--suite=toy",
+                "--suite.name=toy",
                 "--episodes=2",
                 "--workers=0",
                 f"--output={output}",
@@ -164,5 +164,5 @@ def test_the_shift_command_measures_a_trained_policy_and_writes_json(tmp_path, c
 
 
 def test_the_shift_command_refuses_a_missing_policy_naming_the_fix(tmp_path, capsys):
-    assert main(["shift", f"--policy_path={tmp_path / 'nowhere'}", "--suite=toy"]) == 2
+    assert main(["shift", f"--policy_path={tmp_path / 'nowhere'}", "--suite.name=toy"]) == 2
     assert "does not exist" in capsys.readouterr().err

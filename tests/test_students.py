@@ -34,13 +34,13 @@ from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
 
 TOY_STUDENT_RUN = [
-    "--suite=toy",
-    "--rounds=2",
-    "--initial_demos=2",
-    "--budget_per_task=2",
-    "--steps_per_round=40",
-    "--eval_episodes=2",
-    "--max_rollout_steps=40",
+    "--suite.name=toy",
+    "--dagger.rounds=2",
+    "--dagger.initial_demos=2",
+    "--dagger.budget_per_task=2",
+    "--training.steps_per_round=40",
+    "--rollout.eval_episodes=2",
+    "--rollout.max_steps=40",
     "--policy.batch_size=32",
     "--progress=false",
 ]
@@ -80,14 +80,14 @@ def suite():
 @pytest.fixture(scope="module")
 def act_run(tmp_path_factory) -> Path:
     root = tmp_path_factory.mktemp("act") / "run"
-    run(student_config(root, *TINY_ACT, "--workers=0"))
+    run(student_config(root, *TINY_ACT, "--rollout.workers=0"))
     return root
 
 
 @pytest.fixture(scope="module")
 def diffusion_run(tmp_path_factory) -> Path:
     root = tmp_path_factory.mktemp("diffusion") / "run"
-    run(student_config(root, *TINY_DIFFUSION, "--workers=0"))
+    run(student_config(root, *TINY_DIFFUSION, "--rollout.workers=0"))
     return root
 
 
@@ -143,7 +143,7 @@ def test_eval_of_a_lerobot_student_reports_every_task(act_run, tmp_path):
             [
                 "eval",
                 f"--policy_path={policy}",
-                "--suite=toy",
+                "--suite.name=toy",
                 "--episodes=2",
                 "--workers=0",
                 f"--output={output}",
@@ -162,7 +162,7 @@ def test_a_lerobot_student_resumes_after_kill_9_to_the_same_result(act_run, tmp_
         "run",
         *TOY_STUDENT_RUN,
         *TINY_ACT,
-        "--workers=1",
+        "--rollout.workers=1",
         f"--output_dir={tmp_path / 'killed'}",
     ]
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -227,7 +227,7 @@ def test_the_task_vector_is_one_hot_over_the_training_tasks_and_zero_for_an_unse
 def tiny_act_policy(suite, n_action_steps: int = 3):
     """A tiny untrained ACT student of the toy suite, with identity normalisation."""
     options = parse_options(
-        RunConfig, ["--suite=toy", *TINY_ACT, f"--policy.n_action_steps={n_action_steps}"], "t"
+        RunConfig, ["--suite.name=toy", *TINY_ACT, f"--policy.n_action_steps={n_action_steps}"], "t"
     )
     spec = lerobot_student_config(options.policy, suite.features, suite.task_names, task_dropout=0.0)
     from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
@@ -354,7 +354,10 @@ def test_policy_options_are_lerobots_own_and_mtdagger_stays_the_default():
 @pytest.mark.parametrize(
     ("options", "message"),
     [
-        (["--policy.type=act", "--suite=drawers", "--obs_mode=pointcloud"], "cannot read point clouds"),
+        (
+            ["--policy.type=act", "--suite.name=drawers", "--suite.obs_mode=pointcloud"],
+            "cannot read point clouds",
+        ),
         (
             ["--policy.type=act", "--policy.temporal_ensemble_coeff=0.01", "--policy.n_action_steps=1"],
             "temporal_ensemble_coeff",
@@ -375,14 +378,14 @@ def test_a_lerobot_student_runs_on_a_metaworld_state_subset(tmp_path, student):
         draccus.parse(
             RunConfig,
             args=[
-                "--tasks=[reach-v3,button-press-topdown-v3,push-v3]",
-                "--rounds=1",
-                "--steps_per_round=40",
-                "--eval_episodes=1",
-                "--max_rollout_steps=60",
+                "--suite.tasks=[reach-v3,button-press-topdown-v3,push-v3]",
+                "--dagger.rounds=1",
+                "--training.steps_per_round=40",
+                "--rollout.eval_episodes=1",
+                "--rollout.max_steps=60",
                 "--policy.batch_size=64",
                 "--progress=false",
-                "--workers=1",
+                "--rollout.workers=1",
                 f"--output_dir={root}",
                 *student,
             ],

@@ -285,13 +285,13 @@ def test_a_record_missing_a_field_is_a_clear_error():
 # ---------------------------------------------------------------------------------------------
 
 TOY_RUN = [
-    "--suite=toy",
-    "--rounds=2",
-    "--initial_demos=1",
-    "--budget_per_task=2",
-    "--steps_per_round=30",
-    "--eval_episodes=2",
-    "--max_rollout_steps=40",
+    "--suite.name=toy",
+    "--dagger.rounds=2",
+    "--dagger.initial_demos=1",
+    "--dagger.budget_per_task=2",
+    "--training.steps_per_round=30",
+    "--rollout.eval_episodes=2",
+    "--rollout.max_steps=40",
     "--policy.batch_size=32",
     "--policy.state_hidden_dims=[32]",
     "--policy.head_hidden_dims=[32]",
@@ -353,9 +353,9 @@ def test_a_dagger_run_resumed_with_more_rounds_equals_one_started_with_them(tmp_
 
     reference, extended = tmp_path / "reference", tmp_path / "extended"
     run(toy_config(reference))  # 2 rounds from the start
-    run(toy_config(extended, "--rounds=1"))
-    assert len(run(toy_config(extended, "--rounds=2", "--resume=true"))) == 3
-    assert json.loads((extended / "config.json").read_text())["rounds"] == 2
+    run(toy_config(extended, "--dagger.rounds=1"))
+    assert len(run(toy_config(extended, "--dagger.rounds=2", "--resume=true"))) == 3
+    assert json.loads((extended / "config.json").read_text())["dagger"]["rounds"] == 2
     experiments = [ExperimentDir(reference), ExperimentDir(extended)]
     records = [[{**e.read_round_record(k).to_dict(), "config": None} for k in range(3)] for e in experiments]
     assert records[0] == records[1]  # the same allocations, from the same measured success and gain
@@ -371,14 +371,14 @@ def test_a_dagger_run_resumed_with_more_rounds_equals_one_started_with_them(tmp_
 
 def test_rounds_may_only_grow_and_only_for_dagger(tmp_path):
     dagger, bc = tmp_path / "dagger", tmp_path / "bc"
-    run(toy_config(dagger, "--rounds=1"))
-    run(toy_config(bc, "--mode=bc", "--rounds=1"))
-    hint = r"\(--rounds may only grow, and only for a DAgger run"
+    run(toy_config(dagger, "--dagger.rounds=1"))
+    run(toy_config(bc, "--mode=bc", "--dagger.rounds=1"))
+    hint = r"\(--dagger.rounds may only grow, and only for a DAgger run"
     with pytest.raises(UserError, match=r"rounds: 1 -> 0\) " + hint):
-        run(toy_config(dagger, "--rounds=0", "--resume=true"))
+        run(toy_config(dagger, "--dagger.rounds=0", "--resume=true"))
     with pytest.raises(UserError, match=r"rounds: 1 -> 2\) " + hint):
-        run(toy_config(bc, "--mode=bc", "--rounds=2", "--resume=true"))
-    assert json.loads((bc / "config.json").read_text())["rounds"] == 1
+        run(toy_config(bc, "--mode=bc", "--dagger.rounds=2", "--resume=true"))
+    assert json.loads((bc / "config.json").read_text())["dagger"]["rounds"] == 1
     assert ExperimentDir(bc).committed_rounds() == [0] and ExperimentDir(dagger).committed_phases() == [0, 1]
 
 
@@ -393,12 +393,12 @@ def test_nan_loss_is_an_error_and_committed_rounds_survive(tmp_path, monkeypatch
 
     monkeypatch.setattr(MTDAggerPolicy, "forward", nan_forward)
     with pytest.raises(FloatingPointError, match="Training loss became nan"):
-        run(toy_config(tmp_path / "exp", "--rounds=1"))
+        run(toy_config(tmp_path / "exp", "--dagger.rounds=1"))
     experiment = ExperimentDir(tmp_path / "exp")
     assert experiment.committed_rounds() == [0]
     assert experiment.committed_phases() == []
     monkeypatch.undo()
-    run(toy_config(tmp_path / "exp", "--rounds=1", "--resume=true"))
+    run(toy_config(tmp_path / "exp", "--dagger.rounds=1", "--resume=true"))
     assert experiment.committed_phases() == [0, 1]
 
 
@@ -409,7 +409,7 @@ def test_rounds_carry_provenance_in_lerobots_column_names(tmp_path):
 
     from lerobot_mtdagger.datasets.records import INTERVENTION, NEXT_DONE, NEXT_REWARD, NEXT_SUCCESS
 
-    run(toy_config(tmp_path / "run", "--rounds=1"))
+    run(toy_config(tmp_path / "run", "--dagger.rounds=1"))
     experiment = ExperimentDir(tmp_path / "run")
     for k in (0, 1):
         root = experiment.round_root(k)

@@ -11,10 +11,10 @@ import pandas as pd
 import pytest
 
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
-from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs import SuiteConfig, make_suite
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.runner.collect import run_episodes
-from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.configs import RolloutConfig, RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.evaluate import evaluate
 from lerobot_mtdagger.runner.workers import EnvWorkers, RemoteWorkerError, WorkerDiedError
@@ -87,7 +87,7 @@ def round_frames(root):
 def test_runs_with_1_and_2_workers_write_identical_rounds_and_evaluations(tmp_path):
     experiments = {}
     for workers in (1, 2):
-        args = [*TOY_RUN, f"--output_dir={tmp_path / str(workers)}", f"--workers={workers}"]
+        args = [*TOY_RUN, f"--output_dir={tmp_path / str(workers)}", f"--rollout.workers={workers}"]
         run(draccus.parse(RunConfig, args=args))
         experiments[workers] = ExperimentDir(tmp_path / str(workers))
     for round_index in range(3):
@@ -102,9 +102,9 @@ def test_runs_with_1_and_2_workers_write_identical_rounds_and_evaluations(tmp_pa
 
 
 def test_resuming_with_another_worker_count_is_allowed(tmp_path):
-    args = [*TOY_RUN, f"--output_dir={tmp_path / 'exp'}", "--rounds=1"]
-    run(draccus.parse(RunConfig, args=[*args, "--workers=2"]))
-    lines = run(draccus.parse(RunConfig, args=[*args, "--workers=0", "--resume=true"]))
+    args = [*TOY_RUN, f"--output_dir={tmp_path / 'exp'}", "--dagger.rounds=1"]
+    run(draccus.parse(RunConfig, args=[*args, "--rollout.workers=2"]))
+    lines = run(draccus.parse(RunConfig, args=[*args, "--rollout.workers=0", "--resume=true"]))
     assert len(lines) == 2
 
 
@@ -166,7 +166,7 @@ def test_negative_worker_counts_are_refused(suite):
     with pytest.raises(ValueError, match="workers must be >= 0"):
         EnvWorkers(suite, -1)
     with pytest.raises(ValueError, match="workers must be >= 0"):
-        RunConfig(suite="toy", workers=-2)
+        RunConfig(suite=SuiteConfig(name="toy"), rollout=RolloutConfig(workers=-2))
 
 
 @pytest.mark.parametrize(("tasks", "workers"), [(10, 2), (50, 2), (10, 3), (7, 2)])

@@ -34,6 +34,7 @@ from typing import Any
 
 from huggingface_hub import DatasetCardData, HfApi
 
+from lerobot_mtdagger.datasets.config_layout import option
 from lerobot_mtdagger.datasets.records import PhaseRecord, RoundRecord
 from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, ExperimentDir, round_name
 from lerobot_mtdagger.datasets_cards import card_template
@@ -166,8 +167,8 @@ def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: in
         "repo_id": repo_id,
         "round": str(last),
         "revision": round_name(last),
-        "suite": str(config.get("suite", NOT_AVAILABLE)),
-        "obs_mode": str(config.get("obs_mode", NOT_AVAILABLE)),
+        "suite": str(option(config, "suite.name", NOT_AVAILABLE)),
+        "obs_mode": str(option(config, "suite.obs_mode", NOT_AVAILABLE)),
         "method": str(latest.method),
         "temperature": str(latest.temperature),
         "n_min": str(latest.n_min),

@@ -25,6 +25,8 @@ from typing import Any
 
 import numpy as np
 
+from lerobot_mtdagger.datasets.config_layout import migrate_run_config
+
 RECORD_KEY = "mtdagger"
 """Key of the round record's mirror in a round dataset's ``meta/info.json``."""
 
@@ -228,11 +230,13 @@ class RoundRecord:
 
     @classmethod
     def from_dict(cls, values: Mapping[str, Any], where: str = "round record") -> RoundRecord:
-        """Reads a stored record.
+        """Reads a stored record (its run config in today's layout: ``migrate_run_config``).
 
         Raises:
             ValueError: If a field is missing, naming it and ``where``.
         """
+        if isinstance(values.get("config"), Mapping):
+            values = {**values, "config": migrate_run_config(values["config"])}
         return _from_mapping(cls, values, where)
 
 

@@ -44,6 +44,7 @@ import pyarrow.parquet as pq
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import update_chunk_file_indices
 
+from lerobot_mtdagger.datasets.config_layout import flatten, migrate_run_config
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.datasets.records import (
     FORMAT_VERSION,
@@ -111,44 +112,45 @@ def read_committed_json(path: Path, fix: str) -> Any:
         raise CorruptExperimentError(f"{path} is unreadable ({error}); {fix}.") from None
 
 
-RESULT_NEUTRAL_POLICY_OPTIONS: tuple[str, ...] = ("device",)
-"""Policy options that never change a result (the torch device), free to differ on resume."""
+RESULT_NEUTRAL_OPTIONS: tuple[str, ...] = (
+    "resume",
+    "progress",
+    "output_dir",
+    "rollout.workers",
+    "rollout.worker_backend",
+    "rollout.ray_address",
+    "policy.device",
+)
+"""Options (dotted paths) that never change a result, free to differ on resume."""
 
 
 def result_options(config: Mapping[str, Any], ignore: Sequence[str]) -> dict[str, Any]:
-    """A run config without the options that do not change results (compared on resume)."""
-    options = {key: value for key, value in config.items() if key not in ignore}
-    if isinstance(options.get("policy"), Mapping):
-        options["policy"] = {
-            key: value for key, value in options["policy"].items() if key not in RESULT_NEUTRAL_POLICY_OPTIONS
-        }
-    return options
+    """A run config's leaves by dotted path, without the options in ``ignore`` (compared on resume)."""
+    return {key: value for key, value in flatten(migrate_run_config(config)).items() if key not in ignore}
 
 
 def fill_added_options(stored: dict[str, Any], given: Mapping[str, Any], added: Mapping[str, Any]) -> None:
     """Gives ``stored`` each option of ``added`` it lacks where ``given`` holds that default.
 
-    ``added`` maps an option to what it was before it existed; a nested mapping (``policy``) is
-    filled option by option.
+    ``added`` maps an option's dotted path to what it was before it existed.
     """
     for key, default in added.items():
-        if isinstance(default, Mapping):
-            if isinstance(stored.get(key), Mapping) and isinstance(given.get(key), Mapping):
-                stored[key] = dict(stored[key])
-                fill_added_options(stored[key], given[key], default)
-        elif key in given and key not in stored and given[key] == default:
+        if key in given and key not in stored and given[key] == default:
             stored[key] = default
 
 
 def adds_dagger_rounds(stored: Mapping[str, Any], given: Mapping[str, Any]) -> bool:
     """Whether ``given`` asks a stored DAgger run for more rounds (and maybe nothing else)."""
-    rounds = stored.get("rounds"), given.get("rounds")
+    rounds = stored.get(ROUNDS_OPTION), given.get(ROUNDS_OPTION)
     return (
         stored.get("mode") != "bc"
         and given.get("mode") == stored.get("mode")
         and all(isinstance(r, int) for r in rounds)
         and rounds[1] > rounds[0]
     )
+
+
+ROUNDS_OPTION = "dagger.rounds"
 
 
 def _only(frame: Mapping[str, Any], features: Mapping[str, Any]) -> dict[str, Any]:
@@ -231,18 +233,18 @@ class ExperimentDir:
     def check_resumable(
         self,
         config: dict[str, Any],
-        ignore: Sequence[str] = ("resume", "progress", "output_dir", "workers"),
+        ignore: Sequence[str] = RESULT_NEUTRAL_OPTIONS,
         added_defaults: Mapping[str, Any] | None = None,
     ) -> None:
         """Checks that ``root`` holds an experiment started with the same config.
 
-        Options in ``ignore`` and ``RESULT_NEUTRAL_POLICY_OPTIONS`` never change a result, so they
-        may differ from the stored config. So may a larger ``rounds`` of a DAgger run: no round
-        depends on how many follow it, so the run is extended (``extend_rounds``) and its rounds so
-        far are those of a run started with the larger number. An option the stored config lacks (added
-        to the toolkit after the run started) matches when ``config`` gives it its default in
-        ``added_defaults`` (a nested mapping for ``policy``): a new option's default keeps the behaviour
-        the run was made with.
+        Both configs are compared option by option (dotted paths, the stored one migrated to today's
+        layout). Options in ``ignore`` never change a result, so they may differ from the stored
+        config. So may a larger ``dagger.rounds`` of a DAgger run: no round depends on how many
+        follow it, so the run is extended (``extend_rounds``) and its rounds so far are those of a
+        run started with the larger number. An option the stored config lacks (added to the toolkit
+        after the run started) matches when ``config`` gives it its default in ``added_defaults``
+        (by dotted path): a new option's default keeps the behaviour the run was made with.
 
         Raises:
             NotAnExperimentError: If there is no experiment to resume.
@@ -256,35 +258,38 @@ class ExperimentDir:
         given = result_options(config, ignore)
         fill_added_options(stored, given, added_defaults or {})
         if adds_dagger_rounds(stored, given):
-            stored["rounds"] = given["rounds"]
+            stored[ROUNDS_OPTION] = given[ROUNDS_OPTION]
         differing = sorted(key for key in set(stored) | set(given) if stored.get(key) != given.get(key))
         if differing:
             details = ", ".join(f"{k}: {stored.get(k)!r} -> {given.get(k)!r}" for k in differing)
             hint = ""
-            if "rounds" in differing:
+            if ROUNDS_OPTION in differing:
                 hint = (
-                    " (--rounds may only grow, and only for a DAgger run: BC's one round holds the "
-                    "demos of every round)"
+                    " (--dagger.rounds may only grow, and only for a DAgger run: BC's one round holds "
+                    "the demos of every round)"
                 )
-            elif "placement" in differing and "placement" not in stored:
-                hint = " (drawer runs made before --placement existed used --placement=narrow)"
+            elif "suite.placement" in differing and "suite.placement" not in stored:
+                hint = " (drawer runs made before --suite.placement existed used --suite.placement=narrow)"
             raise UserError(
                 f"Cannot resume {self.root} with a different config ({details}){hint}: resume with "
                 "the stored values, or start a new --output_dir."
             )
 
     def extend_rounds(self, rounds: int) -> None:
-        """Raises the stored ``rounds`` of a DAgger run to ``rounds`` (nothing if not larger).
+        """Raises the stored ``dagger.rounds`` of a DAgger run to ``rounds`` (nothing if not larger).
 
-        Call it after ``check_resumable`` accepted the config, with the writer lock held.
+        Call it after ``check_resumable`` accepted the config, with the writer lock held. The config
+        is written back in today's layout.
         """
         config = self.read_config()
-        if rounds > config["rounds"]:
-            logger.info("Extending %s from %d to %d DAgger rounds", self.root, config["rounds"], rounds)
-            write_json_atomic(self.root / CONFIG_FILE, {**config, "rounds": rounds})
+        stored = config["dagger"]["rounds"]
+        if rounds > stored:
+            logger.info("Extending %s from %d to %d DAgger rounds", self.root, stored, rounds)
+            config["dagger"]["rounds"] = rounds
+            write_json_atomic(self.root / CONFIG_FILE, config)
 
     def read_config(self) -> dict[str, Any]:
-        """The run config stored in the experiment.
+        """The run config stored in the experiment, in today's layout (``migrate_run_config``).
 
         Raises:
             NotAnExperimentError: If ``root`` holds no readable ``config.json``.
@@ -296,7 +301,7 @@ class ExperimentDir:
                 "`lerobot-mtdagger run`."
             )
         try:
-            return json.loads(config_path.read_text())
+            return migrate_run_config(json.loads(config_path.read_text()))
         except FileNotFoundError:
             raise NotAnExperimentError(
                 f"{self.root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}): pass the "

@@ -15,8 +15,8 @@ toy                 a point mass pushed to task-specific goals (``envs/toy.py``)
                     state only, for fast tests
 ==================  =====================================================================
 
-``suite_from_config(config)`` builds the suite a command's config names (``run``, ``eval`` and the
-LeRobot env plugin all go through it).
+``suite_from_config(config)`` builds the suite a ``SuiteConfig`` names (``run``, ``eval``, ``shift``
+and the LeRobot env plugin each hold one: ``envs/config.py``).
 
 ``tasks=[...]`` with a named list selects a subset in the given order. Rendering uses MuJoCo's EGL
 backend unless ``MUJOCO_GL`` is already set (``osmesa`` is the fallback without EGL).
@@ -30,7 +30,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
 
 from collections.abc import Sequence  # noqa: E402
-from typing import Any, Protocol  # noqa: E402
+from typing import Any  # noqa: E402
 
 from lerobot_mtdagger.envs.base import (  # noqa: E402
     IMAGE_KEY,
@@ -41,7 +41,12 @@ from lerobot_mtdagger.envs.base import (  # noqa: E402
     ObservationConfig,
     TaskSuite,
 )
-from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.envs.config import (  # noqa: E402
+    DEFAULT_IMAGE_SIZE,
+    DEFAULT_NUM_POINTS,
+    SuiteConfig,
+)
+from lerobot_mtdagger.utils.errors import UserError  # noqa: E402
 
 SUITE_NAMES: tuple[str, ...] = (
     "metaworld-mt10",
@@ -61,7 +66,7 @@ __all__ = [
     "CropBox",
     "ObservationConfig",
     "TaskSuite",
-    "SuiteOptions",
+    "SuiteConfig",
     "make_suite",
     "suite_from_config",
 ]
@@ -152,43 +157,30 @@ def make_suite(
     return MetaWorldSuite(task_names, observation, max_episode_steps=max_episode_steps, name=name)
 
 
-class SuiteOptions(Protocol):
-    """What a command's config says about its suite (``RunConfig``, ``EvalConfig``, the env plugin)."""
-
-    suite: str
-    tasks: Any  # a sequence of task names, or None / empty for all the suite's tasks
-    obs_mode: str
-    image_size: int
-    num_points: int
-
-
-def suite_from_config(config: SuiteOptions, **overrides: Any) -> TaskSuite:
-    """The suite a config names.
-
-    ``max_episode_steps`` comes from ``config.episode_length``, ``placement`` from
-    ``config.placement`` and ``mesh_detail`` from ``config.mesh_detail`` where the config has them.
+def suite_from_config(config: SuiteConfig, **overrides: Any) -> TaskSuite:
+    """The suite a ``SuiteConfig`` names (unset observation options at their defaults).
 
     Args:
-        config: Any object with the ``SuiteOptions`` attributes.
+        config: The command's suite options.
         **overrides: ``make_suite`` keyword arguments that replace the config's.
 
     Raises:
         UserError: On an unknown suite, task or observation setting (one line, naming the option).
     """
-    tasks = config.tasks
-    if isinstance(tasks, str):
-        tasks = [tasks]
+    if config.name is None:
+        raise UserError("No suite given: pass --suite.name (e.g. --suite.name=metaworld-mt10).")
+    config.check()
     options: dict[str, Any] = {
-        "tasks": list(tasks) if tasks else None,
-        "obs_mode": config.obs_mode,
-        "image_size": config.image_size,
-        "num_points": config.num_points,
-        "max_episode_steps": getattr(config, "episode_length", None),
-        "placement": getattr(config, "placement", None),
-        "mesh_detail": getattr(config, "mesh_detail", 1.0),
+        "tasks": list(config.tasks) if config.tasks else None,
+        "obs_mode": config.obs_mode or "state",
+        "image_size": config.image_size or DEFAULT_IMAGE_SIZE,
+        "num_points": config.num_points or DEFAULT_NUM_POINTS,
+        "max_episode_steps": config.episode_length,
+        "placement": config.placement,
+        "mesh_detail": config.mesh_detail,
     }
     try:
-        return make_suite(config.suite, **(options | overrides))
+        return make_suite(config.name, **(options | overrides))
     except UserError:
         raise
     except ValueError as error:  # a bad suite, task or observation option: the user's to fix

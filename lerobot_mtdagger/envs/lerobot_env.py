@@ -4,7 +4,7 @@ Usage::
 
     lerobot-eval --policy.path=<checkpoint>/pretrained_model \
         --env.discover_packages_path=lerobot_mtdagger.envs --env.type=mtdagger_suite \
-        --env.suite=metaworld-mt10 --env.task=reach-v3 --eval.n_episodes=10 --eval.batch_size=1
+        --env.suite.name=metaworld-mt10 --env.task=reach-v3 --eval.n_episodes=10 --eval.batch_size=1
 
 The type name avoids "metaworld": LeRobot 0.4.4 routes any env type containing it to its own
 MetaWorld code. The gym env emits the raw keys LeRobot's ``preprocess_observation`` keeps:
@@ -21,6 +21,7 @@ success does not persist, and lerobot-eval reads ``is_success`` only at an episo
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -34,7 +35,7 @@ from lerobot.envs.configs import EnvConfig
 # config before it could honour a --policy.discover_packages_path (LeRobot 0.4.4 passes that flag on
 # to the config as an unknown field when --policy.path is given), so the env plugin brings it along.
 import lerobot_mtdagger.policies  # noqa: F401
-from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, suite_from_config
+from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, SuiteConfig, suite_from_config
 
 GYM_ID = "MTDAgger/Suite-v0"
 RAW_KEYS = {STATE_KEY: "agent_pos", IMAGE_KEY: "pixels", POINTCLOUD_KEY: "environment_state"}
@@ -50,16 +51,16 @@ class LeRobotSuiteEnv(gym.Env):
 
         Args:
             render_mode: Gymnasium's render mode (``rgb_array``).
-            **suite_options: ``MTDAggerSuiteEnvConfig`` fields: ``suite``, ``task``, ``obs_mode``,
-                ``image_size``, ``num_points``, ``episode_length``, ``placement``, ``mesh_detail``
-                (their defaults where left out), as ``MTDAggerSuiteEnvConfig.gym_kwargs`` gives them.
+            **suite_options: ``MTDAggerSuiteEnvConfig`` fields: ``suite`` (a ``SuiteConfig`` or its
+                mapping) and ``task`` (their defaults where left out), as
+                ``MTDAggerSuiteEnvConfig.gym_kwargs`` gives them.
 
         Raises:
             TypeError: On an option that is not such a field.
         """
         config = MTDAggerSuiteEnvConfig(**suite_options)
         task = config.task
-        self._suite = suite_from_config(config)
+        self._suite = suite_from_config(config.task_suite)
         self._env = self._suite.make_env(task)
         self.task_description = task
         self.render_mode = render_mode
@@ -100,37 +101,37 @@ if GYM_ID not in registry:
     )
 
 
+def _plugin_suite() -> SuiteConfig:
+    """The plugin's default suite: MT10 on state (``--env.suite.name``, ``--env.suite.obs_mode``)."""
+    return SuiteConfig(name="metaworld-mt10", obs_mode="state")
+
+
 @EnvConfig.register_subclass("mtdagger_suite")
 @dataclass
 class MTDAggerSuiteEnvConfig(EnvConfig):
     """``--env.type=mtdagger_suite``: one task of a lerobot-mtdagger suite for ``lerobot-eval``.
 
     Attributes:
-        suite: Suite name (``make_suite``).
+        suite: The suite and its observations (``SuiteConfig``, as ``lerobot-mtdagger run`` and
+            ``eval`` take it: ``--env.suite.name=drawers --env.suite.obs_mode=pointcloud``); its
+            ``obs_mode`` must match what the policy was trained on. ``suite.tasks`` is not used: the
+            env is one task, ``task``.
         task: Task name within the suite (also the task string handed to the policy).
-        obs_mode: ``state``, ``rgb`` or ``pointcloud``; must match what the policy was trained on.
-        image_size: RGB side in pixels.
-        num_points: Points per cloud.
-        episode_length: Truncation length (the task's default when None).
-        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when
-            None, or ``narrow``).
-        mesh_detail: Share of the faces of the arm's meshes the observation renderer keeps (1: all).
     """
 
-    suite: str = "metaworld-mt10"
+    suite: SuiteConfig = field(default_factory=_plugin_suite)
     task: str | None = "reach-v3"
-    obs_mode: str = "state"
-    image_size: int = 84
-    num_points: int = 1024
-    episode_length: int | None = None
-    placement: str | None = None
-    mesh_detail: float = 1.0
     fps: int = 80
     features: dict[str, PolicyFeature] = field(default_factory=dict)
     features_map: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        suite = suite_from_config(self)
+        if isinstance(self.suite, dict):  # gym_kwargs hand the suite over as a mapping
+            self.suite = SuiteConfig(**self.suite)
+        defaults = _plugin_suite()  # draccus builds a SuiteConfig of class defaults when one field is given
+        self.suite.name = self.suite.name or defaults.name
+        self.suite.obs_mode = self.suite.obs_mode or defaults.obs_mode
+        suite = suite_from_config(self.task_suite)
         self.features, self.features_map = {}, {}
         for key, feature in suite.features.items():
             if key == "action":
@@ -146,9 +147,9 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
             self.features_map[raw] = key if key != POINTCLOUD_KEY else "observation.environment_state"
 
     @property
-    def tasks(self) -> list[str]:
-        """The suite's tasks for ``suite_from_config``: the one task (all the suite's when None)."""
-        return [self.task] if self.task else []
+    def task_suite(self) -> SuiteConfig:
+        """``suite`` narrowed to the one task (all the suite's tasks when ``task`` is None)."""
+        return dataclasses.replace(self.suite, tasks=[self.task] if self.task else [])
 
     @property
     def package_name(self) -> str:
@@ -162,14 +163,5 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
 
     @property
     def gym_kwargs(self) -> dict[str, Any]:
-        """Arguments of ``LeRobotSuiteEnv``."""
-        return {
-            "suite": self.suite,
-            "task": self.task,
-            "obs_mode": self.obs_mode,
-            "image_size": self.image_size,
-            "num_points": self.num_points,
-            "episode_length": self.episode_length,
-            "placement": self.placement,
-            "mesh_detail": self.mesh_detail,
-        }
+        """Arguments of ``LeRobotSuiteEnv``: the task and the suite's options."""
+        return {"suite": dataclasses.asdict(self.suite), "task": self.task}

@@ -26,12 +26,16 @@ import dataclasses
 import functools
 import math
 import os
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from lerobot_mtdagger.envs.drawers.variants import DEFAULT_PLACEMENT, LEGACY_PLACEMENT, PLACEMENTS
+from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
+from lerobot_mtdagger.envs.config import SuiteConfig
+from lerobot_mtdagger.envs.drawers.variants import LEGACY_PLACEMENT
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
+from lerobot_mtdagger.utils.ray_session import import_ray
 
 
 @dataclass
@@ -160,6 +164,7 @@ def lerobot_policy_config(options: Any) -> Any:
 
 
 RUN_MODES: tuple[str, ...] = ("dagger", "bc")
+"""``dagger``: Algorithm 1 with the chosen scheduler; ``bc``: the one-round behaviour-cloning baseline."""
 MIXING_MODES: tuple[str, ...] = ("episode", "step")
 """``episode``: one beta coin per episode (the expert or the learner acts throughout); ``step``: a coin
 at every step (classic DAgger)."""
@@ -170,53 +175,56 @@ STEPS_RULES: tuple[str, ...] = ("fixed", "epochs", "plateau")
 ``plateau``: until the loss on held-out episodes stops improving."""
 SAMPLINGS: tuple[str, ...] = ("uniform", "balanced")
 """``uniform``: frames uniformly; ``balanced``: a task uniformly, then one of its frames."""
-"""``dagger``: Algorithm 1 with the chosen scheduler; ``bc``: the one-round behaviour-cloning baseline."""
+WORKER_BACKENDS: tuple[str, ...] = ("local", "ray")
+"""``local``: env workers forked on this machine; ``ray``: Ray actors on a Ray cluster."""
+GAIN_SPLITS: tuple[str, ...] = ("train", "heldout")
+"""Where the performance-gain scheduler measures per-task loss: the training data or held-out episodes."""
 
 PRESETS: dict[str, dict[str, Any]] = {
     "small": {
-        "suite": "metaworld-mt10",
-        "obs_mode": "state",
-        "rounds": 3,
-        "initial_demos": 3,
-        "budget_per_task": 3,
-        "steps_per_round": 1500,
-        "eval_episodes": 5,
+        "suite.name": "metaworld-mt10",
+        "suite.obs_mode": "state",
+        "dagger.rounds": 3,
+        "dagger.initial_demos": 3,
+        "dagger.budget_per_task": 3,
+        "training.steps_per_round": 1500,
+        "rollout.eval_episodes": 5,
         "scheduler.n_min": 1,
         "policy.lr": 3e-4,
         "policy.batch_size": 256,
     },
     "metaworld-state": {
-        "suite": "metaworld-mt50",
-        "obs_mode": "state",
-        "rounds": 10,
-        "initial_demos": 3,
-        "budget_per_task": 3,
-        "steps_per_round": 3000,
-        "eval_episodes": 10,
+        "suite.name": "metaworld-mt50",
+        "suite.obs_mode": "state",
+        "dagger.rounds": 10,
+        "dagger.initial_demos": 3,
+        "dagger.budget_per_task": 3,
+        "training.steps_per_round": 3000,
+        "rollout.eval_episodes": 10,
         "scheduler.n_min": 1,
         "policy.lr": 3e-4,
         "policy.batch_size": 1024,
     },
     "metaworld-pixels": {
-        "suite": "metaworld-mt10",
-        "obs_mode": "rgb",
-        "rounds": 5,
-        "initial_demos": 40,
-        "budget_per_task": 20,
-        "steps_per_round": 3000,
-        "eval_episodes": 10,
+        "suite.name": "metaworld-mt10",
+        "suite.obs_mode": "rgb",
+        "dagger.rounds": 5,
+        "dagger.initial_demos": 40,
+        "dagger.budget_per_task": 20,
+        "training.steps_per_round": 3000,
+        "rollout.eval_episodes": 10,
         "scheduler.n_min": 1,
         "policy.lr": 3e-4,
         "policy.batch_size": 1024,
     },
     "drawers-pointcloud": {
-        "suite": "drawers",
-        "obs_mode": "pointcloud",
-        "rounds": 10,
-        "initial_demos": 30,
-        "budget_per_task": 30,
-        "steps_per_round": 3000,
-        "eval_episodes": 10,
+        "suite.name": "drawers",
+        "suite.obs_mode": "pointcloud",
+        "dagger.rounds": 10,
+        "dagger.initial_demos": 30,
+        "dagger.budget_per_task": 30,
+        "training.steps_per_round": 3000,
+        "rollout.eval_episodes": 10,
         "scheduler.n_min": 5,
         "policy.lr": 1e-4,
         "policy.batch_size": 256,
@@ -230,33 +238,126 @@ PRESET_FIELDS: tuple[str, ...] = tuple(PRESETS["small"])
 """The options every preset fills."""
 
 
+def _require_positive(owner: Any, group: str, names: Sequence[str]) -> None:
+    """Refuses an option of ``names`` that is set and not a finite number > 0."""
+    for name in names:
+        value = getattr(owner, name)
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{group}.{name} must be > 0, got {value}.")
+
+
+def _require_choice(value: str, option: str, choices: Sequence[str]) -> None:
+    """Refuses a ``value`` of ``option`` outside ``choices``."""
+    if value not in choices:
+        raise ValueError(f"{option} must be one of {list(choices)}, got {value!r}.")
+
+
 @dataclass
-class RunConfig:
-    """Options of ``lerobot-mtdagger run`` (one Multitask DAgger experiment, or the BC baseline).
+class DAggerConfig:
+    """The DAgger loop: how many rounds, how many expert episodes, who acts (``--dagger.*``).
 
     Attributes:
-        preset: One of ``PRESETS``; fills every option of ``PRESET_FIELDS`` left unset (None).
-        mode: ``dagger`` (Algorithm 1 with ``scheduler``) or ``bc``: ONE round of expert
-            demonstrations with the same data budget (``initial_demos + rounds * budget / num_tasks``
-            per task, split uniformly), trained like a DAgger phase (``phase_steps``); the scheduler
-            is unused.
-        suite: Task suite (``make_suite`` name).
-        tasks: Subset of the suite's tasks (all when empty).
-        obs_mode: ``state``, ``rgb`` or ``pointcloud``.
-        scheduler: ``--scheduler.type=uniform|need|need_raw|gain`` and its hyperparameters
-            (``scheduler.n_min`` from the preset when unset).
-        rounds: DAgger rounds after round 0.
+        rounds: DAgger rounds after round 0 (None: the preset's).
+        initial_demos: Round-0 expert episodes per task (None: the preset's).
         budget: Expert episodes per DAgger round over all tasks (None: budget_per_task * tasks).
-        budget_per_task: Used when ``budget`` is None.
-        initial_demos: Round-0 expert episodes per task.
-        steps_per_round: Training steps after each round.
-        eval_episodes: Evaluation episodes per task after each training phase.
+        budget_per_task: Used when ``budget`` is None (None: the preset's).
         beta: Probability of executing the expert's action in the first DAgger round.
         beta_decay: Subtracted from beta after every DAgger round.
         beta_min: Floor of beta.
         mixing: ``episode`` (one beta coin per episode: the expert or the learner acts throughout)
             or ``step`` (a coin at every step). Task need is measured on the episodes where only the
             learner acted, so under ``step`` mixing with beta > 0 a round measures nothing.
+    """
+
+    rounds: int | None = None
+    initial_demos: int | None = None
+    budget: int | None = None
+    budget_per_task: int | None = None
+    beta: float = 0.5
+    beta_decay: float = 0.5
+    beta_min: float = 0.0
+    mixing: str = "episode"
+
+    def check(self) -> None:
+        """Refuses impossible values (one line naming the option)."""
+        if self.rounds < 0:
+            raise ValueError(f"dagger.rounds must be >= 0, got {self.rounds}.")
+        if self.initial_demos <= 0:
+            raise ValueError(
+                f"dagger.initial_demos must be > 0, got {self.initial_demos}: round 0 trains the first "
+                "policy on expert demos."
+            )
+        _require_positive(self, "dagger", ("budget", "budget_per_task"))
+        _require_choice(self.mixing, "dagger.mixing", MIXING_MODES)
+        if not 0.0 <= self.beta_min <= self.beta <= 1.0 or self.beta_decay < 0:
+            raise ValueError(
+                f"Need 0 <= dagger.beta_min <= dagger.beta <= 1 and dagger.beta_decay >= 0, got "
+                f"beta={self.beta}, beta_min={self.beta_min}, beta_decay={self.beta_decay}."
+            )
+
+    def budget_for(self, num_tasks: int) -> int:
+        """Expert episodes per DAgger round."""
+        return self.budget if self.budget is not None else self.budget_per_task * num_tasks
+
+
+@dataclass
+class RolloutConfig:
+    """Episodes: where a DAgger rollout is cut, evaluation, env workers (``--rollout.*``).
+
+    Attributes:
+        eval_episodes: Evaluation episodes per task after each training phase (None: the preset's).
+        max_steps: Steps after which a DAgger rollout is cut (None: the env's own horizon, the one
+            evaluation runs to).
+        expert_multiple: Cut a DAgger rollout at this multiple of the steps the expert alone takes
+            to succeed from the same reset seed (the expert runs that episode first, unrecorded; no
+            cut where it fails). None: no such cut. ``max_steps`` still applies.
+        steps_after_success: Steps recorded after the first success before an episode ends.
+        workers: Env worker processes for collection and evaluation (None: one per core; 0: step
+            the envs in the main process; with ``worker_backend=ray``, at least one actor). Never
+            changes a result.
+        worker_backend: ``local`` (forked processes on this machine) or ``ray`` (Ray actors spread
+            over a Ray cluster, ``runner/ray_workers.py``). Never changes a result.
+        ray_address: The Ray cluster of ``worker_backend=ray`` (``auto``: the one ``ray start`` left
+            on this machine; ``ray://host:10001``; None: start a local Ray).
+    """
+
+    eval_episodes: int | None = None
+    max_steps: int | None = None
+    expert_multiple: float | None = None
+    steps_after_success: int = 10
+    workers: int | None = None
+    worker_backend: str = "local"
+    ray_address: str | None = None
+
+    def check(self) -> None:
+        """Refuses impossible values (one line naming the option)."""
+        for name in ("eval_episodes", "steps_after_success"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"rollout.{name} must be >= 0, got {getattr(self, name)}.")
+        _require_positive(self, "rollout", ("max_steps", "expert_multiple"))
+        resolve_workers(self.workers)  # refuses a negative count before anything runs
+        _require_choice(self.worker_backend, "rollout.worker_backend", WORKER_BACKENDS)
+        if self.worker_backend == "ray":
+            import_ray()  # refuses a missing Ray before anything runs
+
+    @property
+    def worker_count(self) -> int:
+        """Env worker processes to start (``workers``, or one per core)."""
+        return resolve_workers(self.workers)
+
+    def env_workers(self, suite: Any) -> Any:
+        """The ``EnvWorkers`` of ``suite`` on this config's backend (a context manager)."""
+        from lerobot_mtdagger.runner.ray_workers import make_env_workers
+
+        return make_env_workers(suite, self.worker_count, self.worker_backend, self.ray_address)
+
+
+@dataclass
+class TrainingConfig:
+    """How each phase trains the student (``--training.*``; the optimiser is the policy's).
+
+    Attributes:
+        steps_per_round: Training steps after each round (``steps_rule=fixed``; None: the preset's).
         warm_start: Continue from the previous round's weights (else retrain from scratch).
         steps_rule: ``fixed`` (``steps_per_round`` steps per phase), ``epochs`` (``epochs`` passes
             over the phase's training frames, at least one step) or ``plateau`` (until the loss on
@@ -275,50 +376,9 @@ class RunConfig:
         heldout_fraction: Fraction of each task's episodes held out of training when
             ``gain_split=heldout`` or ``steps_rule=plateau`` (decided once per episode, so an
             episode never changes side; a task's first episode is always trained on).
-        max_rollout_steps: Steps after which a DAgger rollout is cut (None: the env's own horizon,
-            the one evaluation runs to).
-        rollout_expert_multiple: Cut a DAgger rollout at this multiple of the steps the expert alone
-            takes to succeed from the same reset seed (the expert runs that episode first,
-            unrecorded; no cut where it fails). None: no such cut. ``max_rollout_steps`` still applies.
-        steps_after_success: Steps recorded after the first success before an episode ends.
-        num_points: Points per cloud (pointcloud mode).
-        image_size: Image side (rgb mode).
-        mesh_detail: Share of the faces of the arm's meshes the observation renderer keeps, in (0, 1]
-            (rgb and pointcloud modes; 1: the exact model). 0.2 renders about twice as fast on a CPU
-            and changes only the arm's silhouette by millimetres (``docs/benchmarks.md``).
-        placement: ``drawers`` suite only: how resets move and recolour the drawers (``kitchen``
-            when None, stored as such; ``narrow``: the suite's first ranges, which runs made before
-            this option existed used). Refused for other suites.
-        policy: The student and its options: ``--policy.type=mtdagger`` (default; ``PolicyOptions``)
-            or a LeRobot policy (``act``, ``diffusion``) with LeRobot's own options plus
-            ``batch_size`` (``StudentOptions``). ``policy.batch_size`` (and for ``mtdagger``
-            ``policy.lr``) come from the preset when unset.
-        output_dir: Experiment directory (refused if it exists, unless ``resume``); default
-            ``outputs/mtdagger/<preset>-<method>-seed<seed>``.
-        seed: Seed of everything (collection, evaluation, training).
-        resume: Continue the experiment in ``output_dir`` from its last committed round.
-        progress: Show progress bars (only on a terminal); the summary line of each round is
-            always printed.
-        workers: Env worker processes for collection and evaluation (None: one per core; 0: step
-            the envs in the main process). Never changes a result.
     """
 
-    preset: str = "small"
-    mode: str = "dagger"
-    suite: str | None = None
-    tasks: list[str] = field(default_factory=list)
-    obs_mode: str | None = None
-    scheduler: SchedulerConfig = field(default_factory=NeedSchedulerConfig)
-    rounds: int | None = None
-    budget: int | None = None
-    budget_per_task: int | None = None
-    initial_demos: int | None = None
     steps_per_round: int | None = None
-    eval_episodes: int | None = None
-    beta: float = 0.5
-    beta_decay: float = 0.5
-    beta_min: float = 0.0
-    mixing: str = "episode"
     warm_start: bool = True
     steps_rule: str = "fixed"
     epochs: float = 100.0
@@ -329,19 +389,70 @@ class RunConfig:
     sampling: str = "uniform"
     gain_split: str = "train"
     heldout_fraction: float = 0.2
-    max_rollout_steps: int | None = None
-    rollout_expert_multiple: float | None = None
-    steps_after_success: int = 10
-    num_points: int = 1024
-    image_size: int = 84
-    mesh_detail: float = 1.0
-    placement: str | None = None
+
+    def check(self) -> None:
+        """Refuses impossible values (one line naming the option)."""
+        positive = ("steps_per_round", "epochs", "plateau_every", "plateau_patience", "plateau_max_steps")
+        _require_positive(self, "training", positive)
+        _require_choice(self.steps_rule, "training.steps_rule", STEPS_RULES)
+        _require_choice(self.normalisation, "training.normalisation", NORMALISATIONS)
+        _require_choice(self.sampling, "training.sampling", SAMPLINGS)
+        _require_choice(self.gain_split, "training.gain_split", GAIN_SPLITS)
+        if not 0.0 < self.heldout_fraction < 1.0:
+            raise ValueError(f"training.heldout_fraction must be in (0, 1), got {self.heldout_fraction}.")
+
+    @property
+    def holds_out_episodes(self) -> bool:
+        """Whether each task's episodes are split into training and held-out ones."""
+        return self.gain_split == "heldout" or self.steps_rule == "plateau"
+
+
+@dataclass
+class RunConfig:
+    """Options of ``lerobot-mtdagger run`` (one Multitask DAgger experiment, or the BC baseline).
+
+    Twelve top-level options; the rest sit in their group (``--suite.obs_mode``, ``--dagger.rounds``,
+    ``--rollout.eval_episodes``, ``--training.steps_rule``, ``--policy.lr``, ``--scheduler.n_min``).
+    A flat config stored before the groups existed is migrated on reading
+    (``datasets/config_layout.py``), and the old spellings are refused with the new one named.
+
+    Attributes:
+        preset: One of ``PRESETS``; fills every option of ``PRESET_FIELDS`` left unset (None).
+        mode: ``dagger`` (Algorithm 1 with ``scheduler``) or ``bc``: ONE round of expert
+            demonstrations with the same data budget (``initial_demos + rounds * budget / num_tasks``
+            per task, split uniformly), trained like a DAgger phase (``phase_steps``); the scheduler
+            is unused.
+        suite: The suite and its observations (``SuiteConfig``; shared with ``eval``, ``shift`` and
+            the LeRobot env plugin).
+        dagger: Rounds, demo budgets and beta (``DAggerConfig``).
+        rollout: Episode cuts, evaluation episodes and env workers (``RolloutConfig``).
+        training: Steps per phase, sampling, held-out split (``TrainingConfig``).
+        scheduler: ``--scheduler.type=uniform|need|need_raw|gain`` and its hyperparameters
+            (``scheduler.n_min`` from the preset when unset).
+        policy: The student and its options: ``--policy.type=mtdagger`` (default; ``PolicyOptions``)
+            or a LeRobot policy (``act``, ``diffusion``) with LeRobot's own options plus
+            ``batch_size`` (``StudentOptions``). ``policy.batch_size`` (and for ``mtdagger``
+            ``policy.lr``) come from the preset when unset.
+        output_dir: Experiment directory (refused if it exists, unless ``resume``); default
+            ``outputs/mtdagger/<preset>-<method>-seed<seed>``.
+        seed: Seed of everything (collection, evaluation, training).
+        resume: Continue the experiment in ``output_dir`` from its last committed round.
+        progress: Show progress bars (only on a terminal); the summary line of each round is
+            always printed.
+    """
+
+    preset: str = "small"
+    mode: str = "dagger"
+    suite: SuiteConfig = field(default_factory=SuiteConfig)
+    dagger: DAggerConfig = field(default_factory=DAggerConfig)
+    rollout: RolloutConfig = field(default_factory=RolloutConfig)
+    training: TrainingConfig = field(default_factory=TrainingConfig)
+    scheduler: SchedulerConfig = field(default_factory=NeedSchedulerConfig)
     policy: StudentOptions = field(default_factory=PolicyOptions)
     output_dir: Path | None = None
     seed: int = 0
     resume: bool = False
     progress: bool = True
-    workers: int | None = None
 
     def __post_init__(self) -> None:
         if self.preset not in PRESETS:
@@ -356,8 +467,7 @@ class RunConfig:
                 setattr(owner, name, value)
         if self.output_dir is None:
             self.output_dir = Path("outputs") / "mtdagger" / f"{self.preset}-{self.method}-seed{self.seed}"
-        if self.suite == "drawers" and self.placement is None:
-            self.placement = DEFAULT_PLACEMENT
+        self.suite.fill_defaults()
         self._check()
 
     def _field_owner(self, path: str) -> tuple[Any, str]:
@@ -369,45 +479,12 @@ class RunConfig:
         return owner, name
 
     def _check(self) -> None:
-        for name in ("rounds", "initial_demos", "eval_episodes", "steps_after_success"):
-            if getattr(self, name) < 0:
-                raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}.")
-        resolve_workers(self.workers)  # refuses a negative count before anything runs
         if self.seed < 0:
             raise ValueError(f"seed must be >= 0, got {self.seed}.")
-        positive = (
-            "steps_per_round",
-            "budget",
-            "budget_per_task",
-            "max_rollout_steps",
-            "epochs",
-            "plateau_every",
-            "plateau_patience",
-            "plateau_max_steps",
-        )
-        for name in (*positive, "rollout_expert_multiple"):
-            value = getattr(self, name)
-            if value is not None and not (math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be > 0, got {value}.")
-        for name, choices in (
-            ("mixing", MIXING_MODES),
-            ("steps_rule", STEPS_RULES),
-            ("normalisation", NORMALISATIONS),
-            ("sampling", SAMPLINGS),
-        ):
-            if getattr(self, name) not in choices:
-                raise ValueError(f"{name} must be one of {list(choices)}, got {getattr(self, name)!r}.")
-        if self.initial_demos == 0:
-            raise ValueError("initial_demos must be > 0: round 0 trains the first policy on expert demos.")
-        if not 0.0 <= self.beta_min <= self.beta <= 1.0 or self.beta_decay < 0:
-            raise ValueError(
-                f"Need 0 <= beta_min <= beta <= 1 and beta_decay >= 0, got beta={self.beta}, "
-                f"beta_min={self.beta_min}, beta_decay={self.beta_decay}."
-            )
-        if self.gain_split not in ("train", "heldout"):
-            raise ValueError(f"gain_split must be 'train' or 'heldout', got {self.gain_split!r}.")
-        if not 0.0 < self.heldout_fraction < 1.0:
-            raise ValueError(f"heldout_fraction must be in (0, 1), got {self.heldout_fraction}.")
+        self.suite.check()
+        self.dagger.check()
+        self.rollout.check()
+        self.training.check()
         lr_name = "lr" if isinstance(self.policy, PolicyOptions) else "optimizer_lr"
         lr = getattr(self.policy, lr_name)
         if self.policy.batch_size <= 0 or not (math.isfinite(lr) and lr > 0):
@@ -417,21 +494,15 @@ class RunConfig:
             )
         check_device(self.policy.device)
         self._check_student()
-        if self.placement is not None and self.suite != "drawers":
-            raise ValueError(f"placement applies to the drawers suite only; drop it for {self.suite!r}.")
-        if self.placement is not None and self.placement not in PLACEMENTS:
-            raise ValueError(
-                f"Unknown drawer placement {self.placement!r}; choose one of {sorted(PLACEMENTS)}."
-            )
 
     def _check_student(self) -> None:
         """Refuses a LeRobot student the runner cannot train (point clouds, temporal ensembling)."""
         if self.student_type == "mtdagger":
             return
-        if self.obs_mode == "pointcloud":
+        if self.suite.obs_mode == "pointcloud":
             raise ValueError(
                 f"--policy.type={self.student_type} cannot read point clouds (a LeRobot policy takes "
-                "state and images): use --policy.type=mtdagger or --obs_mode=state|rgb."
+                "state and images): use --policy.type=mtdagger or --suite.obs_mode=state|rgb."
             )
         if getattr(self.policy, "temporal_ensemble_coeff", None) is not None:
             raise ValueError(
@@ -454,11 +525,6 @@ class RunConfig:
         """The experiment's method as reports name it: ``bc`` or the scheduling method."""
         return "bc" if self.is_bc else self.scheduler.type
 
-    @property
-    def worker_count(self) -> int:
-        """Env worker processes to start (``workers``, or one per core)."""
-        return resolve_workers(self.workers)
-
     def phase_steps(self, frames: int) -> int:
         """Optimiser steps of one training phase on ``frames`` training frames.
 
@@ -468,36 +534,38 @@ class RunConfig:
         except with fixed steps and a warm start: the final DAgger policy has then taken
         ``(rounds + 1) * steps_per_round`` steps in all, and so does BC.
         """
-        if self.steps_rule == "plateau":
-            return self.plateau_max_steps
-        if self.steps_rule == "epochs":
-            return max(1, math.ceil(self.epochs * frames / self.policy.batch_size))
-        if self.is_bc and self.warm_start:
-            return self.steps_per_round * (self.rounds + 1)
-        return self.steps_per_round
-
-    def budget_for(self, num_tasks: int) -> int:
-        """Expert episodes per DAgger round."""
-        return self.budget if self.budget is not None else self.budget_per_task * num_tasks
+        training = self.training
+        if training.steps_rule == "plateau":
+            return training.plateau_max_steps
+        if training.steps_rule == "epochs":
+            return max(1, math.ceil(training.epochs * frames / self.policy.batch_size))
+        if self.is_bc and training.warm_start:
+            return training.steps_per_round * (self.dagger.rounds + 1)
+        return training.steps_per_round
 
     @classmethod
     def option_defaults(cls) -> dict[str, Any]:
-        """What each top-level option was before it existed, by name (e.g. ``plateau_every: 200``).
+        """What each option was before it existed, by dotted path (e.g. ``training.plateau_every: 200``).
 
-        Its plain default, except ``placement``: drawer runs made before it existed used ``narrow``;
-        ``policy`` maps the policy options alike.
+        Its plain default, except ``suite.placement``: drawer runs made before it existed used
+        ``narrow``. Policy options are those of ``mtdagger`` (the only student then).
         """
-        fields = dataclasses.fields(cls)
-        defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
-        policy = {
-            f.name: f.default
-            for f in dataclasses.fields(PolicyOptions)
-            if f.default is not dataclasses.MISSING
-        }
-        return defaults | {"placement": LEGACY_PLACEMENT, "policy": policy}
+        defaults: dict[str, Any] = {}
+        for group, options in (
+            ("suite", SuiteConfig),
+            ("dagger", DAggerConfig),
+            ("rollout", RolloutConfig),
+            ("training", TrainingConfig),
+            ("policy", PolicyOptions),
+        ):
+            for option in dataclasses.fields(options):
+                if option.default is not dataclasses.MISSING:
+                    defaults[f"{group}.{option.name}"] = option.default
+        top = {f.name: f.default for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
+        return top | defaults | {"suite.placement": LEGACY_PLACEMENT}
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready form (stored in every round's record)."""
+        """JSON-ready form (stored in every round's record; ``migrate_run_config``'s layout)."""
         record = dataclasses.asdict(self)
         record["policy"] = policy_options_dict(self.policy)
         record["output_dir"] = str(self.output_dir)
@@ -556,11 +624,20 @@ def default_worker_count() -> int:
     return os.cpu_count() or 1
 
 
-def renamed_option_error(args: list[str]) -> str | None:
+RUN_OPTION_RENAMES: dict[str, str] = FLAT_OPTION_PATHS
+"""``run``'s (and ``compare``'s run) options before they were grouped, and their spelling today."""
+SUITE_OPTION_RENAMES: dict[str, str] = {
+    old: new for old, new in FLAT_OPTION_PATHS.items() if new.startswith("suite.")
+}
+"""``eval``'s and ``shift``'s suite options before ``SuiteConfig``, and their spelling today."""
+
+
+def renamed_option_error(args: Sequence[str], renames: Mapping[str, str] | None = None) -> str | None:
     """A message naming the new spelling when ``args`` use an option that was renamed (else None).
 
-    ``--scheduler.type=bc`` became ``--mode=bc`` (BC is a run mode, not a scheduler) and ``--n_min``
-    became ``--scheduler.n_min`` (one home per option).
+    ``--scheduler.type=bc`` became ``--mode=bc`` (BC is a run mode, not a scheduler), ``--n_min``
+    became ``--scheduler.n_min`` (one home per option), and each option of ``renames`` (the
+    command's grouped options: ``--obs_mode`` became ``--suite.obs_mode``) its new path.
     """
     for arg in args:
         name, _, value = arg.partition("=")
@@ -571,4 +648,11 @@ def renamed_option_error(args: list[str]) -> str | None:
             )
         if name == "--n_min":
             return f"--n_min is no longer accepted: use --scheduler.n_min={value or '<n>'}."
+        new = (renames or {}).get(name.removeprefix("--")) if name.startswith("--") else None
+        if new is not None:
+            given = f"={value}" if value else ""
+            return (
+                f"{name} is now --{new} (options are grouped: suite, dagger, rollout, training; the "
+                f"README's changelog lists every rename): use --{new}{given}."
+            )
     return None

@@ -91,14 +91,15 @@ class RunContext:
     @property
     def last_round(self) -> int:
         """Index of the last round of the experiment."""
-        return 0 if self.config.is_bc else self.config.rounds
+        return 0 if self.config.is_bc else self.config.dagger.rounds
 
 
 def beta_for_round(config: RunConfig, round_index: int) -> float:
     """Probability of executing the expert's action in a round (1 in round 0)."""
     if round_index == 0:
         return 1.0
-    return max(config.beta - (round_index - 1) * config.beta_decay, config.beta_min)
+    dagger = config.dagger
+    return max(dagger.beta - (round_index - 1) * dagger.beta_decay, dagger.beta_min)
 
 
 def new_scheduler(config: RunConfig, num_tasks: int) -> Scheduler:
@@ -115,10 +116,10 @@ def initial_allocation(ctx: RunContext) -> list[int]:
     """Round-0 episodes per task: n0, plus the DAgger rounds' budget for BC (split uniformly)."""
     num_tasks = len(ctx.task_names)
     if not ctx.config.is_bc:
-        return [ctx.config.initial_demos] * num_tasks
-    extra = ctx.config.rounds * ctx.config.budget_for(num_tasks)
+        return [ctx.config.dagger.initial_demos] * num_tasks
+    extra = ctx.config.dagger.rounds * ctx.config.dagger.budget_for(num_tasks)
     uniform = allocate_probabilities(np.full(num_tasks, 1.0 / num_tasks), extra, 0)
-    return [ctx.config.initial_demos + int(n) for n in uniform]
+    return [ctx.config.dagger.initial_demos + int(n) for n in uniform]
 
 
 def schedule_round(ctx: RunContext, round_index: int) -> tuple[Scheduler, Allocation]:
@@ -136,7 +137,7 @@ def schedule_round(ctx: RunContext, round_index: int) -> tuple[Scheduler, Alloca
         rates = [np.nan if r is None else r for r in previous.learner_success]
         measurements |= {"success_rate": rates, "episodes": previous.learner_episodes}
     scheduler.update(**measurements)
-    allocation = scheduler.allocate(ctx.config.budget_for(len(ctx.task_names)))
+    allocation = scheduler.allocate(ctx.config.dagger.budget_for(len(ctx.task_names)))
     if round_index == 1:
         allocation.notes.append(
             "round 1: no learner rollout and no warm-started phase measured yet, the prior decides"
@@ -159,7 +160,7 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
             runner = PolicyRunner.from_pretrained(
                 ctx.experiment.policy_root(round_index - 1), config.policy.device
             )
-        beta, max_steps = beta_for_round(config, round_index), config.max_rollout_steps
+        beta, max_steps = beta_for_round(config, round_index), config.rollout.max_steps
     with tqdm(
         total=sum(counts), desc=f"round {round_index} collect", leave=False, disable=not ctx.show_progress
     ) as bar:
@@ -173,10 +174,10 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
             stream=COLLECT_STREAM,
             record=True,
             max_steps=max_steps,
-            steps_after_success=config.steps_after_success,
+            steps_after_success=config.rollout.steps_after_success,
             progress=lambda _: bar.update(1),
-            mixing=config.mixing,
-            expert_multiple=config.rollout_expert_multiple,
+            mixing=config.dagger.mixing,
+            expert_multiple=config.rollout.expert_multiple,
         )
     collected = time.perf_counter()
     dataset = ctx.experiment.write_round(
@@ -298,7 +299,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     }
     ctx.timings.setdefault(round_index, {}).update(timing)
     demos = ctx.experiment.read_round_record(round_index).demos_so_far
-    record = trained.record(round_index, ctx.config.gain_split, demos, ctx.timings[round_index])
+    record = trained.record(round_index, ctx.config.training.gain_split, demos, ctx.timings[round_index])
     record.eval, record.heldout_eval = evaluations
     ctx.experiment.commit_phase(round_index, staging, record)
 
@@ -308,7 +309,7 @@ def evaluate_student(ctx: RunContext, runner: PolicyRunner) -> tuple[dict | None
     results = [evaluate_phase(ctx, runner, ctx.workers), None]
     if ctx.heldout_suite is not None:
         # Workers of their own, only while they evaluate: each holds its drawers' envs and renderers.
-        with EnvWorkers(ctx.heldout_suite, ctx.config.worker_count) as heldout_workers:
+        with ctx.config.rollout.env_workers(ctx.heldout_suite) as heldout_workers:
             results[1] = evaluate_phase(ctx, runner, heldout_workers)
     return tuple(None if result is None else result.to_dict() for result in results)
 
@@ -319,14 +320,14 @@ def evaluate_phase(ctx: RunContext, runner: PolicyRunner, workers: EnvWorkers) -
     ``ctx.workers`` step the training tasks; workers of ``ctx.heldout_suite`` the unseen ones, whose
     result is recorded beside the training tasks' and never reaches the scheduler.
     """
-    if ctx.config.eval_episodes == 0:
+    if ctx.config.rollout.eval_episodes == 0:
         return None
-    episodes = ctx.config.eval_episodes * len(workers.suite.task_names)
+    episodes = ctx.config.rollout.eval_episodes * len(workers.suite.task_names)
     with tqdm(total=episodes, desc="eval", leave=False, disable=not ctx.show_progress) as bar:
         result, _ = evaluate(
             workers,
             runner,
-            ctx.config.eval_episodes,
+            ctx.config.rollout.eval_episodes,
             ctx.config.seed,
             progress=lambda _: bar.update(1),
         )
@@ -359,12 +360,13 @@ def check_budget(config: RunConfig, num_tasks: int) -> None:
     Raises:
         UserError: With the numbers and the fix.
     """
-    budget = config.budget_for(num_tasks)
+    budget = config.dagger.budget_for(num_tasks)
     n_min = config.scheduler.min_episodes
     if not config.is_bc and budget < n_min * num_tasks:
         raise UserError(
             f"budget={budget} is smaller than n_min * num_tasks = {n_min} * {num_tasks} = "
-            f"{n_min * num_tasks}: raise --budget to at least {n_min * num_tasks} or lower --scheduler.n_min."
+            f"{n_min * num_tasks}: raise --dagger.budget to at least {n_min * num_tasks} or lower "
+            "--scheduler.n_min."
         )
 
 
@@ -383,7 +385,7 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         WorkerDiedError: If an env worker process dies.
     """
     with quiet_third_party():  # importing MetaWorld's renderer logs an OpenGL INFO line
-        suite = suite_from_config(config)
+        suite = suite_from_config(config.suite)
     check_budget(config, len(suite.task_names))
     check_heldout(config, len(suite.task_names))
     experiment = ExperimentDir(config.output_dir)
@@ -395,7 +397,7 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         if config.resume:
             experiment.check_committed_files()  # refuses foreign, corrupt or changed rounds and policies
             experiment.clear_staging()
-            experiment.extend_rounds(config.rounds)  # a DAgger run resumed with more --rounds
+            experiment.extend_rounds(config.dagger.rounds)  # a DAgger run resumed with more rounds
         return _run_locked(config, suite, experiment, on_summary)
 
 
@@ -406,7 +408,7 @@ def unseen_task_suite(config: RunConfig, suite: TaskSuite) -> TaskSuite | None:
     (``--policy.task_dropout=0``), or nothing is evaluated.
     """
     heldout = suite.heldout_suite()
-    if heldout is None or config.eval_episodes == 0:
+    if heldout is None or config.rollout.eval_episodes == 0:
         return None
     if config.policy.resolved_task_dropout(True) == 0.0:
         logger.info(
@@ -427,7 +429,7 @@ def _run_locked(
     lines = []
     rounds_done, phases_done = set(experiment.committed_rounds()), set(experiment.committed_phases())
     try:
-        with EnvWorkers(suite, config.worker_count) as workers:
+        with config.rollout.env_workers(suite) as workers:
             heldout = unseen_task_suite(config, suite)
             ctx = RunContext(config, suite, experiment, workers, show, heldout_suite=heldout)
             for round_index in range(ctx.last_round + 1):

@@ -69,7 +69,7 @@ class PolicyRunner:
             feature, given = self.policy.config.input_features[key], suite_features.get(key)
             if given is None:
                 raise UserError(
-                    f"The policy takes {key!r}, which --obs_mode={obs_mode} does not give (it gives "
+                    f"The policy takes {key!r}, which --suite.obs_mode={obs_mode} does not give (it gives "
                     f"{sorted(suite_features)}): pass the obs_mode the policy was trained on."
                 )
             if tuple(given["shape"]) != tuple(feature.shape):

@@ -921,13 +921,17 @@ def train_on_rounds(
     image_keys = list(policy_cfg.image_features)
     phase_seed = stream_seed(config.seed, TRAINING_STREAM, round_index)
     split = split_frames(
-        data, config.gain_split, config.heldout_fraction, config.seed, hold_out=config.steps_rule == "plateau"
+        data,
+        config.training.gain_split,
+        config.training.heldout_fraction,
+        config.seed,
+        hold_out=config.training.steps_rule == "plateau",
     )
     stats = compute_stats(data.subset(normalisation_frames(config, data, split.train)), image_keys)
     torch.manual_seed(phase_seed)
     policy, preprocessor, postprocessor = _new_student(policy_cfg, stats)
     runner = None if previous is None else PolicyRunner.from_pretrained(previous, config.policy.device)
-    if runner is not None and config.warm_start:
+    if runner is not None and config.training.warm_start:
         policy.load_state_dict(runner.policy.state_dict())
     normalised = NormalisedData(data, preprocessor, image_keys, list(policy_cfg.task_names))
     options = StepOptions(
@@ -935,7 +939,7 @@ def train_on_rounds(
         batch_size=config.policy.batch_size,
         lr=getattr(config.policy, "lr", None) or config.policy.optimizer_lr,
         seed=phase_seed,
-        sampling=config.sampling,
+        sampling=config.training.sampling,
         plateau=plateau_stop(config, split),
         task_dropout=getattr(policy_cfg, "task_dropout", 0.0),
     )
@@ -966,31 +970,33 @@ def train_on_rounds(
 
 def plateau_stop(config: RunConfig, split: FrameSplit) -> PlateauStop | None:
     """The phase's plateau stop on the held-out frames (``steps_rule=plateau``), or None."""
-    if config.steps_rule != "plateau":
+    training = config.training
+    if training.steps_rule != "plateau":
         return None
-    return PlateauStop(index=split.heldout, every=config.plateau_every, patience=config.plateau_patience)
+    return PlateauStop(index=split.heldout, every=training.plateau_every, patience=training.plateau_patience)
 
 
 def normalisation_frames(config: RunConfig, data: TrainingData, train_index: torch.Tensor) -> torch.Tensor:
     """The training frames the normalisation statistics come from: round 0's (``fixed``) or all."""
-    if config.normalisation == "recompute":
+    if config.training.normalisation == "recompute":
         return train_index
     return train_index[data.episode_id[train_index] < EPISODE_ID_STRIDE]
 
 
 def check_heldout(config: RunConfig, num_tasks: int) -> None:
-    """Refuses ``steps_rule=plateau`` when round 0 would hold no episode out, before anything runs.
+    """Refuses ``training.steps_rule=plateau`` when round 0 would hold no episode out, before anything runs.
 
     Raises:
         UserError: With the numbers and the fix.
     """
-    if config.steps_rule != "plateau":
+    training, demos = config.training, config.dagger.initial_demos
+    if training.steps_rule != "plateau":
         return
-    fraction, demos = config.heldout_fraction, config.initial_demos
+    fraction = training.heldout_fraction
     if not any(heldout_mask(demos, fraction, config.seed, task).any() for task in range(num_tasks)):
         raise UserError(
-            f"--steps_rule=plateau needs held-out episodes, and round 0 would hold none out: a task's "
-            f"first episode is always trained on, and --heldout_fraction={config.heldout_fraction} of the "
-            f"other {config.initial_demos - 1} per task gives none. Raise --heldout_fraction or "
-            "--initial_demos, or choose --steps_rule=fixed or epochs."
+            f"--training.steps_rule=plateau needs held-out episodes, and round 0 would hold none out: a "
+            f"task's first episode is always trained on, and --training.heldout_fraction={fraction} of "
+            f"the other {demos - 1} per task gives none. Raise --training.heldout_fraction or "
+            "--dagger.initial_demos, or choose --training.steps_rule=fixed or epochs."
         )

@@ -345,13 +345,30 @@ def _worker_loop(connection: Connection, suite: TaskSuite, inherited: list[Conne
                 return
             if command[0] == "close":
                 return
-            try:
-                reply = ("ok", worker.handle(command))
-            except Exception as error:  # noqa: BLE001 - re-raised in the main process (``_receive``)
-                reply = ("error", (_picklable(error), traceback.format_exc()))
-            connection.send(reply)
+            connection.send(answer(worker, command))
     finally:
         worker.close()
+
+
+def answer(worker: RolloutWorker, command: tuple[str, Any]) -> tuple[str, Any]:
+    """``("ok", reply)``, or ``("error", (exception, traceback text))`` to re-raise in the main process."""
+    try:
+        return "ok", worker.handle(command)
+    except Exception as error:  # noqa: BLE001 - re-raised in the main process (``reply_payload``)
+        return "error", (_picklable(error), traceback.format_exc())
+
+
+def reply_payload(reply: tuple[str, Any]) -> Any:
+    """The payload of a worker's ``answer``.
+
+    Raises:
+        Exception: The worker's own exception, with its traceback as the cause.
+    """
+    status, payload = reply
+    if status == "error":
+        error, text = payload
+        raise error from RemoteWorkerError(text)
+    return payload
 
 
 def _picklable(error: Exception) -> Exception:
@@ -462,13 +479,10 @@ class EnvWorkers:
         if connection not in wait([connection, process.sentinel]):
             raise self._died(index)
         try:
-            status, payload = connection.recv()
+            reply = connection.recv()
         except (EOFError, OSError) as error:
             raise self._died(index) from error
-        if status == "error":
-            error, text = payload
-            raise error from RemoteWorkerError(text)
-        return payload
+        return reply_payload(reply)
 
     def _died(self, index: int) -> WorkerDiedError:
         """The error for worker ``index`` having ended without answering."""

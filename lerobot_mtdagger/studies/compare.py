@@ -11,7 +11,7 @@ options, in its own folder under the compare folder::
 
 BC budgets are expert demos per task. The default is the cumulative demos per task of DAgger after
 each round (``initial_demos + k * budget_per_task``, k = 0..rounds), so BC has a point at every x
-where DAgger has one; BC at the budget of round k is ``run --mode=bc --rounds=k``, which also
+where DAgger has one; BC at the budget of round k is ``run --mode=bc --dagger.rounds=k``, which also
 trains it by the same rule as DAgger's phase k (``RunConfig.phase_steps``).
 
 Runs are independent processes (``--jobs`` at once, default one per core); each gets
@@ -19,7 +19,7 @@ Runs are independent processes (``--jobs`` at once, default one per core); each 
 finished run is skipped, a cut-off run is resumed (``--resume=true``), so ``compare`` itself resumes.
 A run started by ``compare`` ends itself within a second of ``compare`` ending (``follow_parent``), so a
 ``compare`` that is killed leaves no run writing on into its folder.
-Asked again with more ``--rounds``, it extends the finished DAgger runs by the new rounds and adds BC
+Asked again with more ``--dagger.rounds``, it extends the finished DAgger runs by the new rounds and adds BC
 at the new budgets; the rounds already made are kept as they are.
 """
 
@@ -29,26 +29,23 @@ import json
 import logging
 import os
 import signal
-import subprocess
-import sys
 import threading
 import time
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from lerobot_mtdagger.runner.configs import RunConfig, default_worker_count
 from lerobot_mtdagger.scheduler import scheduling_methods
+from lerobot_mtdagger.studies.launchers import PARENT_PID_ENV, Job, RayRunPool, RunPool
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
+from lerobot_mtdagger.utils.ray_session import import_ray
 
 logger = logging.getLogger(__name__)
 
 RUNS_DIR = "runs"
 COMPARE_FILE = "compare.json"
-PARENT_PID_ENV = "LEROBOT_MTDAGGER_PARENT_PID"
-"""Set by ``compare`` in each run's environment: the process id the run must not outlive."""
 PARENT_POLL_S = 0.5
 
 
@@ -60,8 +57,16 @@ class CompareConfig:
         methods: Scheduling methods and ``bc``.
         seeds: Seeds; every method runs every seed.
         bc_budgets: BC expert demos per task (empty: DAgger's cumulative demos after each round).
-        jobs: Runs at once (None: one per core).
-        output_dir: The compare folder.
+        jobs: Runs at once with ``launcher=local`` (None: one per core).
+        output_dir: The compare folder (on storage every Ray node sees, with ``launcher=ray``).
+        launcher: ``local`` (each run a process on this machine) or ``ray`` (each run a Ray task
+            on the cluster at ``ray_address``, ``studies/launchers.py``).
+        ray_address: The Ray cluster of ``launcher=ray`` (``auto``: the one ``ray start`` left on
+            this machine; ``ray://host:10001``; None: start a local Ray).
+        ray_cpus_per_run: CPUs each run holds with ``launcher=ray`` (its torch threads, and from 2
+            its env workers).
+        ray_gpus_per_run: GPUs each run holds with ``launcher=ray`` (0: none; pass
+            ``--policy.device=cuda`` for the runs to use them).
     """
 
     methods: list[str] = field(default_factory=lambda: ["bc", "uniform", "need", "gain"])
@@ -69,15 +74,25 @@ class CompareConfig:
     bc_budgets: list[int] = field(default_factory=list)
     jobs: int | None = None
     output_dir: Path = Path("outputs/compare")
+    launcher: str = "local"
+    ray_address: str | None = None
+    ray_cpus_per_run: int = 1
+    ray_gpus_per_run: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.launcher not in LAUNCHERS:
+            raise ValueError(f"launcher must be one of {list(LAUNCHERS)}, got {self.launcher!r}.")
+        if self.ray_cpus_per_run < 1 or self.ray_gpus_per_run < 0:
+            raise ValueError(
+                f"ray_cpus_per_run must be >= 1 and ray_gpus_per_run >= 0, got {self.ray_cpus_per_run}, "
+                f"{self.ray_gpus_per_run}."
+            )
+        if self.launcher == "ray":
+            import_ray()  # refuses a missing Ray before anything runs
 
 
-@dataclass(frozen=True)
-class Job:
-    """One run of the comparison."""
-
-    name: str
-    args: tuple[str, ...]
-    last_phase: int
+LAUNCHERS: tuple[str, ...] = ("local", "ray")
+"""``local``: runs as processes on this machine; ``ray``: runs as Ray tasks on a Ray cluster."""
 
 
 def split_arguments(argv: Sequence[str]) -> tuple[list[str], list[str]]:
@@ -102,22 +117,23 @@ def base_run_config(run_args: Sequence[str]) -> RunConfig:
 
 
 def bc_rounds_for(config: RunConfig, budgets: Sequence[int], num_tasks: int) -> dict[int, int]:
-    """BC budget (demos per task) -> the ``--rounds`` that gives it.
+    """BC budget (demos per task) -> the ``--dagger.rounds`` that gives it.
 
     Raises:
         ValueError: On a budget that no whole number of rounds gives.
     """
-    per_round = config.budget_for(num_tasks) / num_tasks
+    dagger = config.dagger
+    per_round = dagger.budget_for(num_tasks) / num_tasks
     if not budgets:
-        return {int(config.initial_demos + k * per_round): k for k in range(config.rounds + 1)}
+        return {int(dagger.initial_demos + k * per_round): k for k in range(dagger.rounds + 1)}
     mapping = {}
     for budget in budgets:
-        k = (budget - config.initial_demos) / per_round
+        k = (budget - dagger.initial_demos) / per_round
         if k < 0 or k != int(k):
-            valid = [int(config.initial_demos + j * per_round) for j in range(config.rounds + 4)]
+            valid = [int(dagger.initial_demos + j * per_round) for j in range(dagger.rounds + 4)]
             raise UserError(
                 f"BC budget {budget} demos per task is not initial_demos + k * budget per task "
-                f"({config.initial_demos} + k * {per_round:g}); choose among {valid}..."
+                f"({dagger.initial_demos} + k * {per_round:g}); choose among {valid}..."
             )
         mapping[int(budget)] = int(k)
     return mapping
@@ -132,29 +148,13 @@ def jobs_for(compare: CompareConfig, run_args: Sequence[str], num_tasks: int) ->
             if method != "bc":
                 name = f"{method}-seed{seed}"
                 args = (*run_args, f"--scheduler.type={method}", f"--seed={seed}")
-                jobs.append(Job(name, args, last_phase=config.rounds))
+                jobs.append(Job(name, args, last_phase=config.dagger.rounds))
                 continue
             for budget, rounds in sorted(bc_rounds_for(config, compare.bc_budgets, num_tasks).items()):
                 name = f"bc-{budget}demos-seed{seed}"
-                args = (*run_args, "--mode=bc", f"--rounds={rounds}", f"--seed={seed}")
+                args = (*run_args, "--mode=bc", f"--dagger.rounds={rounds}", f"--seed={seed}")
                 jobs.append(Job(name, args, last_phase=0))
     return jobs
-
-
-def is_finished(folder: Path, last_phase: int) -> bool:
-    """Whether the run in ``folder`` committed its training phases up to ``last_phase``.
-
-    A DAgger run finished at fewer rounds than asked is not: resuming it with more ``--rounds``
-    extends it (``ExperimentDir.check_resumable``).
-    """
-    from lerobot_mtdagger.datasets.rounds import (  # LeRobot: loaded only when needed
-        CONFIG_FILE,
-        ExperimentDir,
-    )
-
-    if not (folder / CONFIG_FILE).exists():
-        return False
-    return last_phase in ExperimentDir(folder).committed_phases()
 
 
 def runs_not_started(compare_dir: Path) -> list[str]:
@@ -173,118 +173,6 @@ def runs_not_started(compare_dir: Path) -> list[str]:
     except (json.JSONDecodeError, KeyError, TypeError) as error:
         raise UserError(f"{path} is not a compare plan ({error!r}); rerun compare to rewrite it.") from None
     return [name for name in jobs if not (Path(compare_dir) / RUNS_DIR / name).is_dir()]
-
-
-def job_command(job: Job, folder: Path, threads: int, workers: int) -> tuple[list[str], dict[str, str]]:
-    """The command line and environment of one job's ``lerobot-mtdagger run`` (resumed if started)."""
-    from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
-
-    resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []
-    command = [
-        sys.executable,
-        "-m",
-        "lerobot_mtdagger.cli",
-        "run",
-        *job.args,
-        f"--output_dir={folder}",
-        f"--workers={workers}",
-        "--progress=false",
-        *resume,
-    ]
-    env = {
-        **os.environ,
-        "OMP_NUM_THREADS": str(threads),
-        "MKL_NUM_THREADS": str(threads),
-        PARENT_PID_ENV: str(os.getpid()),
-    }
-    return command, env
-
-
-class RunPool:
-    """The runs of one ``compare``, ``parallel`` at once, each in its own process.
-
-    One failed run stops none of the others. An interrupt (Ctrl-C, or any exception in the waiting
-    thread) starts no further run and ends the running ones, which the next ``compare`` resumes.
-    """
-
-    def __init__(self, runs_dir: Path, parallel: int, threads: int, workers: int) -> None:
-        """Prepares the pool; nothing runs before ``run_all``.
-
-        Args:
-            runs_dir: The compare folder's ``runs/``.
-            parallel: Runs at once.
-            threads: Torch threads per run.
-            workers: Env worker processes per run.
-        """
-        self.runs_dir = runs_dir
-        self.parallel = parallel
-        self.threads = threads
-        self.workers = workers
-        self._lock = threading.Lock()
-        self._live: set[subprocess.Popen] = set()
-        self._stopping = False
-
-    def run_all(self, jobs: Sequence[Job]) -> list[Path]:
-        """Runs (or resumes, or skips) every job; returns the run folders in the order of ``jobs``.
-
-        Raises:
-            UserError: Once every job has ended, if any run failed; each failed run and its log are named.
-        """
-        executor = ThreadPoolExecutor(max_workers=self.parallel)
-        futures = [executor.submit(self.run_one, job) for job in jobs]
-        try:
-            wait(futures)
-        except BaseException:
-            executor.shutdown(wait=False, cancel_futures=True)
-            self._end_running()
-            raise
-        finally:
-            executor.shutdown(wait=True)
-        errors = [future.exception() for future in futures if future.exception() is not None]
-        for error in errors:
-            if not isinstance(error, UserError):
-                raise error  # a fault of this code rather than of one run: keep its traceback
-        if errors:
-            raise UserError(
-                f"{len(errors)} of {len(jobs)} runs failed; the others finished. Fix the cause and run the "
-                "same compare again to resume: " + " ".join(str(error) for error in errors)
-            )
-        return [future.result() for future in futures]
-
-    def run_one(self, job: Job) -> Path:
-        """Runs (or resumes, or skips) one job in its own process; returns its folder.
-
-        Raises:
-            UserError: If the run fails, or the pool was interrupted before it started (its log is named).
-        """
-        folder = self.runs_dir / job.name
-        if is_finished(folder, job.last_phase):
-            logger.info("%s: finished, skipped", job.name)
-            return folder
-        command, env = job_command(job, folder, self.threads, self.workers)
-        log_path = self.runs_dir / f"{job.name}.log"
-        with log_path.open("a") as log:
-            with self._lock:
-                if self._stopping:
-                    raise UserError(f"Run {job.name} not started: compare was interrupted.")
-                process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env)
-                self._live.add(process)
-            try:
-                returncode = process.wait()
-            finally:
-                with self._lock:
-                    self._live.discard(process)
-        if returncode != 0:
-            raise UserError(f"Run {job.name} failed (exit {returncode}); see {log_path}.")
-        return folder
-
-    def _end_running(self) -> None:
-        """Starts no further run and ends (SIGTERM) every running one."""
-        with self._lock:
-            self._stopping = True
-            for process in self._live:
-                process.terminate()
-        logger.warning("compare interrupted: no further run starts; the running ones were ended.")
 
 
 def follow_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread | None:
@@ -340,7 +228,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.studies.results import check_comparable, results_rows, write_results
 
-    task_names = suite_from_config(base_run_config(run_args)).task_names
+    task_names = suite_from_config(base_run_config(run_args).suite).task_names
     jobs = jobs_for(compare_config, run_args, len(task_names))
     cores = default_worker_count()
     parallel = compare_config.jobs or cores
@@ -359,7 +247,16 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
             indent=1,
         )
     )
-    folders = RunPool(runs_dir, parallel, threads, workers).run_all(jobs)
+    if compare_config.launcher == "ray":
+        pool = RayRunPool(
+            runs_dir,
+            compare_config.ray_cpus_per_run,
+            compare_config.ray_gpus_per_run,
+            compare_config.ray_address,
+        )
+    else:
+        pool = RunPool(runs_dir, parallel, threads, workers)
+    folders = pool.run_all(jobs)
     rows = results_rows(folders)
     write_results(rows, compare_config.output_dir, task_names, configs=check_comparable(folders))
     return rows

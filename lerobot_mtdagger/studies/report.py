@@ -88,8 +88,8 @@ def average_runs(runs: Sequence[RunPoints]) -> list[CurvePoint]:
     if not curves:
         raise UserError(
             f"None of the {len(runs)} experiment(s) has an evaluated phase (they ran with "
-            "--eval_episodes=0?): evaluate their policies with `lerobot-mtdagger eval` or rerun them "
-            "with --eval_episodes > 0."
+            "--rollout.eval_episodes=0?): evaluate their policies with `lerobot-mtdagger eval` or rerun them "
+            "with --rollout.eval_episodes > 0."
         )
     return curves
 

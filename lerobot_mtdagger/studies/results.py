@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import pyarrow.parquet as pq
 
+from lerobot_mtdagger.datasets.config_layout import flatten, migrate_run_config, option
 from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, ExperimentDir
 from lerobot_mtdagger.studies.report import CurvePoint, RunPoints, average_runs, curve_name
 from lerobot_mtdagger.utils.errors import UserError
@@ -115,7 +116,7 @@ def _row(
         "expert_frames_per_task": frames.tolist(),
         "eval_success_mean": float(phase.eval_mean),
         "eval_success": [float(s) for s in phase.eval["success"]],
-        "eval_episodes_per_task": int(config.get("eval_episodes") or 0),
+        "eval_episodes_per_task": int(option(config, "rollout.eval_episodes") or 0),
         # The signals the scheduler saw after this phase (they decide round k+1's allocation).
         "metric": following.metric if following is not None else None,
         "kalman_p": following.kalman_posterior.get("p") if following is not None else None,
@@ -337,12 +338,21 @@ def _read_json(path: Path) -> Any:
 # -------------------------------------------------------------------------------------------------
 
 
-PER_RUN_FIELDS = ("seed", "output_dir", "resume", "progress", "workers")
-"""Config fields that may differ between the runs of one method (they never change a result, or are
-what the runs are repeated over)."""
+PER_RUN_FIELDS = (
+    "seed",
+    "output_dir",
+    "resume",
+    "progress",
+    "rollout.workers",
+    "rollout.worker_backend",
+    "rollout.ray_address",
+)
+"""Options (dotted paths) that may differ between the runs of one method (they never change a
+result, or are what the runs are repeated over)."""
 
-BC_BUDGET_FIELDS = ("rounds", "scheduler")
-"""Fields that may also differ between BC runs: the budget (``rounds``) and the unused scheduler."""
+BC_BUDGET_FIELDS = ("dagger.rounds", "scheduler")
+"""Options that may also differ between BC runs: the budget (``dagger.rounds``) and the unused
+scheduler (every ``scheduler.*`` option)."""
 
 
 @dataclass(frozen=True)
@@ -381,9 +391,9 @@ def run_progress(root: Path) -> RunProgress:
     path = Path(root) / CONFIG_FILE
     if not path.is_file():
         raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
-    config = json.loads(path.read_text())
     experiment = ExperimentDir(root)
-    last_phase = 0 if config.get("mode") == "bc" else int(config.get("rounds") or 0)
+    config = experiment.read_config()
+    last_phase = 0 if config.get("mode") == "bc" else int(option(config, "dagger.rounds") or 0)
     return RunProgress(
         root=Path(root),
         rounds=len(experiment.committed_rounds()),
@@ -435,7 +445,7 @@ def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = 
     ``labels`` is grouped under that label, not under its method.
 
     Returns:
-        The config each method's runs share (without those fields), by method name.
+        The options each method's runs share (by dotted path, without those fields), by method name.
 
     Raises:
         ValueError: Naming the method, the differing fields with their values and two such runs.
@@ -446,11 +456,15 @@ def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = 
         path = root / CONFIG_FILE
         if not path.is_file():
             raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
-        config = json.loads(path.read_text())
+        config = ExperimentDir(root).read_config()
         is_bc = config.get("mode") == "bc"
-        method = (labels or {}).get(root) or ("bc" if is_bc else config.get("scheduler", {}).get("type"))
+        method = (labels or {}).get(root) or ("bc" if is_bc else option(config, "scheduler.type"))
         ignored = PER_RUN_FIELDS + (BC_BUDGET_FIELDS if is_bc else ())
-        shared = {key: value for key, value in config.items() if key not in ignored}
+        shared = {
+            key: value
+            for key, value in flatten(config).items()
+            if not any(key == name or key.startswith(f"{name}.") for name in ignored)
+        }
         if method not in first_of_method:
             first_of_method[method] = (root, shared)
             continue
@@ -466,6 +480,10 @@ def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = 
 
 
 def config_differences(first: Mapping, second: Mapping) -> str:
-    """``"key: a vs b, ..."`` for every top-level key whose value differs (empty when none does)."""
+    """``"option: a vs b, ..."`` for every option whose value differs (empty when none does).
+
+    Either config may be nested, flat by dotted path or stored before the options were grouped.
+    """
+    first, second = (flatten(migrate_run_config(config)) for config in (first, second))
     differing = sorted(key for key in set(first) | set(second) if first.get(key) != second.get(key))
     return ", ".join(f"{key}: {first.get(key)!r} vs {second.get(key)!r}" for key in differing)

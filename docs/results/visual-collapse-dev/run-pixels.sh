@@ -6,10 +6,11 @@
 #   git worktree add --detach ../study-code-pixels 868b86d; cd ../study-code-pixels
 #   ln -sf ../main/.venv .venv && ln -sfn ../main/outputs outputs
 #   OMP_NUM_THREADS=1 nohup nice -n 10 bash ../main/docs/results/visual-collapse-dev/run-pixels.sh SEED >> outputs/pixels-dev.log 2>&1 &
+# A variant: NAME=pixels-balanced ... run-pixels.sh SEED --sampling=balanced (written to outputs/visual-dev/NAME-seedSEED).
 set -euo pipefail
 SEED=$1
 shift
-OUT="outputs/visual-dev/pixels-seed$SEED"
+OUT="outputs/visual-dev/${NAME:-pixels}-seed$SEED"
 RESUME=false
 [ -d "$OUT" ] && RESUME=true
 .venv/bin/lerobot-mtdagger run --suite=metaworld-mt10 --obs_mode=rgb --scheduler.type=need \

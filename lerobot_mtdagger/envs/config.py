@@ -1,0 +1,80 @@
+"""``SuiteConfig``: the suite and its observations, one config for every command that builds a suite.
+
+``lerobot-mtdagger run`` (``--suite.name=drawers --suite.obs_mode=pointcloud``), ``eval`` and
+``shift`` (the same spellings) and LeRobot's env plugin (``--env.suite.name=...``) hold one
+``SuiteConfig`` and build their suite from it with ``suite_from_config``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from lerobot_mtdagger.envs.drawers.variants import DEFAULT_PLACEMENT, PLACEMENTS
+from lerobot_mtdagger.utils.errors import UserError
+
+DEFAULT_NUM_POINTS = 1024
+DEFAULT_IMAGE_SIZE = 84
+DRAWERS = "drawers"
+
+
+@dataclass
+class SuiteConfig:
+    """A task suite and its observations.
+
+    Attributes:
+        name: Suite name (``make_suite``: ``metaworld-mt10``, ``drawers``, ``toy``, ...). None: the
+            command's default (``run``: the preset's).
+        tasks: Subset of the suite's tasks (all when empty; ``eval`` and ``shift`` also take
+            ``heldout``: the suite's unseen tasks).
+        obs_mode: ``state``, ``rgb`` or ``pointcloud``. None: the command's default (``run``: the
+            preset's; ``eval``: what the policy was trained on).
+        num_points: Points per cloud (pointcloud mode). None: 1 024 (``eval``: the policy's).
+        image_size: Image side (rgb mode). None: 84 (``eval``: the policy's).
+        mesh_detail: Share of the faces of the arm's meshes the observation renderer keeps, in
+            (0, 1] (rgb and pointcloud modes; 1: the exact model). 0.2 renders about twice as fast
+            on a CPU and changes only the arm's silhouette by millimetres (``docs/benchmarks.md``).
+        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when
+            None; ``narrow``: the suite's first ranges). Refused for other suites.
+        episode_length: Steps after which an episode is truncated (None: each task's own horizon).
+    """
+
+    name: str | None = None
+    tasks: list[str] = field(default_factory=list)
+    obs_mode: str | None = None
+    num_points: int | None = None
+    image_size: int | None = None
+    mesh_detail: float = 1.0
+    placement: str | None = None
+    episode_length: int | None = None
+
+    def check(self) -> None:
+        """Refuses options that cannot name a suite, before anything runs.
+
+        Raises:
+            UserError: One line naming the option and its fix.
+        """
+        if self.placement is not None and self.name != DRAWERS:
+            raise UserError(f"suite.placement applies to the drawers suite only; drop it for {self.name!r}.")
+        if self.placement is not None and self.placement not in PLACEMENTS:
+            raise UserError(
+                f"Unknown drawer placement {self.placement!r}; choose --suite.placement from "
+                f"{sorted(PLACEMENTS)}."
+            )
+        for name in ("num_points", "image_size", "episode_length"):
+            value = getattr(self, name)
+            if value is not None and value <= 0:
+                raise UserError(f"suite.{name} must be > 0, got {value}.")
+        if not 0.0 < self.mesh_detail <= 1.0:
+            raise UserError(f"suite.mesh_detail must be in (0, 1], got {self.mesh_detail}.")
+
+    def fill_defaults(self) -> None:
+        """Gives unset observation options their defaults (a run stores them resolved).
+
+        ``num_points`` 1 024, ``image_size`` 84 and, for the drawers, ``placement`` ``kitchen``.
+        """
+        if self.num_points is None:
+            self.num_points = DEFAULT_NUM_POINTS
+        if self.image_size is None:
+            self.image_size = DEFAULT_IMAGE_SIZE
+        if self.name == DRAWERS and self.placement is None:
+            self.placement = DEFAULT_PLACEMENT

@@ -1,0 +1,152 @@
+"""Env workers as Ray actors (``--rollout.worker_backend=ray``): a run's simulators on a Ray cluster.
+
+``RayEnvWorkers`` is ``EnvWorkers`` with each worker a Ray actor instead of a forked process: the
+same ``RolloutWorker`` answers the same commands (``answer``), the main process keeps the policy and
+batches it over the same lanes, and every episode depends only on its seeds and the learner's
+actions, so a run gives the same rounds and evaluations on either backend, at any worker count.
+Actors are spread over the cluster's nodes (Ray's ``SPREAD`` strategy), one CPU each.
+
+The suite travels to each actor pickled (cloudpickle); an expert registered with ``register_expert``
+in the main process does not travel with it (the actor's process has its own registry): give such
+experts with ``suite.with_experts(...)`` or register them in a module the actors import.
+
+An actor that dies (its process killed, its node lost) raises ``WorkerDiedError`` naming the actor
+and its node on the next reply; nothing of the running round is committed, and ``--resume=true``
+continues from the last committed round.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+from collections import deque
+from typing import Any
+
+from lerobot_mtdagger.envs.base import TaskSuite
+from lerobot_mtdagger.runner.workers import (
+    EnvWorkers,
+    RolloutWorker,
+    WorkerDiedError,
+    answer,
+    reply_payload,
+)
+from lerobot_mtdagger.utils.ray_session import connect
+
+logger = logging.getLogger(__name__)
+
+
+class RolloutActor:
+    """A ``RolloutWorker`` in a Ray actor (the class is wrapped by ``ray.remote`` on first use)."""
+
+    def __init__(self, suite: TaskSuite) -> None:
+        """Holds the suite's envs on this actor (one torch thread: the policy runs in the main process)."""
+        import torch
+
+        torch.set_num_threads(1)
+        self.worker = RolloutWorker(suite)
+
+    def where(self) -> str:
+        """``host (node <id>):pid`` of this actor's process."""
+        import ray
+
+        node = ray.get_runtime_context().get_node_id()[:8]
+        return f"{socket.gethostname()} (node {node}):{os.getpid()}"
+
+    def handle(self, command: tuple[str, Any]) -> tuple[str, Any]:
+        """The worker's ``answer`` to one command."""
+        return answer(self.worker, command)
+
+    def close(self) -> None:
+        """Closes every env."""
+        self.worker.close()
+
+
+class _ActorConnection:
+    """One actor seen as a pipe: ``send`` submits a command, ``recv`` waits for the oldest reply.
+
+    Several commands may be in flight (rollouts pipeline two groups of episodes); an actor runs one
+    caller's calls in the order they were made, so replies come back in order, as through a pipe.
+    """
+
+    def __init__(self, ray: Any, actor: Any) -> None:
+        self.ray = ray
+        self.actor = actor
+        self.pending: deque[Any] = deque()
+
+    def send(self, command: tuple[str, Any]) -> None:
+        self.pending.append(self.actor.handle.remote(command))
+
+    def recv(self) -> tuple[str, Any]:
+        return self.ray.get(self.pending.popleft())
+
+
+class RayEnvWorkers(EnvWorkers):
+    """``EnvWorkers`` whose ``workers`` are Ray actors on the cluster at ``address`` (None: local Ray)."""
+
+    def __init__(self, suite: TaskSuite, workers: int, address: str | None = None) -> None:
+        """Starts ``workers`` actors (at least one) and waits until each holds the suite.
+
+        Raises:
+            UserError: If Ray is missing or there is no cluster at ``address``.
+        """
+        self._ray = connect(address)
+        self._places: list[str] = []
+        super().__init__(suite, max(workers, 1))
+
+    def _start_processes(self, workers: int) -> None:
+        ray = self._ray
+        actor_class = ray.remote(num_cpus=1, max_restarts=0, scheduling_strategy="SPREAD")(RolloutActor)
+        suite = ray.put(self.suite)
+        actors = [actor_class.remote(suite) for _ in range(workers)]
+        self._places = ray.get([actor.where.remote() for actor in actors])
+        self._processes = actors
+        self._connections = [_ActorConnection(ray, actor) for actor in actors]
+        logger.info("started %d env worker actors: %s", workers, self._places)
+
+    def _receive(self, index: int) -> Any:
+        """The reply of actor ``index``.
+
+        Raises:
+            WorkerDiedError: If the actor (or its node) is gone.
+            Exception: The worker's own exception, with its traceback as the cause.
+        """
+        exceptions = self._ray.exceptions
+        try:
+            reply = self._connections[index].recv()
+        except (exceptions.RayActorError, exceptions.ObjectLostError) as error:
+            raise self._died(index) from error
+        return reply_payload(reply)
+
+    def _died(self, index: int) -> WorkerDiedError:
+        """The error for actor ``index`` having gone without answering."""
+        return WorkerDiedError(
+            f"Env worker {index} (Ray actor on {self._places[index]}) died (killed, out of memory, or "
+            "its node was lost); nothing of the running round was committed. Rerun with --resume=true "
+            "to continue from the last committed round."
+        )
+
+    def close(self) -> None:
+        """Closes every actor's envs and ends the actors."""
+        ray = self._ray
+        closing = []
+        for actor in self._processes:
+            try:
+                closing.append(actor.close.remote())
+            except ray.exceptions.RayActorError:
+                logger.debug("env worker actor already gone")
+        if closing:
+            ray.wait(closing, num_returns=len(closing), timeout=10.0)
+        for actor in self._processes:
+            ray.kill(actor)
+        self._processes.clear()
+        self._connections.clear()
+
+
+def make_env_workers(
+    suite: TaskSuite, workers: int, backend: str = "local", address: str | None = None
+) -> EnvWorkers:
+    """The env workers of a run on ``backend`` (``local`` or ``ray``)."""
+    if backend == "ray":
+        return RayEnvWorkers(suite, workers, address)
+    return EnvWorkers(suite, workers)

@@ -1,0 +1,254 @@
+"""Launchers of a ``compare`` grid: each planned run as a process on this machine, or as a Ray task.
+
+``RunPool`` (``--launcher=local``, the default) runs ``--jobs`` runs at once, each a
+``lerobot-mtdagger run`` process; ``RayRunPool`` (``--launcher=ray``) runs each as a Ray task holding
+its share of a cluster's CPUs (and GPUs), the same command in the same folder. Both skip finished
+runs, resume cut-off ones, let one failed run stop none of the others, and on Ctrl-C start no
+further run and end the running ones (which the next ``compare`` resumes).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import subprocess
+import sys
+import threading
+from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor, wait
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.ray_session import connect
+
+logger = logging.getLogger(__name__)
+
+PARENT_PID_ENV = "LEROBOT_MTDAGGER_PARENT_PID"
+"""Set by ``compare`` in each run's environment: the process id the run must not outlive."""
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run of the comparison."""
+
+    name: str
+    args: tuple[str, ...]
+    last_phase: int
+
+
+def is_finished(folder: Path, last_phase: int) -> bool:
+    """Whether the run in ``folder`` committed its training phases up to ``last_phase``.
+
+    A DAgger run finished at fewer rounds than asked is not: resuming it with more ``--dagger.rounds``
+    extends it (``ExperimentDir.check_resumable``).
+    """
+    from lerobot_mtdagger.datasets.rounds import (  # LeRobot: loaded only when needed
+        CONFIG_FILE,
+        ExperimentDir,
+    )
+
+    if not (folder / CONFIG_FILE).exists():
+        return False
+    return last_phase in ExperimentDir(folder).committed_phases()
+
+
+def job_command(job: Job, folder: Path, threads: int, workers: int) -> tuple[list[str], dict[str, str]]:
+    """One job's ``lerobot-mtdagger run`` command (resumed if started) and its environment variables.
+
+    The variables are the thread counts; the pid the run must not outlive is the launcher's to add.
+    """
+    from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
+
+    resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []
+    command = [
+        sys.executable,
+        "-m",
+        "lerobot_mtdagger.cli",
+        "run",
+        *job.args,
+        f"--output_dir={folder}",
+        f"--rollout.workers={workers}",
+        "--progress=false",
+        *resume,
+    ]
+    return command, {"OMP_NUM_THREADS": str(threads), "MKL_NUM_THREADS": str(threads)}
+
+
+class RunPool:
+    """The runs of one ``compare``, ``parallel`` at once, each in its own process.
+
+    One failed run stops none of the others. An interrupt (Ctrl-C, or any exception in the waiting
+    thread) starts no further run and ends the running ones, which the next ``compare`` resumes.
+    """
+
+    def __init__(self, runs_dir: Path, parallel: int, threads: int, workers: int) -> None:
+        """Prepares the pool; nothing runs before ``run_all``.
+
+        Args:
+            runs_dir: The compare folder's ``runs/``.
+            parallel: Runs at once.
+            threads: Torch threads per run.
+            workers: Env worker processes per run.
+        """
+        self.runs_dir = runs_dir
+        self.parallel = parallel
+        self.threads = threads
+        self.workers = workers
+        self._lock = threading.Lock()
+        self._live: set[subprocess.Popen] = set()
+        self._stopping = False
+
+    def run_all(self, jobs: Sequence[Job]) -> list[Path]:
+        """Runs (or resumes, or skips) every job; returns the run folders in the order of ``jobs``.
+
+        Raises:
+            UserError: Once every job has ended, if any run failed; each failed run and its log are named.
+        """
+        executor = ThreadPoolExecutor(max_workers=self.parallel)
+        futures = [executor.submit(self.run_one, job) for job in jobs]
+        try:
+            wait(futures)
+        except BaseException:
+            executor.shutdown(wait=False, cancel_futures=True)
+            self._end_running()
+            raise
+        finally:
+            executor.shutdown(wait=True)
+        errors = [future.exception() for future in futures if future.exception() is not None]
+        for error in errors:
+            if not isinstance(error, UserError):
+                raise error  # a fault of this code rather than of one run: keep its traceback
+        if errors:
+            raise UserError(
+                f"{len(errors)} of {len(jobs)} runs failed; the others finished. Fix the cause and run the "
+                "same compare again to resume: " + " ".join(str(error) for error in errors)
+            )
+        return [future.result() for future in futures]
+
+    def run_one(self, job: Job) -> Path:
+        """Runs (or resumes, or skips) one job in its own process; returns its folder.
+
+        Raises:
+            UserError: If the run fails, or the pool was interrupted before it started (its log is named).
+        """
+        folder = self.runs_dir / job.name
+        if is_finished(folder, job.last_phase):
+            logger.info("%s: finished, skipped", job.name)
+            return folder
+        command, variables = job_command(job, folder, self.threads, self.workers)
+        env = {**os.environ, **variables, PARENT_PID_ENV: str(os.getpid())}
+        log_path = self.runs_dir / f"{job.name}.log"
+        with log_path.open("a") as log:
+            with self._lock:
+                if self._stopping:
+                    raise UserError(f"Run {job.name} not started: compare was interrupted.")
+                process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env)
+                self._live.add(process)
+            try:
+                returncode = process.wait()
+            finally:
+                with self._lock:
+                    self._live.discard(process)
+        if returncode != 0:
+            raise UserError(f"Run {job.name} failed (exit {returncode}); see {log_path}.")
+        return folder
+
+    def _end_running(self) -> None:
+        """Starts no further run and ends (SIGTERM) every running one."""
+        with self._lock:
+            self._stopping = True
+            for process in self._live:
+                process.terminate()
+        logger.warning("compare interrupted: no further run starts; the running ones were ended.")
+
+
+def run_job_process(command: list[str], variables: dict[str, str], log_path: str) -> int:
+    """Runs one job's command to its end, its output appended to ``log_path``; returns its exit code.
+
+    The body of a ``RayRunPool`` task, on whichever node holds it: the run inherits that node's
+    environment plus ``variables``, and ends with this process (``follow_parent``), so a cancelled
+    or lost task leaves no run behind.
+    """
+    env = {**os.environ, **variables, PARENT_PID_ENV: str(os.getpid())}
+    with open(log_path, "a") as log:
+        process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env)
+        try:
+            return process.wait()
+        finally:
+            if process.poll() is None:  # cancelled (KeyboardInterrupt in the task): end the run
+                process.terminate()
+                process.wait()
+
+
+class RayRunPool:
+    """The runs of one ``compare`` as Ray tasks, each holding ``cpus`` CPUs and ``gpus`` GPUs.
+
+    Ray runs as many at once as the cluster's resources allow. Every node must see the compare
+    folder at the same path (shared storage) and have this package installed at the same
+    interpreter path. One failed run stops none of the others; an interrupt cancels every task (the
+    running runs end and are resumed by the next ``compare``).
+    """
+
+    def __init__(self, runs_dir: Path, cpus: int, gpus: float, address: str | None) -> None:
+        """Joins (or starts) the Ray cluster; nothing runs before ``run_all``.
+
+        Args:
+            runs_dir: The compare folder's ``runs/``.
+            cpus: CPUs per run (its torch threads and, from 2, its env workers).
+            gpus: GPUs per run (0: none; a fraction shares one).
+            address: The Ray cluster (None: a local Ray on this machine).
+
+        Raises:
+            UserError: If Ray is missing or there is no cluster at ``address``.
+        """
+        self.runs_dir = runs_dir
+        self.cpus = cpus
+        self.gpus = gpus
+        self.ray = connect(address)
+
+    def run_all(self, jobs: Sequence[Job]) -> list[Path]:
+        """Runs (or resumes, or skips) every job; returns the run folders in the order of ``jobs``.
+
+        Raises:
+            UserError: Once every job has ended, if any run failed; each failed run and its log are named.
+        """
+        ray = self.ray
+        task = ray.remote(num_cpus=self.cpus, num_gpus=self.gpus, max_retries=0)(run_job_process)
+        workers = 0 if self.cpus < 2 else self.cpus
+        submitted: dict[Any, Job] = {}
+        for job in jobs:
+            folder = self.runs_dir / job.name
+            if is_finished(folder, job.last_phase):
+                logger.info("%s: finished, skipped", job.name)
+                continue
+            command, variables = job_command(job, folder, self.cpus, workers)
+            log_path = str(self.runs_dir / f"{job.name}.log")
+            submitted[task.remote(command, variables, log_path)] = job
+        try:
+            outcomes = [self._outcome(reference, job) for reference, job in submitted.items()]
+        except BaseException:
+            for reference in submitted:
+                ray.cancel(reference)
+            logger.warning("compare interrupted: the Ray tasks were cancelled; the running runs ended.")
+            raise
+        errors = [error for error in outcomes if error is not None]
+        if errors:
+            raise UserError(
+                f"{len(errors)} of {len(jobs)} runs failed; the others finished. Fix the cause and run the "
+                "same compare again to resume: " + " ".join(errors)
+            )
+        return [self.runs_dir / job.name for job in jobs]
+
+    def _outcome(self, reference: Any, job: Job) -> str | None:
+        """None when the run of ``job`` succeeded, else what went wrong (naming its log)."""
+        log_path = self.runs_dir / f"{job.name}.log"
+        try:
+            returncode = self.ray.get(reference)
+        except self.ray.exceptions.RayError as error:
+            kind = type(error).__name__
+            return f"Run {job.name} lost its Ray task ({kind}: node or worker gone?); see {log_path}."
+        if returncode != 0:
+            return f"Run {job.name} failed (exit {returncode}); see {log_path}."
+        return None

@@ -1,0 +1,66 @@
+"""Joining (or starting) a Ray cluster for ``compare --launcher=ray`` and ``--rollout.worker_backend=ray``.
+
+Ray is an optional dependency (``pip install -e ".[ray]"``). ``connect(address)`` joins the cluster at
+``address`` (``auto``: the one ``ray start`` left on this machine; ``ray://host:10001``: a Ray client)
+or, without one, starts a local Ray on this machine's cores. A process joins at most once; later calls
+reuse the connection.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from types import ModuleType
+
+from lerobot_mtdagger.utils.errors import UserError
+
+logger = logging.getLogger(__name__)
+
+RAY_MISSING = 'Ray is not installed: pip install -e ".[ray]" (or pip install "ray>=2.40,<3").'
+
+
+def import_ray() -> ModuleType:
+    """The ``ray`` module.
+
+    Raises:
+        UserError: If Ray is not installed, naming the install command.
+    """
+    try:
+        import ray
+    except ImportError:
+        raise UserError(RAY_MISSING) from None
+    return ray
+
+
+def connect(address: str | None) -> ModuleType:
+    """The ``ray`` module, connected to the cluster at ``address`` (None: a local Ray on this machine).
+
+    Raises:
+        UserError: If Ray is missing, or there is no cluster at ``address``.
+    """
+    ray = import_ray()
+    if ray.is_initialized():
+        return ray
+    options: dict = {"include_dashboard": False, "log_to_driver": False}
+    if address:
+        options["address"] = address
+    os.environ.setdefault("RAY_AUTH_MODE", "disabled")  # a local cluster of this user's processes
+    # Ray runs its workers at nice 15 unless told otherwise; a run or an env worker is the work itself
+    # (at 15 it starves beside any other job). Applies to a Ray this process starts; for a cluster
+    # started with `ray start`, export RAY_worker_niceness=0 there (docs/cluster.md).
+    os.environ.setdefault("RAY_worker_niceness", "0")
+    try:
+        ray.init(**options)
+    except ConnectionError as error:
+        raise UserError(
+            f"No Ray cluster at {address!r} ({error}): start one with `ray start --head`, or drop the "
+            "address to start a local Ray."
+        ) from None
+    resources = ray.cluster_resources()
+    logger.info(
+        "Ray: %d node(s), %g CPU(s), %g GPU(s)",
+        len(ray.nodes()),
+        resources.get("CPU", 0),
+        resources.get("GPU", 0),
+    )
+    return ray
