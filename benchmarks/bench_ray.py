@@ -132,6 +132,9 @@ def main() -> None:
         local.close()
         remote.close()
         if cluster is not None:
+            import ray
+
+            ray.shutdown()  # the driver leaves the cluster first, then its nodes go
             cluster.shutdown()
     medians = {name: statistics.median(values) for name, values in rates.items()}
     for name, value in medians.items():
