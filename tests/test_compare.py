@@ -105,7 +105,13 @@ def _compare_in_its_first_run(folder: Path, seeds: str) -> tuple[subprocess.Pope
     ]
     args = ["compare", "--methods=[need]", f"--seeds={seeds}", f"--output_dir={folder}", "--jobs=1", *longer]
     cli = str(Path(sys.executable).parent / "lerobot-mtdagger")
-    process = subprocess.Popen([cli, *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    process = subprocess.Popen(
+        [cli, *args],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        # A shell's background job ignores SIGINT, and so would compare: let it hear Ctrl-C.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     round_zero = folder / "runs" / "need-seed0" / "rounds" / "round-000"
     deadline = time.time() + 120
     while not round_zero.exists() and process.poll() is None and time.time() < deadline:
