@@ -88,6 +88,7 @@ def test_ray_env_workers_give_the_same_rounds_and_evaluations_as_local_ones(tmp_
     assert verify_experiment(ExperimentDir(tmp_path / "ray"))[2] == []
 
 
+@pytest.mark.slow  # CI runs it with the slow set
 def test_a_ray_actor_killed_mid_round_is_named_nothing_is_committed_and_resume_gives_the_same_run(
     tmp_path, monkeypatch
 ):
@@ -134,6 +135,7 @@ def results_without_timings(folder: Path) -> list[dict[str, str]]:
     return [{k: v for k, v in row.items() if k != "experiment" and not k.endswith("_s")} for row in rows]
 
 
+@pytest.mark.slow  # CI runs it with the slow set
 def test_compare_on_ray_writes_the_same_results_as_the_local_launcher_and_skips_finished_runs(tmp_path):
     grid = ["compare", "--methods=[need,bc]", "--seeds=[5]", *(a for a in TOY if not a.startswith("--seed"))]
     assert main([*grid, f"--output_dir={tmp_path / 'local'}", "--jobs=2"]) == 0
