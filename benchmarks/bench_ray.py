@@ -19,19 +19,17 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 
 import numpy as np
+from bench_collect import collect_rate, eval_rate  # the same round and evaluation, timed
 
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.policies import MTDAggerPolicy
-from lerobot_mtdagger.runner.collect import run_episodes
 from lerobot_mtdagger.runner.configs import PolicyOptions
-from lerobot_mtdagger.runner.evaluate import PolicyRunner, evaluate
+from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.ray_workers import RayEnvWorkers
 from lerobot_mtdagger.runner.train import build_processors, policy_config
 from lerobot_mtdagger.runner.workers import EnvWorkers
-from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
 TARGET = 0.8
 DRAWERS = ["drawer-bar-wide", "drawer-knob-large", "drawer-lip-wide"]
@@ -47,32 +45,6 @@ def untrained_runner(suite) -> PolicyRunner:
         stats[key] = {"mean": 0 * ones, "std": ones, "min": -ones, "max": ones}
     preprocessor, postprocessor = build_processors(config, stats)
     return PolicyRunner(MTDAggerPolicy(config), preprocessor, postprocessor)
-
-
-def collect(workers: EnvWorkers, runner, episodes: int, seed: int) -> tuple[float, list]:
-    """Recorded steps per second of one DAgger round of ``episodes`` per task, and its episodes."""
-    start = time.perf_counter()
-    result = run_episodes(
-        workers,
-        [episodes] * len(workers.suite.task_names),
-        policy=runner,
-        beta=0.0,
-        seed=seed,
-        round_index=1,
-        stream=COLLECT_STREAM,
-        record=True,
-        max_steps=None,
-        steps_after_success=10,
-        mixing="episode",
-    )
-    return sum(e.steps for e in result) / (time.perf_counter() - start), result
-
-
-def evaluation(workers: EnvWorkers, runner, episodes: int) -> float:
-    """Evaluation episodes per second."""
-    start = time.perf_counter()
-    evaluate(workers, runner, episodes, seed=0)
-    return episodes * len(workers.suite.task_names) / (time.perf_counter() - start)
 
 
 def same_episodes(first: list, second: list) -> bool:
@@ -119,15 +91,15 @@ def main() -> None:
     identical = True
     try:
         for pool in (local, remote):  # warm-up: every env built, every renderer initialised
-            collect(pool, runner, 1, seed=99)
+            collect_rate(pool, runner, 1, seed=99)
         for repeat in range(args.repeats):
-            local_rate, local_episodes = collect(local, runner, args.episodes, seed=repeat)
-            ray_rate, ray_episodes = collect(remote, runner, args.episodes, seed=repeat)
+            local_rate, local_episodes = collect_rate(local, runner, args.episodes, seed=repeat)
+            ray_rate, ray_episodes = collect_rate(remote, runner, args.episodes, seed=repeat)
             identical &= same_episodes(local_episodes, ray_episodes)
             rates["collect local"].append(local_rate)
             rates["collect ray"].append(ray_rate)
-            rates["eval local"].append(evaluation(local, runner, args.eval_episodes))
-            rates["eval ray"].append(evaluation(remote, runner, args.eval_episodes))
+            rates["eval local"].append(eval_rate(local, runner, args.eval_episodes))
+            rates["eval ray"].append(eval_rate(remote, runner, args.eval_episodes))
     finally:
         local.close()
         remote.close()
