@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import inspect
+import io
 import json
 import shutil
 from pathlib import Path
@@ -23,6 +26,7 @@ from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.runner.configs import PRESET_FIELDS, PRESETS, DAggerConfig, RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.studies.results import results_rows
+from lerobot_mtdagger.utils import parsing
 from lerobot_mtdagger.utils.errors import UserError
 
 
@@ -128,6 +132,26 @@ OLD_RUN_OPTIONS = [
     "--policy.task_embedding_dim=4",
 ]
 """``OLD_EXPERIMENT``'s options in today's spelling (its --rounds=1 aside)."""
+
+
+def help_text() -> str:
+    output = io.StringIO()
+    with contextlib.redirect_stdout(output), pytest.raises(SystemExit):
+        parse("--help")
+    return output.getvalue()
+
+
+def test_draccus_reads_each_config_class_source_once_and_the_help_is_unchanged(monkeypatch):
+    """Without the cache every parse of ``RunConfig`` re-read a class's module once per field (2-3 s)."""
+    read, getsource = [], inspect.getsource
+    monkeypatch.setattr(inspect, "getsource", lambda obj: read.append(obj) or getsource(obj))
+    parsing._class_source.cache_clear()
+    cached_help = help_text()
+    classes = [obj for obj in read if isinstance(obj, type)]
+    assert RunConfig in classes and len(classes) == len(set(classes)), classes  # once, not per field
+    assert any(cls.__name__ == "ACTConfigStudent" for cls in classes)  # no source: found out once too
+    monkeypatch.setattr(parsing.draccus_docstring, "inspect", inspect)  # draccus as it comes
+    assert help_text() == cached_help
 
 
 def test_the_run_config_has_at_most_twelve_top_level_options():
