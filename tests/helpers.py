@@ -1,4 +1,4 @@
-"""Helpers shared by tests that tamper with committed experiments."""
+"""Helpers shared by tests that tamper with committed experiments or kill runs."""
 
 from __future__ import annotations
 
@@ -18,3 +18,25 @@ def edit_round_record(round_root: Path, edit: Callable[[dict[str, Any]], None]) 
     info = json.loads(info_path.read_text())
     info["mtdagger"] = record
     info_path.write_text(json.dumps(info))
+
+
+def child_pids(pid: int) -> list[int]:
+    """Process ids whose parent is ``pid`` (Linux /proc)."""
+    children = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            children.append(int(stat.parent.name))
+    return children
+
+
+def is_running(pid: int) -> bool:
+    """Whether process ``pid`` exists and is not a zombie waiting to be reaped."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"

@@ -30,7 +30,7 @@ from lerobot_mtdagger.studies.compare import (
 )
 from lerobot_mtdagger.studies.figures import hardest_tasks, seed_reach
 from lerobot_mtdagger.studies.launchers import is_finished
-from tests.test_dagger import _children, _running
+from tests.helpers import child_pids, is_running
 
 TINY = [
     "--suite.name=toy",
@@ -117,38 +117,41 @@ def _compare_in_its_first_run(folder: Path, seeds: str) -> tuple[subprocess.Pope
     while not round_zero.exists() and process.poll() is None and time.time() < deadline:
         time.sleep(0.05)
     assert process.poll() is None, "compare ended before its first run had committed round 0"
-    runs = _children(process.pid)
+    runs = child_pids(process.pid)
     assert runs, "compare should have started its first run"
     return process, args, runs
 
 
+@pytest.mark.slow  # runs of subprocesses, about 45 s
 def test_a_killed_compare_leaves_no_run_writing_on_and_the_next_compare_finishes_it(tmp_path):
     """kill -9 of compare: its run (and the run's env workers) end within seconds; compare resumes it."""
     folder = tmp_path / "cmp"
     process, args, runs = _compare_in_its_first_run(folder, "[0]")
-    workers = [worker for run in runs for worker in _children(run)]
+    workers = [worker for run in runs for worker in child_pids(run)]
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
     for pids, seconds, what in ((runs, 3, "the run"), (workers, 20, "the run's env workers")):
         deadline = time.time() + seconds
-        while any(_running(pid) for pid in pids) and time.time() < deadline:
+        while any(is_running(pid) for pid in pids) and time.time() < deadline:
             time.sleep(0.1)
-        assert not any(_running(pid) for pid in pids), f"{what} outlived the compare that started it"
+        assert not any(is_running(pid) for pid in pids), f"{what} outlived the compare that started it"
     assert not is_finished(folder / "runs" / "need-seed0", 2)
     assert main(args) == 0
     assert is_finished(folder / "runs" / "need-seed0", 2)
     assert "has ended; ending this run" in (folder / "runs" / "need-seed0.log").read_text()
 
 
+@pytest.mark.slow  # a compare in a subprocess, about 25 s
 def test_ctrl_c_on_compare_ends_its_run_and_starts_no_other(tmp_path):
     folder = tmp_path / "cmp"
     process, _, runs = _compare_in_its_first_run(folder, "[0,1]")
     os.kill(process.pid, signal.SIGINT)  # to compare alone, not to its process group
     process.wait(timeout=20)
-    assert not any(_running(pid) for pid in runs), "the running run was not ended"
+    assert not any(is_running(pid) for pid in runs), "the running run was not ended"
     assert not (folder / "runs" / "need-seed1").exists(), "a queued run started after the interrupt"
 
 
+@pytest.mark.slow  # two runs in subprocesses, about 35 s
 def test_one_failed_run_stops_none_of_the_runs_queued_after_it(tmp_path, capsys):
     folder = tmp_path / "cmp"
     blocked = folder / "runs" / "bc-1demos-seed0"

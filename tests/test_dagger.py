@@ -25,7 +25,7 @@ from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.utils.errors import UserError
 from tests.conftest import lerobot_train
-from tests.helpers import edit_round_record
+from tests.helpers import child_pids, edit_round_record, is_running
 
 TASKS = ["reach-v3", "button-press-topdown-v3", "push-v3"]
 TINY = [
@@ -302,28 +302,6 @@ def _cli(output_dir: Path, *extra: str) -> list[str]:
     ]
 
 
-def _children(pid: int) -> list[int]:
-    """Process ids whose parent is ``pid`` (Linux /proc)."""
-    children = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if int(fields[1]) == pid:
-            children.append(int(stat.parent.name))
-    return children
-
-
-def _running(pid: int) -> bool:
-    """Whether process ``pid`` exists and is not a zombie waiting to be reaped."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except OSError:
-        return False
-    return state != "Z"
-
-
 def _allocations(root: Path) -> list:
     experiment = ExperimentDir(root)
     return [
@@ -335,8 +313,10 @@ def _allocations(root: Path) -> list:
 @pytest.mark.parametrize(
     "kill_when",
     [
-        "policies/.staging/round-001",  # during training phase 1
-        "policies/round-000/training.json",  # as round 1's parallel collection starts
+        # MetaWorld's kills run with the slow set (the kill campaign hits 20 moments of this run);
+        # tests/test_toy.py kills a toy run with two env workers in the default suite.
+        pytest.param("policies/.staging/round-001", marks=pytest.mark.slow),  # training phase 1
+        pytest.param("policies/round-000/training.json", marks=pytest.mark.slow),  # round-1 collection
         pytest.param("policies/.staging/round-001/model.safetensors", marks=pytest.mark.slow),  # eval
         pytest.param("rounds/round-001", marks=pytest.mark.slow),  # right after round 1's commit
     ],
@@ -352,14 +332,14 @@ def test_kill_9_and_resume_gives_the_same_allocations(tmp_path, kill_when):
     while not (killed / kill_when).exists() and process.poll() is None and time.time() < deadline:
         time.sleep(0.05)
     assert process.poll() is None, "the run finished before it could be killed"
-    workers = _children(process.pid)
+    workers = child_pids(process.pid)
     assert len(workers) == 2, "the run should have its two env workers"
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
     deadline = time.time() + 20
-    while any(_running(pid) for pid in workers) and time.time() < deadline:
+    while any(is_running(pid) for pid in workers) and time.time() < deadline:
         time.sleep(0.1)
-    assert not any(_running(pid) for pid in workers), "env workers outlived the run"
+    assert not any(is_running(pid) for pid in workers), "env workers outlived the run"
     subprocess.run(_cli(killed, "--scheduler.type=need", "--resume=true"), check=True, capture_output=True)
     assert _allocations(killed) == _allocations(reference)
     assert verify_experiment(ExperimentDir(killed)) == (3, 3, [])

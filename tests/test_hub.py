@@ -35,7 +35,7 @@ from lerobot_mtdagger.datasets.rounds import RECORD_FILES, ExperimentDir
 from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
 from tests.helpers import edit_round_record
 
-TASKS = ["reach-v3", "button-press-topdown-v3"]
+TASKS = ["toy-left", "toy-right"]
 DATASET_REPO = "tester/mtdagger-rounds"
 POLICY_REPO = "tester/mtdagger-policy"
 
@@ -147,6 +147,7 @@ def experiment_dir(tmp_path_factory) -> Path:
         [
             str(Path(sys.executable).parent / "lerobot-mtdagger"),
             "run",
+            "--suite.name=toy",
             f"--suite.tasks=[{','.join(TASKS)}]",
             "--dagger.rounds=1",
             "--training.steps_per_round=20",
@@ -299,8 +300,8 @@ def test_card_in_each_revision_covers_rounds_up_to_it(experiment_dir, fake_api):
     card1 = (fake_api.snapshot(DATASET_REPO, "round-001") / "README.md").read_text()
 
     assert "| task | round 0 | round 1 |" in card1
-    assert "| reach-v3 | 3 | 3 |" in card1
-    assert "| button-press-topdown-v3 | 3 | 3 |" in card1
+    assert "| toy-left | 3 | 3 |" in card1
+    assert "| toy-right | 3 | 3 |" in card1
     assert "| task | round 0 |\n" in card0 and "round 1 |" not in card0
     assert f'LeRobotDataset("{DATASET_REPO}", revision="round-001")' in card1
     assert f'LeRobotDataset("{DATASET_REPO}", revision="round-000")' in card0
@@ -317,9 +318,9 @@ def test_rendered_card_has_metadata_tasks_and_eval(experiment_dir):
     assert data["task_categories"] == ["robotics"]
     assert data["tags"] == ["LeRobot", "mtdagger", "dagger", "multitask"]
     assert data["configs"] == [{"config_name": "default", "data_files": "data/*/*.parquet"}]
-    assert "Suite: `metaworld-mt10`, observation mode `state`" in text
+    assert "Suite: `toy`, observation mode `state`" in text
     assert "Scheduling method: `need`" in text
-    assert "| 0 | reach-v3 |\n| 1 | button-press-topdown-v3 |" in text
+    assert "| 0 | toy-left |\n| 1 | toy-right |" in text
     assert "| 1 | `round-001` | 6 |" in text
     evals = [experiment.read_phase_record(k).eval for k in (0, 1)]
     assert "| **mean** | " + " | ".join(f"{e['mean']:.3f}" for e in evals) + " |" in text

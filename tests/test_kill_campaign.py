@@ -25,7 +25,8 @@ import pytest
 
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
-from tests.test_dagger import _children, _cli, _running
+from tests.helpers import child_pids, is_running
+from tests.test_dagger import _cli
 
 pytestmark = pytest.mark.slow
 
@@ -98,14 +99,14 @@ def kill_at(root: Path, path: str, delay: float) -> tuple[bool, str]:
     time.sleep(delay)
     if process.poll() is not None:
         return False, "the run had finished"
-    workers = _children(process.pid)
+    workers = child_pids(process.pid)
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
     hit = what_was_hit(root)
     deadline = time.time() + 20
-    while any(_running(pid) for pid in workers) and time.time() < deadline:
+    while any(is_running(pid) for pid in workers) and time.time() < deadline:
         time.sleep(0.05)
-    assert not any(_running(pid) for pid in workers), "env workers outlived the run"
+    assert not any(is_running(pid) for pid in workers), "env workers outlived the run"
     return True, hit
 
 

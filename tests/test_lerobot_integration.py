@@ -93,6 +93,7 @@ def test_stock_lerobot_train_and_eval_on_state(tmp_path, expert_dataset_factory)
     assert np.isfinite(info["overall"]["avg_sum_reward"])
 
 
+@pytest.mark.slow  # rendered clouds and lerobot-eval, about 40 s
 def test_stock_lerobot_eval_on_point_clouds_through_the_rename_map(tmp_path, expert_dataset_factory):
     suite = make_suite("metaworld-mt10", tasks=TASKS, obs_mode="pointcloud", num_points=128)
     root = expert_dataset_factory(suite, episodes_per_task=1, steps=20)

@@ -78,7 +78,7 @@ def run_toy(root: Path, *extra: str) -> list[str]:
     return dagger.run(draccus.parse(RunConfig, args=[*TOY, f"--output_dir={root}", *extra]))
 
 
-@pytest.mark.parametrize("workers", [1, 2])
+@pytest.mark.parametrize("workers", [pytest.param(1, marks=pytest.mark.slow), 2])  # 1: the slow set
 def test_ray_env_workers_give_the_same_rounds_and_evaluations_as_local_ones(tmp_path, workers):
     local = run_toy(tmp_path / "local", "--rollout.workers=2")
     remote = run_toy(tmp_path / "ray", f"--rollout.workers={workers}", "--rollout.worker_backend=ray")

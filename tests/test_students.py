@@ -96,7 +96,7 @@ def diffusion_run(tmp_path_factory) -> Path:
 # -------------------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("name", ["act_run", "diffusion_run"])
+@pytest.mark.parametrize("name", ["act_run", pytest.param("diffusion_run", marks=pytest.mark.slow)])
 def test_a_lerobot_student_runs_every_round_and_verifies(request, name):
     root = request.getfixturevalue(name)
     experiment = ExperimentDir(root)
@@ -117,7 +117,7 @@ def test_a_lerobot_student_learns_the_toy_tasks(act_run):
     assert phase.eval["mean"] >= 0.5, phase.eval
 
 
-@pytest.mark.parametrize("name", ["act_run", "diffusion_run"])
+@pytest.mark.parametrize("name", ["act_run", pytest.param("diffusion_run", marks=pytest.mark.slow)])
 def test_the_saved_student_loads_and_acts_with_stock_lerobot(request, name):
     from lerobot.configs.policies import PreTrainedConfig
     from lerobot.policies.factory import get_policy_class, make_pre_post_processors
@@ -156,6 +156,7 @@ def test_eval_of_a_lerobot_student_reports_every_task(act_run, tmp_path):
     assert result["episodes"] == [2, 2, 2] and len(result["success"]) == 3
 
 
+@pytest.mark.slow  # three ACT runs, about 25 s (tests/test_toy.py kills a run in the default suite)
 def test_a_lerobot_student_resumes_after_kill_9_to_the_same_result(act_run, tmp_path):
     command = [
         str(Path(sys.executable).parent / "lerobot-mtdagger"),

@@ -4,6 +4,8 @@ commit of rounds, and the whole runner end to end in seconds."""
 from __future__ import annotations
 
 import json
+import os
+import signal
 
 import draccus
 import numpy as np
@@ -30,6 +32,7 @@ from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.scheduler import scheduling_methods
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM, EVAL_STREAM
+from tests.helpers import child_pids, is_running
 
 TASKS = list(TOY_TASKS)
 
@@ -346,6 +349,52 @@ def test_a_run_cut_after_a_phase_resumes_to_the_same_rounds_and_weights(tmp_path
     ]
     for name, tensor in weights[0].items():
         torch.testing.assert_close(tensor, weights[1][name], rtol=0, atol=0)
+
+
+KILLED_RUN = ["--rollout.workers=2", "--training.steps_per_round=150"]  # a phase long enough to hit
+
+
+def test_kill_9_during_training_then_resume_equals_the_uninterrupted_run(tmp_path):
+    """A toy run with two env workers killed (SIGKILL) in phase 1: its workers end with it, and
+    ``--resume=true`` gives the uninterrupted run's rounds and weights (MetaWorld: the slow set)."""
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    from lerobot_mtdagger.policies import MTDAggerPolicy
+
+    reference, killed = tmp_path / "reference", tmp_path / "killed"
+    run(toy_config(reference, *KILLED_RUN))
+    command = [str(Path(sys.executable).parent / "lerobot-mtdagger"), "run", *TOY_RUN, *KILLED_RUN]
+    process = subprocess.Popen(
+        [*command, f"--output_dir={killed}"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    deadline = time.time() + 120
+    while not (killed / "policies" / ".staging" / "round-001").exists() and time.time() < deadline:
+        assert process.poll() is None, "the run ended before phase 1 started"
+        time.sleep(0.02)
+    workers = child_pids(process.pid)
+    assert len(workers) == 2, "the run should have its two env workers"
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    deadline = time.time() + 20
+    while any(is_running(pid) for pid in workers) and time.time() < deadline:
+        time.sleep(0.1)
+    assert not any(is_running(pid) for pid in workers), "env workers outlived the run"
+    assert ExperimentDir(killed).committed_phases() == [0], "the kill should have cut phase 1"
+    subprocess.run([*command, f"--output_dir={killed}", "--resume=true"], check=True, capture_output=True)
+    assert verify_experiment(ExperimentDir(killed)) == (3, 3, [])
+    records = [[ExperimentDir(root).read_round_record(k) for k in range(3)] for root in (reference, killed)]
+    strip = [[{**r.to_dict(), "config": None} for r in rs] for rs in records]  # config holds output_dir
+    assert strip[0] == strip[1]
+    for k in range(3):
+        weights = [
+            MTDAggerPolicy.from_pretrained(str(ExperimentDir(r).policy_root(k))).state_dict()
+            for r in (reference, killed)
+        ]
+        for name, tensor in weights[0].items():
+            torch.testing.assert_close(tensor, weights[1][name], rtol=0, atol=0)
 
 
 def test_a_dagger_run_resumed_with_more_rounds_equals_one_started_with_them(tmp_path):
