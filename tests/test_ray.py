@@ -11,6 +11,7 @@ import csv
 import hashlib
 import os
 import signal
+import time
 from pathlib import Path
 
 import draccus
@@ -26,6 +27,7 @@ from lerobot_mtdagger.runner import dagger
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.ray_workers import RayEnvWorkers
 from lerobot_mtdagger.runner.workers import WorkerDiedError
+from lerobot_mtdagger.utils.errors import UserError
 
 ray = pytest.importorskip("ray")
 
@@ -126,6 +128,30 @@ def test_an_exception_in_a_ray_actor_is_raised_with_its_traceback(tmp_path):
         with pytest.raises(ValueError, match="Unknown worker command") as raised:
             workers._receive(0)
         assert "in handle" in str(raised.value.__cause__)
+
+
+@pytest.mark.slow  # CI runs it with the slow set
+def test_a_pool_reserving_no_cpu_starts_beside_actors_holding_every_cpu_and_a_full_cluster_is_named(
+    monkeypatch,
+):
+    """The unseen drawers' pool runs while the run's own actors hold every CPU (a cluster sized to
+    ``--rollout.workers`` used to wait on itself forever); actors that cannot be placed are an error."""
+    from lerobot_mtdagger.runner import ray_workers
+
+    suite = suite_from_config(SuiteConfig(name="toy"))
+    cpus = int(ray.cluster_resources()["CPU"])
+    with RayEnvWorkers(suite, cpus) as holding:
+        monkeypatch.setattr(ray_workers, "ACTOR_START_TIMEOUT_S", 60.0)
+        with RayEnvWorkers(suite, 2, reserve_cpus=False) as sharing:
+            assert len(sharing._places) == 2
+        monkeypatch.setattr(ray_workers, "ACTOR_START_TIMEOUT_S", 5.0)
+        with pytest.raises(UserError, match=f"the cluster has {cpus} CPUs, 0 free. Lower --rollout.workers"):
+            RayEnvWorkers(suite, 1)
+        assert len(holding._places) == cpus
+    deadline = time.time() + 30  # the actor that was never placed is gone: every CPU comes back
+    while ray.available_resources().get("CPU", 0) < cpus and time.time() < deadline:
+        time.sleep(0.5)
+    assert ray.available_resources().get("CPU", 0) == cpus
 
 
 def results_without_timings(folder: Path) -> list[dict[str, str]]:

@@ -348,11 +348,15 @@ class RolloutConfig:
         """Env worker processes to start (``workers``, or one per core)."""
         return resolve_workers(self.workers)
 
-    def env_workers(self, suite: Any) -> Any:
-        """The ``EnvWorkers`` of ``suite`` on this config's backend (a context manager)."""
+    def env_workers(self, suite: Any, reserve_cpus: bool = True) -> Any:
+        """The ``EnvWorkers`` of ``suite`` on this config's backend (a context manager).
+
+        ``reserve_cpus=False``: a pool that runs only while the run's own workers wait (on Ray its
+        actors reserve no CPU, so a cluster the size of ``workers`` does not wait on itself).
+        """
         from lerobot_mtdagger.runner.ray_workers import make_env_workers
 
-        return make_env_workers(suite, self.worker_count, self.worker_backend, self.ray_address)
+        return make_env_workers(suite, self.worker_count, self.worker_backend, self.ray_address, reserve_cpus)
 
 
 @dataclass

@@ -309,7 +309,8 @@ def evaluate_student(ctx: RunContext, runner: PolicyRunner) -> tuple[dict | None
     results = [evaluate_phase(ctx, runner, ctx.workers), None]
     if ctx.heldout_suite is not None:
         # Workers of their own, only while they evaluate: each holds its drawers' envs and renderers.
-        with ctx.config.rollout.env_workers(ctx.heldout_suite) as heldout_workers:
+        # They run while the run's own workers wait, on the CPUs those hold (Ray: no reservation).
+        with ctx.config.rollout.env_workers(ctx.heldout_suite, reserve_cpus=False) as heldout_workers:
             results[1] = evaluate_phase(ctx, runner, heldout_workers)
     return tuple(None if result is None else result.to_dict() for result in results)
 

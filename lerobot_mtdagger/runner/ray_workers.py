@@ -4,7 +4,11 @@
 same ``RolloutWorker`` answers the same commands (``answer``), the main process keeps the policy and
 batches it over the same lanes, and every episode depends only on its seeds and the learner's
 actions, so a run gives the same rounds and evaluations on either backend, at any worker count.
-Actors are spread over the cluster's nodes (Ray's ``SPREAD`` strategy), one CPU each.
+Actors are spread over the cluster's nodes (Ray's ``SPREAD`` strategy), one CPU each; a pool that
+only runs while the run's own actors wait (the unseen drawers' evaluation) reserves no CPU of its
+own (``reserve_cpus=False``), so a cluster the size of ``--rollout.workers`` never waits on itself.
+Actors that cannot be placed within ``ACTOR_START_TIMEOUT_S`` (a cluster too small, nodes gone) are
+a ``UserError`` naming the CPUs asked for and free, not a silent wait.
 
 The suite travels to each actor pickled (cloudpickle); an expert registered with ``register_expert``
 in the main process does not travel with it (the actor's process has its own registry): give such
@@ -31,9 +35,14 @@ from lerobot_mtdagger.runner.workers import (
     answer,
     reply_payload,
 )
+from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.ray_session import connect
 
 logger = logging.getLogger(__name__)
+
+ACTOR_START_TIMEOUT_S = 300.0
+"""Seconds the actors of a pool may take to be placed and to build their envs (importing this package
+on a busy node takes about a minute)."""
 
 
 class RolloutActor:
@@ -84,25 +93,53 @@ class _ActorConnection:
 class RayEnvWorkers(EnvWorkers):
     """``EnvWorkers`` whose ``workers`` are Ray actors on the cluster at ``address`` (None: local Ray)."""
 
-    def __init__(self, suite: TaskSuite, workers: int, address: str | None = None) -> None:
+    def __init__(
+        self, suite: TaskSuite, workers: int, address: str | None = None, reserve_cpus: bool = True
+    ) -> None:
         """Starts ``workers`` actors (at least one) and waits until each holds the suite.
 
+        Args:
+            suite: The tasks the actors step.
+            workers: How many actors.
+            address: The Ray cluster (None: a local Ray).
+            reserve_cpus: One CPU per actor (False: none, for a pool that runs only while the run's
+                own actors wait, on their CPUs).
+
         Raises:
-            UserError: If Ray is missing or there is no cluster at ``address``.
+            UserError: If Ray is missing, there is no cluster at ``address``, or the actors cannot
+                be placed within ``ACTOR_START_TIMEOUT_S``.
         """
         self._ray = connect(address)
         self._places: list[str] = []
+        self._cpus_per_actor = 1 if reserve_cpus else 0
         super().__init__(suite, max(workers, 1))
 
     def _start_processes(self, workers: int) -> None:
         ray = self._ray
-        actor_class = ray.remote(num_cpus=1, max_restarts=0, scheduling_strategy="SPREAD")(RolloutActor)
+        actor_class = ray.remote(num_cpus=self._cpus_per_actor, max_restarts=0, scheduling_strategy="SPREAD")(
+            RolloutActor
+        )
         suite = ray.put(self.suite)
         actors = [actor_class.remote(suite) for _ in range(workers)]
-        self._places = ray.get([actor.where.remote() for actor in actors])
+        try:
+            self._places = ray.get([actor.where.remote() for actor in actors], timeout=ACTOR_START_TIMEOUT_S)
+        except ray.exceptions.GetTimeoutError:
+            for actor in actors:
+                ray.kill(actor)  # never placed later behind the run's back
+            raise self._not_placed(workers) from None
         self._processes = actors
         self._connections = [_ActorConnection(ray, actor) for actor in actors]
         logger.info("started %d env worker actors: %s", workers, self._places)
+
+    def _not_placed(self, workers: int) -> UserError:
+        """The error for ``workers`` actors that Ray could not place in time."""
+        ray = self._ray
+        total, free = ray.cluster_resources().get("CPU", 0), ray.available_resources().get("CPU", 0)
+        return UserError(
+            f"Ray could not place all {workers} env worker actors ({self._cpus_per_actor} CPU each) "
+            f"within {ACTOR_START_TIMEOUT_S:g} s: the cluster has {total:g} CPUs, {free:g} free. Lower "
+            "--rollout.workers, add nodes, or end what holds the CPUs (`ray status` lists them)."
+        )
 
     def _receive(self, index: int) -> Any:
         """The reply of actor ``index``.
@@ -144,9 +181,13 @@ class RayEnvWorkers(EnvWorkers):
 
 
 def make_env_workers(
-    suite: TaskSuite, workers: int, backend: str = "local", address: str | None = None
+    suite: TaskSuite,
+    workers: int,
+    backend: str = "local",
+    address: str | None = None,
+    reserve_cpus: bool = True,
 ) -> EnvWorkers:
-    """The env workers of a run on ``backend`` (``local`` or ``ray``)."""
+    """The env workers of a run on ``backend`` (``local`` or ``ray``; ``reserve_cpus``: Ray only)."""
     if backend == "ray":
-        return RayEnvWorkers(suite, workers, address)
+        return RayEnvWorkers(suite, workers, address, reserve_cpus)
     return EnvWorkers(suite, workers)
