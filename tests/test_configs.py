@@ -154,6 +154,15 @@ def test_draccus_reads_each_config_class_source_once_and_the_help_is_unchanged(m
     assert help_text() == cached_help
 
 
+def test_a_learning_rate_schedule_is_checked_and_refused_for_a_lerobot_student(capsys, tmp_path):
+    assert parse("--training.lr_schedule=cosine").training.lr_schedule == "cosine"
+    out = tmp_path / "out"
+    assert main(["run", "--training.lr_schedule=linear", f"--output_dir={out}"]) == 2
+    assert "training.lr_schedule" in capsys.readouterr().err and not out.exists()
+    assert main(["run", "--policy.type=act", "--training.lr_schedule=cosine", f"--output_dir={out}"]) == 2
+    assert "follows its own scheduler preset" in capsys.readouterr().err and not out.exists()
+
+
 def test_the_run_config_has_at_most_twelve_top_level_options():
     assert len(dataclasses.fields(RunConfig)) <= 12
 
@@ -195,7 +204,9 @@ def test_a_flat_config_migrates_into_the_groups():
     # Every option of today's config is either a migrated one or one added since (with its default).
     today = flatten(parse("--suite.name=toy").to_dict())
     added = set(today) - set(leaves)
-    assert added == {"suite.episode_length", "rollout.worker_backend", "rollout.ray_address"}, added
+    expected = {"suite.episode_length", "rollout.worker_backend", "rollout.ray_address"}
+    expected.add("training.lr_schedule")
+    assert added == expected, added
     assert all(today[path] == RunConfig.option_defaults()[path] for path in added)
 
 

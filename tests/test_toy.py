@@ -318,6 +318,19 @@ def test_every_method_runs_end_to_end_and_verifies(tmp_path, method):
     assert records[2].allocation["method"] == method
 
 
+def test_the_learning_rate_schedule_reaches_the_training_phase(tmp_path):
+    from lerobot_mtdagger.policies import MTDAggerPolicy
+
+    weights = {}
+    for schedule in ("constant", "cosine"):
+        root = tmp_path / schedule
+        run(toy_config(root, "--dagger.rounds=0", f"--training.lr_schedule={schedule}"))
+        policy = MTDAggerPolicy.from_pretrained(str(ExperimentDir(root).policy_root(0)))
+        weights[schedule] = policy.state_dict()
+        assert json.loads((root / "config.json").read_text())["training"]["lr_schedule"] == schedule
+    assert any(not torch.equal(t, weights["cosine"][n]) for n, t in weights["constant"].items())
+
+
 def test_bc_mode_runs_one_round_with_the_same_budget_and_compute(tmp_path):
     lines = run(toy_config(tmp_path / "bc", "--mode=bc"))
     experiment = ExperimentDir(tmp_path / "bc")

@@ -14,6 +14,7 @@ from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
 from lerobot_mtdagger.runner.train import (
     EPISODE_ID_STRIDE,
+    MTDAggerOps,
     NormalisedData,
     PlateauStop,
     StepOptions,
@@ -262,6 +263,31 @@ def test_training_is_deterministic_for_a_seed_and_does_not_depend_on_log_interva
         assert result == reference
     other_weights = runs[3][0].state_dict()
     assert not all(torch.equal(t, other_weights[n]) for n, t in reference_weights.items())
+
+
+def test_a_cosine_schedule_takes_each_phase_from_the_full_rate_to_zero(monkeypatch):
+    rates: dict[str, list[float]] = {}
+    build = MTDAggerOps.optimizer
+
+    def recording(self, steps):
+        optimizer, scheduler, clip = build(self, steps)
+        seen = rates.setdefault(self.lr_schedule, [])
+        optimizer.register_step_pre_hook(lambda opt, *_: seen.append(opt.param_groups[0]["lr"]))
+        return optimizer, scheduler, clip
+
+    monkeypatch.setattr(MTDAggerOps, "optimizer", recording)
+    data = synthetic_data()
+    weights = {}
+    for schedule in ("constant", "cosine"):
+        policy = small_policy()
+        options = StepOptions(steps=40, batch_size=64, lr=1e-3, seed=0, lr_schedule=schedule)
+        train_phase(policy, normalised(data, policy), torch.arange(len(data)), torch.arange(9), options)
+        weights[schedule] = policy.state_dict()
+    assert rates["constant"] == [1e-3] * 40
+    cosine = rates["cosine"]
+    assert len(cosine) == 40 and cosine[0] == 1e-3 and cosine == sorted(cosine, reverse=True)
+    assert cosine[20] == pytest.approx(5e-4) and cosine[-1] < 2e-6  # 0 after the last step
+    assert any(not torch.equal(t, weights["cosine"][n]) for n, t in weights["constant"].items())
 
 
 def test_on_step_reports_progress_at_log_intervals_and_at_the_end():

@@ -178,6 +178,9 @@ STEPS_RULES: tuple[str, ...] = ("fixed", "epochs", "plateau")
 ``plateau``: until the loss on held-out episodes stops improving."""
 SAMPLINGS: tuple[str, ...] = ("uniform", "balanced")
 """``uniform``: frames uniformly; ``balanced``: a task uniformly, then one of its frames."""
+LR_SCHEDULES: tuple[str, ...] = ("constant", "cosine")
+"""``constant``: the learning rate throughout a phase; ``cosine``: decayed to 0 over the phase's steps
+(each phase starts again at the full rate)."""
 WORKER_BACKENDS: tuple[str, ...] = ("local", "ray")
 """``local``: env workers forked on this machine; ``ray``: Ray actors on a Ray cluster."""
 GAIN_SPLITS: tuple[str, ...] = ("train", "heldout")
@@ -379,6 +382,8 @@ class TrainingConfig:
             start sees inputs normalised as before) or ``recompute`` (statistics of D(k) each phase).
         sampling: ``uniform`` (frames uniformly) or ``balanced`` (a task uniformly, then one of its
             frames).
+        lr_schedule: ``constant`` or ``cosine`` (the ``mtdagger`` policy's learning rate decayed to 0
+            over each phase's steps; a LeRobot student follows its config's scheduler preset).
         gain_split: ``train`` (per-task loss on the training data) or ``heldout`` (on held-out episodes).
         heldout_fraction: Fraction of each task's episodes held out of training when
             ``gain_split=heldout`` or ``steps_rule=plateau`` (decided once per episode, so an
@@ -394,6 +399,7 @@ class TrainingConfig:
     plateau_max_steps: int = 20_000
     normalisation: str = "fixed"
     sampling: str = "uniform"
+    lr_schedule: str = "constant"
     gain_split: str = "train"
     heldout_fraction: float = 0.2
 
@@ -404,6 +410,7 @@ class TrainingConfig:
         _require_choice(self.steps_rule, "training.steps_rule", STEPS_RULES)
         _require_choice(self.normalisation, "training.normalisation", NORMALISATIONS)
         _require_choice(self.sampling, "training.sampling", SAMPLINGS)
+        _require_choice(self.lr_schedule, "training.lr_schedule", LR_SCHEDULES)
         _require_choice(self.gain_split, "training.gain_split", GAIN_SPLITS)
         if not 0.0 < self.heldout_fraction < 1.0:
             raise ValueError(f"training.heldout_fraction must be in (0, 1), got {self.heldout_fraction}.")
@@ -506,6 +513,11 @@ class RunConfig:
         """Refuses a LeRobot student the runner cannot train (point clouds, temporal ensembling)."""
         if self.student_type == "mtdagger":
             return
+        if self.training.lr_schedule != "constant":
+            raise ValueError(
+                f"--training.lr_schedule={self.training.lr_schedule} is for the mtdagger policy; "
+                f"--policy.type={self.student_type} follows its own scheduler preset: drop the option."
+            )
         if self.suite.obs_mode == "pointcloud":
             raise ValueError(
                 f"--policy.type={self.student_type} cannot read point clouds (a LeRobot policy takes "

@@ -464,11 +464,14 @@ class MTDAggerOps:
     per-task loss is the action MSE of ``policy.predict``; the optimiser is a fused AdamW.
     """
 
-    def __init__(self, policy: MTDAggerPolicy, data: NormalisedData, lr: float) -> None:
-        """Remembers the policy, its frames and the learning rate."""
+    def __init__(
+        self, policy: MTDAggerPolicy, data: NormalisedData, lr: float, lr_schedule: str = "constant"
+    ) -> None:
+        """Remembers the policy, its frames, the learning rate and its schedule over a phase."""
         self.policy = policy
         self.data = data
         self.lr = lr
+        self.lr_schedule = lr_schedule
 
     def step_loss(self, index: torch.Tensor, first_of_interval: bool) -> torch.Tensor:
         """The imitation loss on the frames at ``index``."""
@@ -485,15 +488,21 @@ class MTDAggerOps:
         return per_task_loss(self.policy, self.data, index, num_tasks)
 
     def optimizer(self, steps: int) -> tuple[torch.optim.Optimizer, Any, float]:
-        """Fused AdamW (``make_optimizer``), no scheduler, the config's gradient clip norm."""
-        del steps
-        return make_optimizer(self.policy, self.lr), None, self.policy.config.optimizer_grad_clip_norm
+        """Fused AdamW (``make_optimizer``), its schedule over ``steps``, the config's gradient clip norm.
+
+        ``constant``: no scheduler; ``cosine``: the rate decays from ``lr`` to 0 at step ``steps``.
+        """
+        optimizer = make_optimizer(self.policy, self.lr)
+        scheduler = None
+        if self.lr_schedule == "cosine":
+            scheduler = torch.optim.lr_scheduler.CosineAnnealingLR(optimizer, T_max=max(steps, 1))
+        return optimizer, scheduler, self.policy.config.optimizer_grad_clip_norm
 
 
 def phase_ops(policy: Any, data: NormalisedData, options: StepOptions) -> Any:
     """The training seam of ``policy``: ``MTDAggerOps`` or ``students.LeRobotOps``."""
     if isinstance(policy, MTDAggerPolicy):
-        return MTDAggerOps(policy, data, options.lr)
+        return MTDAggerOps(policy, data, options.lr, options.lr_schedule)
     from lerobot_mtdagger.runner.students import LeRobotOps
 
     return LeRobotOps(policy, data, options.task_dropout, options.seed)
@@ -585,6 +594,8 @@ class StepOptions:
         lr: AdamW learning rate.
         seed: Seed of the batch sampling.
         sampling: ``uniform`` over frames or ``balanced`` over tasks.
+        lr_schedule: ``constant`` or ``cosine`` over ``steps`` (``mtdagger``; a LeRobot student
+            follows its config's scheduler preset).
         plateau: End the phase when the held-out loss stops improving and keep the weights of its
             minimum (None: train all ``steps``).
         log_interval: Steps between two reads of the loss.
@@ -596,6 +607,7 @@ class StepOptions:
     lr: float
     seed: int
     sampling: str = "uniform"
+    lr_schedule: str = "constant"
     plateau: PlateauStop | None = None
     log_interval: int = LOG_INTERVAL
     task_dropout: float = 0.0
@@ -940,6 +952,7 @@ def train_on_rounds(
         lr=getattr(config.policy, "lr", None) or config.policy.optimizer_lr,
         seed=phase_seed,
         sampling=config.training.sampling,
+        lr_schedule=config.training.lr_schedule,
         plateau=plateau_stop(config, split),
         task_dropout=getattr(policy_cfg, "task_dropout", 0.0),
     )
