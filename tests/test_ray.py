@@ -141,7 +141,7 @@ def test_a_pool_reserving_no_cpu_starts_beside_actors_holding_every_cpu_and_a_fu
     suite = suite_from_config(SuiteConfig(name="toy"))
     cpus = int(ray.cluster_resources()["CPU"])
     with RayEnvWorkers(suite, cpus) as holding:
-        monkeypatch.setattr(ray_workers, "ACTOR_START_TIMEOUT_S", 60.0)
+        monkeypatch.setattr(ray_workers, "ACTOR_START_TIMEOUT_S", 180.0)
         with RayEnvWorkers(suite, 2, reserve_cpus=False) as sharing:
             assert len(sharing._places) == 2
         monkeypatch.setattr(ray_workers, "ACTOR_START_TIMEOUT_S", 5.0)
