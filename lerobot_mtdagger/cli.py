@@ -43,6 +43,7 @@ from lerobot_mtdagger.envs.config import DEFAULT_IMAGE_SIZE, DEFAULT_NUM_POINTS,
 from lerobot_mtdagger.runner.configs import (
     RUN_OPTION_RENAMES,
     SUITE_OPTION_RENAMES,
+    WORKER_BACKENDS,
     RunConfig,
     renamed_option_error,
     resolve_workers,
@@ -52,6 +53,7 @@ from lerobot_mtdagger.studies.compare import CompareConfig, follow_parent, split
 from lerobot_mtdagger.studies.simulate import SyntheticTasks, simulate
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
+from lerobot_mtdagger.utils.ray_session import import_ray
 
 HELDOUT_TASKS = "heldout"
 """``--suite.tasks='[heldout]'``: the suite's unseen tasks (``eval``, ``shift``)."""
@@ -223,6 +225,9 @@ class EvalConfig:
         seed: Seed of the evaluation episodes.
         output: Optional JSON file for the results.
         workers: Env worker processes (None: one per core; 0: in this process).
+        worker_backend: ``local`` (forked processes) or ``ray`` (Ray actors, as ``run``'s
+            ``--rollout.worker_backend``; the same episodes either way).
+        ray_address: The Ray cluster of ``worker_backend=ray`` (None: start a local Ray).
         trust_checkpoint: Let the policy's processor configs name Python classes, which LeRobot's
             loader imports and calls (default: only LeRobot registry names are accepted).
     """
@@ -233,6 +238,8 @@ class EvalConfig:
     seed: int = 0
     output: Path | None = None
     workers: int | None = None
+    worker_backend: str = "local"
+    ray_address: str | None = None
     trust_checkpoint: bool = False
 
     @property
@@ -240,8 +247,20 @@ class EvalConfig:
         """Env worker processes to start."""
         return resolve_workers(self.workers)
 
+    def env_workers(self, suite: TaskSuite) -> Any:
+        """The env workers of ``suite`` on ``worker_backend`` (a context manager)."""
+        from lerobot_mtdagger.runner.ray_workers import make_env_workers
+
+        return make_env_workers(suite, self.worker_count, self.worker_backend, self.ray_address)
+
     def __post_init__(self) -> None:
         resolve_workers(self.workers)  # refuses a negative count before anything runs
+        if self.worker_backend not in WORKER_BACKENDS:
+            raise ValueError(
+                f"worker_backend must be one of {list(WORKER_BACKENDS)}, got {self.worker_backend!r}."
+            )
+        if self.worker_backend == "ray":
+            import_ray()  # refuses a missing Ray before anything runs
         if self.policy_path is None:
             raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
         if self.episodes <= 0:
@@ -293,10 +312,9 @@ def observation_options(runner: PolicyRunner, suite: SuiteConfig) -> dict[str, A
 def eval_command(config: EvalConfig) -> dict:
     """Evaluates a pretrained policy per task with the pure policy acting."""
     from lerobot_mtdagger.runner.evaluate import evaluate
-    from lerobot_mtdagger.runner.workers import EnvWorkers
 
     suite, runner = _suite_and_policy(config)
-    with EnvWorkers(suite, config.worker_count) as workers:
+    with config.env_workers(suite) as workers:
         result, _ = evaluate(workers, runner, config.episodes, config.seed)
     progress = result.progress or [None] * len(result.task_names)
     for task, success, score in zip(result.task_names, result.success, progress, strict=True):
@@ -321,11 +339,10 @@ class ShiftConfig(EvalConfig):
 
 def shift_command(config: ShiftConfig) -> dict:
     """Measures a pretrained policy's covariate shift per task and prints it."""
-    from lerobot_mtdagger.runner.workers import EnvWorkers
     from lerobot_mtdagger.studies.shift import measure_shift
 
     suite, runner = _suite_and_policy(config)
-    with EnvWorkers(suite, config.worker_count) as workers:
+    with config.env_workers(suite) as workers:
         result = measure_shift(workers, runner, config.episodes, config.seed)
     print(shift_table(result))
     if config.output is not None:

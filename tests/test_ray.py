@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import hashlib
+import json
 import os
 import signal
 import time
@@ -152,6 +153,24 @@ def test_a_pool_reserving_no_cpu_starts_beside_actors_holding_every_cpu_and_a_fu
     while ray.available_resources().get("CPU", 0) < cpus and time.time() < deadline:
         time.sleep(0.5)
     assert ray.available_resources().get("CPU", 0) == cpus
+
+
+@pytest.mark.parametrize("command", ["eval", "shift"])
+def test_eval_and_shift_on_ray_actors_give_the_local_workers_results(tmp_path, capsys, monkeypatch, command):
+    started, start = [], RayEnvWorkers._start_processes
+    spy = lambda self, n: started.append(n) or start(self, n)  # noqa: E731
+    monkeypatch.setattr(RayEnvWorkers, "_start_processes", spy)
+    run_toy(tmp_path / "run", "--dagger.rounds=0")
+    policy = ExperimentDir(tmp_path / "run").policy_root(0)
+    results = {}
+    for backend in ("local", "ray"):
+        output = tmp_path / f"{backend}.json"
+        args = [command, f"--policy_path={policy}", "--suite.name=toy", "--episodes=3", "--workers=2"]
+        assert main([*args, f"--worker_backend={backend}", f"--output={output}"]) == 0
+        results[backend] = json.loads(output.read_text())
+    assert results["ray"] == results["local"] and started == [2]  # two actors, for the ray pass only
+    assert main([command, f"--policy_path={policy}", "--suite.name=toy", "--worker_backend=slurm"]) == 2
+    assert "worker_backend must be one of ['local', 'ray'], got 'slurm'" in capsys.readouterr().err
 
 
 def results_without_timings(folder: Path) -> list[dict[str, str]]:
