@@ -30,6 +30,7 @@ import pyarrow.parquet as pq
 
 from lerobot_mtdagger.datasets.config_layout import flatten, migrate_run_config, option
 from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, ExperimentDir
+from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.studies.report import CurvePoint, RunPoints, average_runs, curve_name
 from lerobot_mtdagger.utils.errors import UserError
 
@@ -482,8 +483,13 @@ def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = 
 def config_differences(first: Mapping, second: Mapping) -> str:
     """``"option: a vs b, ..."`` for every option whose value differs (empty when none does).
 
-    Either config may be nested, flat by dotted path or stored before the options were grouped.
+    Either config may be nested, flat by dotted path or stored before the options were grouped. An
+    option one config lacks (stored before the option existed) counts as what it was then
+    (``RunConfig.option_defaults``: ``training.lr_schedule`` was ``constant``).
     """
+    defaults = RunConfig.option_defaults()
     first, second = (flatten(migrate_run_config(config)) for config in (first, second))
-    differing = sorted(key for key in set(first) | set(second) if first.get(key) != second.get(key))
-    return ", ".join(f"{key}: {first.get(key)!r} vs {second.get(key)!r}" for key in differing)
+    keys = set(first) | set(second)
+    values = [{key: config.get(key, defaults.get(key)) for key in keys} for config in (first, second)]
+    differing = sorted(key for key in keys if values[0][key] != values[1][key])
+    return ", ".join(f"{key}: {values[0][key]!r} vs {values[1][key]!r}" for key in differing)
