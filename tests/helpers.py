@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -40,3 +44,19 @@ def is_running(pid: int) -> bool:
     except OSError:
         return False
     return state != "Z"
+
+
+def kill_9_and_check_workers_end(process: subprocess.Popen, workers: int | None = None) -> None:
+    """SIGKILLs a run and checks that its env worker processes end within 20 s.
+
+    ``workers``: how many env worker processes the run must have had when killed (None: any).
+    """
+    children = child_pids(process.pid)
+    if workers is not None:
+        assert len(children) == workers, f"the run should have its {workers} env workers"
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    deadline = time.time() + 20
+    while any(is_running(pid) for pid in children) and time.time() < deadline:
+        time.sleep(0.05)
+    assert not any(is_running(pid) for pid in children), "env workers outlived the run"

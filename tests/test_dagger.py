@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import signal
 import subprocess
 import sys
 import time
@@ -25,7 +23,7 @@ from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.utils.errors import UserError
 from tests.conftest import lerobot_train
-from tests.helpers import child_pids, edit_round_record, is_running
+from tests.helpers import edit_round_record, kill_9_and_check_workers_end
 
 TASKS = ["reach-v3", "button-press-topdown-v3", "push-v3"]
 TINY = [
@@ -332,14 +330,7 @@ def test_kill_9_and_resume_gives_the_same_allocations(tmp_path, kill_when):
     while not (killed / kill_when).exists() and process.poll() is None and time.time() < deadline:
         time.sleep(0.05)
     assert process.poll() is None, "the run finished before it could be killed"
-    workers = child_pids(process.pid)
-    assert len(workers) == 2, "the run should have its two env workers"
-    os.kill(process.pid, signal.SIGKILL)
-    process.wait()
-    deadline = time.time() + 20
-    while any(is_running(pid) for pid in workers) and time.time() < deadline:
-        time.sleep(0.1)
-    assert not any(is_running(pid) for pid in workers), "env workers outlived the run"
+    kill_9_and_check_workers_end(process, workers=2)
     subprocess.run(_cli(killed, "--scheduler.type=need", "--resume=true"), check=True, capture_output=True)
     assert _allocations(killed) == _allocations(reference)
     assert verify_experiment(ExperimentDir(killed)) == (3, 3, [])

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import os
-import signal
 import subprocess
 import time
 from pathlib import Path
@@ -25,7 +24,7 @@ import pytest
 
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
-from tests.helpers import child_pids, is_running
+from tests.helpers import kill_9_and_check_workers_end
 from tests.test_dagger import _cli
 
 pytestmark = pytest.mark.slow
@@ -99,15 +98,8 @@ def kill_at(root: Path, path: str, delay: float) -> tuple[bool, str]:
     time.sleep(delay)
     if process.poll() is not None:
         return False, "the run had finished"
-    workers = child_pids(process.pid)
-    os.kill(process.pid, signal.SIGKILL)
-    process.wait()
-    hit = what_was_hit(root)
-    deadline = time.time() + 20
-    while any(is_running(pid) for pid in workers) and time.time() < deadline:
-        time.sleep(0.05)
-    assert not any(is_running(pid) for pid in workers), "env workers outlived the run"
-    return True, hit
+    kill_9_and_check_workers_end(process)
+    return True, what_was_hit(root)
 
 
 @pytest.mark.parametrize(("event", "delay"), campaign_moments())

@@ -4,8 +4,6 @@ commit of rounds, and the whole runner end to end in seconds."""
 from __future__ import annotations
 
 import json
-import os
-import signal
 
 import draccus
 import numpy as np
@@ -32,7 +30,7 @@ from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.scheduler import scheduling_methods
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM, EVAL_STREAM
-from tests.helpers import child_pids, is_running
+from tests.helpers import kill_9_and_check_workers_end
 
 TASKS = list(TOY_TASKS)
 
@@ -387,14 +385,7 @@ def test_kill_9_during_training_then_resume_equals_the_uninterrupted_run(tmp_pat
     while not (killed / "policies" / ".staging" / "round-001").exists() and time.time() < deadline:
         assert process.poll() is None, "the run ended before phase 1 started"
         time.sleep(0.02)
-    workers = child_pids(process.pid)
-    assert len(workers) == 2, "the run should have its two env workers"
-    os.kill(process.pid, signal.SIGKILL)
-    process.wait()
-    deadline = time.time() + 20
-    while any(is_running(pid) for pid in workers) and time.time() < deadline:
-        time.sleep(0.1)
-    assert not any(is_running(pid) for pid in workers), "env workers outlived the run"
+    kill_9_and_check_workers_end(process, workers=2)
     assert ExperimentDir(killed).committed_phases() == [0], "the kill should have cut phase 1"
     subprocess.run([*command, f"--output_dir={killed}", "--resume=true"], check=True, capture_output=True)
     assert verify_experiment(ExperimentDir(killed)) == (3, 3, [])
