@@ -219,8 +219,9 @@ class EvalConfig:
         policy_path: Pretrained model folder or Hub id (with its processors).
         suite: The suite (``SuiteConfig``, spelt as for ``run``: ``--suite.name=drawers``).
             ``--suite.tasks='[heldout]'`` evaluates the suite's unseen tasks, which a policy trained
-            with ``task_dropout > 0`` acts on with its shared embedding. ``suite.obs_mode``,
-            ``suite.num_points`` and ``suite.image_size`` default to what the policy was trained on.
+            with ``task_dropout > 0`` acts on with its shared embedding. ``suite.tasks``,
+            ``suite.obs_mode``, ``suite.num_points`` and ``suite.image_size`` default to what the
+            policy was trained on (its tasks that the suite has, else all the suite's).
         episodes: Episodes per task.
         seed: Seed of the evaluation episodes.
         output: Optional JSON file for the results.
@@ -286,7 +287,12 @@ def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
             )
     else:
         suite = suite_from_config(suite_config)
+        trained = [name for name in suite.task_names if name in runner.task_names]
+        if not suite_config.tasks and trained and len(trained) < len(suite.task_names):
+            logger.info("Evaluating the %d tasks of %s the policy knows", len(trained), suite_config.name)
+            suite = suite_from_config(suite_config, tasks=trained)
     runner.check_inputs(suite.features, suite_config.obs_mode)
+    runner.check_tasks(suite.task_names)
     return suite, runner
 
 

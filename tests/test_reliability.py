@@ -470,3 +470,40 @@ def test_eval_of_a_hub_id_that_cannot_be_fetched_is_one_error_line(monkeypatch, 
     assert main(["eval", "--policy_path=nobody/no-such-policy"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "Cannot load the Hub policy nobody/no-such-policy" in err[0], err
+
+
+def test_eval_of_an_rgb_policy_runs_and_a_wrong_image_size_is_named(tmp_path, capsys):
+    """An image policy takes channel-first inputs where the suite's features are channel-last."""
+    experiment = tmp_path / "rgb"
+    rgb_run = [
+        "run",
+        "--suite.name=metaworld-mt10",
+        "--suite.tasks=[reach-v3]",
+        "--suite.obs_mode=rgb",
+        "--suite.image_size=32",
+        "--suite.episode_length=30",
+        "--dagger.rounds=0",
+        "--dagger.initial_demos=1",
+        "--training.steps_per_round=2",
+        "--rollout.eval_episodes=1",
+        "--rollout.workers=0",
+        "--progress=false",
+        f"--output_dir={experiment}",
+    ]
+    assert main(rgb_run) == 0
+    policy = ExperimentDir(experiment).policy_root(0)
+    output = tmp_path / "eval.json"
+    evaluation = ["eval", f"--policy_path={policy}", "--episodes=1", "--seed=3", "--workers=0"]
+    assert main([*evaluation, f"--output={output}"]) == 0, capsys.readouterr().err
+    result = json.loads(output.read_text())
+    assert result["task_names"] == ["reach-v3"], "the suite's tasks default to the policy's"
+    assert result["episodes"] == [1]
+
+    capsys.readouterr()
+    assert main([*evaluation, "--suite.image_size=48"]) == 2
+    err = capsys.readouterr().err
+    assert "'observation.image' of shape (3, 32, 32), the suite gives (3, 48, 48)" in err, err
+
+    assert main([*evaluation, "--suite.tasks=[push-v3]"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "trained on ['reach-v3'], not on ['push-v3']" in err[0], err

@@ -19,9 +19,11 @@ from lerobot.utils.constants import OBS_IMAGES
 
 from lerobot_mtdagger.datasets.checkpoints import load_policy
 from lerobot_mtdagger.policies import TASK_FEATURE, MTDAggerPolicy
+from lerobot_mtdagger.policies.task_conditioning import TaskOneHotProcessorStep
 from lerobot_mtdagger.runner.collect import PolicyFn, run_episodes, success_by_task
 from lerobot_mtdagger.runner.workers import EnvWorkers, Episode
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 from lerobot_mtdagger.utils.seeds import EVAL_STREAM
 
 
@@ -59,23 +61,61 @@ class PolicyRunner:
         """
         return make_runner(*load_policy(path, device, trust_checkpoint))
 
+    @property
+    def task_names(self) -> list[str]:
+        """The tasks the policy was trained on: its task embedding's rows or its one-hot positions."""
+        names = getattr(self.policy.config, "task_names", None)
+        if names:
+            return list(names)
+        for step in getattr(self.preprocessor, "steps", []):
+            if isinstance(step, TaskOneHotProcessorStep):
+                return list(step.task_names)
+        return []
+
+    @property
+    def acts_on_unseen_tasks(self) -> bool:
+        """Whether the policy has an input for a task outside ``task_names``.
+
+        An ``mtdagger`` policy has one only when trained with task dropout (its shared embedding); a
+        LeRobot student's one-hot vector is all zeros for such a task.
+        """
+        if isinstance(self.policy, MTDAggerPolicy):
+            return self.policy.any_task_index is not None
+        return True
+
+    def check_tasks(self, task_names: Sequence[str]) -> None:
+        """Refuses tasks the policy cannot act on (not trained on them and no shared embedding).
+
+        Raises:
+            UserError: Naming the unknown tasks, the policy's tasks and the options to change.
+        """
+        known = self.task_names
+        unknown = [name for name in task_names if name not in known]
+        if unknown and known and not self.acts_on_unseen_tasks:
+            raise UserError(
+                f"The policy was trained on {known}, not on {unknown}: pass --suite.tasks with tasks it "
+                "knows, or evaluate a policy trained with --policy.task_dropout > 0 (its shared embedding "
+                "acts on unseen tasks)."
+            )
+
     def check_inputs(self, suite_features: dict[str, dict[str, Any]], obs_mode: str) -> None:
         """Refuses a suite whose observations do not match the policy's inputs (key and shape).
 
         Raises:
             UserError: Naming the input, both shapes and the option to change.
         """
+        given_features = dataset_to_policy_features(suite_features)  # images channel-first, as trained
         for key in self.input_keys:
-            feature, given = self.policy.config.input_features[key], suite_features.get(key)
+            feature, given = self.policy.config.input_features[key], given_features.get(key)
             if given is None:
                 raise UserError(
                     f"The policy takes {key!r}, which --suite.obs_mode={obs_mode} does not give (it gives "
                     f"{sorted(suite_features)}): pass the obs_mode the policy was trained on."
                 )
-            if tuple(given["shape"]) != tuple(feature.shape):
+            if tuple(given.shape) != tuple(feature.shape):
                 raise UserError(
                     f"The policy takes {key!r} of shape {tuple(feature.shape)}, the suite gives "
-                    f"{tuple(given['shape'])}: pass the obs_mode, image_size or num_points the policy "
+                    f"{tuple(given.shape)}: pass the obs_mode, image_size or num_points the policy "
                     "was trained with."
                 )
 
