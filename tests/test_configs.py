@@ -88,9 +88,21 @@ def test_scheduler_n_min_typed_by_the_user_is_kept_whatever_the_method():
 
 
 def test_python_construction_applies_presets_the_same_way():
-    config = RunConfig(preset="drawers-pointcloud", dagger=DAggerConfig(rounds=1))
+    config = RunConfig(preset="drawers-pointcloud-paper", dagger=DAggerConfig(rounds=1))
     assert config.dagger.rounds == 1 and config.scheduler.n_min == 5 and config.policy.lr == 1e-4
     assert config.dagger.initial_demos == 30 and config.suite.name == "drawers"
+    assert config.suite.num_points == 1024
+
+
+def test_the_cpu_visual_presets_keep_the_papers_rounds_with_less_data_and_compute():
+    for name in ("metaworld-pixels", "drawers-pointcloud"):
+        cpu, paper = RunConfig(preset=name), RunConfig(preset=f"{name}-paper")
+        assert cpu.dagger.rounds == paper.dagger.rounds and cpu.suite.name == paper.suite.name
+        assert cpu.suite.obs_mode == paper.suite.obs_mode
+        assert cpu.dagger.initial_demos < paper.dagger.initial_demos
+        cpu_samples = cpu.training.steps_per_round * cpu.policy.batch_size
+        assert cpu_samples < paper.training.steps_per_round * paper.policy.batch_size
+    assert RunConfig(preset="drawers-pointcloud").suite.num_points == 512
 
 
 def test_bc_is_a_run_mode():

@@ -507,3 +507,18 @@ def test_eval_of_an_rgb_policy_runs_and_a_wrong_image_size_is_named(tmp_path, ca
     assert main([*evaluation, "--suite.tasks=[push-v3]"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "trained on ['reach-v3'], not on ['push-v3']" in err[0], err
+
+
+def test_a_run_of_a_rescaled_preset_resumes_with_its_paper_preset(finished, tmp_path):
+    """``drawers-pointcloud`` and ``metaworld-pixels`` were scaled to a CPU; their former values live on."""
+    older_root = tmp_path / "older-preset"
+    shutil.copytree(finished, older_root)
+    paper = RunConfig(preset="drawers-pointcloud-paper", output_dir=older_root).to_dict()
+    (older_root / "config.json").write_text(json.dumps(paper | {"preset": "drawers-pointcloud"}))
+    experiment = ExperimentDir(older_root)
+    experiment.check_resumable(RunConfig(preset="drawers-pointcloud-paper", output_dir=older_root).to_dict())
+    rescaled = RunConfig(preset="drawers-pointcloud", output_dir=older_root).to_dict()
+    expected = r"dagger.initial_demos: 30 -> 10.*resume it with that preset\)"
+    with pytest.raises(UserError, match=expected) as info:
+        experiment.check_resumable(rescaled)
+    assert "--preset=drawers-pointcloud-paper" in str(info.value)

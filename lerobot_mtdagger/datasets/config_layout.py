@@ -52,6 +52,14 @@ FLAT_OPTION_PATHS: dict[str, str] = {
 """Each option of the flat run config (before the groups) and its path today."""
 
 
+RESCALED_PRESETS: dict[str, str] = {
+    "metaworld-pixels": "metaworld-pixels-paper",
+    "drawers-pointcloud": "drawers-pointcloud-paper",
+}
+"""Presets whose values changed (scaled to a 2-core CPU on 2026-11-26) -> the preset that keeps the
+former values. A stored config holds the values themselves, so only resuming is affected."""
+
+
 def is_flat(config: Mapping[str, Any]) -> bool:
     """Whether ``config`` was stored before the options were grouped (its ``suite`` is a name)."""
     return not isinstance(config.get("suite"), Mapping)

@@ -44,7 +44,7 @@ import pyarrow.parquet as pq
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import update_chunk_file_indices
 
-from lerobot_mtdagger.datasets.config_layout import flatten, migrate_run_config
+from lerobot_mtdagger.datasets.config_layout import RESCALED_PRESETS, flatten, migrate_run_config
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.datasets.records import (
     FORMAT_VERSION,
@@ -113,6 +113,7 @@ def read_committed_json(path: Path, fix: str) -> Any:
 
 
 RESULT_NEUTRAL_OPTIONS: tuple[str, ...] = (
+    "preset",  # a config stores every option the preset filled, resolved: those are compared
     "resume",
     "progress",
     "output_dir",
@@ -270,6 +271,12 @@ class ExperimentDir:
                 )
             elif "suite.placement" in differing and "suite.placement" not in stored:
                 hint = " (drawer runs made before --suite.placement existed used --suite.placement=narrow)"
+            elif self.read_config().get("preset") in RESCALED_PRESETS:
+                name = self.read_config()["preset"]
+                hint = (
+                    f" (a run made before 2026-11-26 with --preset={name} has the values of today's "
+                    f"--preset={RESCALED_PRESETS[name]}: resume it with that preset)"
+                )
             raise UserError(
                 f"Cannot resume {self.root} with a different config ({details}){hint}: resume with "
                 "the stored values, or start a new --output_dir."

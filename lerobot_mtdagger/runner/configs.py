@@ -2,18 +2,24 @@
 
 Every option a preset fills (``PRESET_FIELDS``) has one home, its own field; None there means "from
 the preset" (``--preset``, default ``small``: MT10 state, a few rounds, minutes on a 2-core CPU), so
-a value given on the command line always wins. Presets follow the paper's "Setup" and
-hyperparameter table (n_min is ``scheduler.n_min``; lr and batch are ``policy.lr`` and
-``policy.batch_size``):
+a value given on the command line always wins. The ``*-paper`` presets follow the paper's "Setup"
+and hyperparameter table (n_min is ``scheduler.n_min``; lr and batch are ``policy.lr`` and
+``policy.batch_size``; points is ``suite.num_points``) and are sized for a GPU; ``metaworld-pixels``
+and ``drawers-pointcloud`` keep the paper's rounds and scale the demonstrations, steps and batch down
+to a 2-core CPU (the visual-collapse study's reduced run, ``docs/results/visual-collapse-dev``):
 
-=====================  =========  =============  ===================  =====  ==========  ======
-preset                 obs_mode   initial demos  budget per round      n_min  lr          batch
-=====================  =========  =============  ===================  =====  ==========  ======
-small                  state      3 per task     3 per task            1      3e-4        256
-metaworld-state        state      3 per task     3 per task            1      3e-4        1024
-metaworld-pixels       rgb        40 per task    20 per task           1      3e-4        1024
-drawers-pointcloud     pointcloud 30 per task    30 per task           5      1e-4        256
-=====================  =========  =============  ===================  =====  ==========  ======
+=========================  ==========  ======  =======  ==========  =====  =====  ====  =====  ======
+preset                     obs_mode    rounds  initial  per round   steps  n_min  lr    batch  points
+=========================  ==========  ======  =======  ==========  =====  =====  ====  =====  ======
+small                      state       3       3        3           1500   1      3e-4  256
+metaworld-state            state       10      3        3           3000   1      3e-4  1024
+metaworld-pixels           rgb         5       10       10          1500   2      3e-4  64
+metaworld-pixels-paper     rgb         5       40       20          3000   1      3e-4  1024
+drawers-pointcloud         pointcloud  10      10       5           1500   2      3e-4  64     512
+drawers-pointcloud-paper   pointcloud  10      30       30          3000   5      1e-4  256    1024
+=========================  ==========  ======  =======  ==========  =====  =====  ====  =====  ======
+
+(initial and per round: expert demonstrations per task; steps: ``training.steps_per_round``.)
 
 The DAgger mixing coefficient ``beta`` is the probability that the EXPERT's action is executed at
 a step (classic DAgger; the paper's text is ambiguous): 0.5 in the first DAgger round, decayed by
@@ -32,7 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
-from lerobot_mtdagger.envs.config import SuiteConfig
+from lerobot_mtdagger.envs.config import DEFAULT_NUM_POINTS, SuiteConfig
 from lerobot_mtdagger.envs.drawers.variants import LEGACY_PLACEMENT
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
 from lerobot_mtdagger.utils.parsing import cache_dataclass_sources
@@ -190,6 +196,7 @@ PRESETS: dict[str, dict[str, Any]] = {
     "small": {
         "suite.name": "metaworld-mt10",
         "suite.obs_mode": "state",
+        "suite.num_points": DEFAULT_NUM_POINTS,
         "dagger.rounds": 3,
         "dagger.initial_demos": 3,
         "dagger.budget_per_task": 3,
@@ -202,6 +209,7 @@ PRESETS: dict[str, dict[str, Any]] = {
     "metaworld-state": {
         "suite.name": "metaworld-mt50",
         "suite.obs_mode": "state",
+        "suite.num_points": DEFAULT_NUM_POINTS,
         "dagger.rounds": 10,
         "dagger.initial_demos": 3,
         "dagger.budget_per_task": 3,
@@ -214,6 +222,20 @@ PRESETS: dict[str, dict[str, Any]] = {
     "metaworld-pixels": {
         "suite.name": "metaworld-mt10",
         "suite.obs_mode": "rgb",
+        "suite.num_points": DEFAULT_NUM_POINTS,
+        "dagger.rounds": 5,
+        "dagger.initial_demos": 10,
+        "dagger.budget_per_task": 10,
+        "training.steps_per_round": 1500,
+        "rollout.eval_episodes": 5,
+        "scheduler.n_min": 2,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 64,
+    },
+    "metaworld-pixels-paper": {
+        "suite.name": "metaworld-mt10",
+        "suite.obs_mode": "rgb",
+        "suite.num_points": DEFAULT_NUM_POINTS,
         "dagger.rounds": 5,
         "dagger.initial_demos": 40,
         "dagger.budget_per_task": 20,
@@ -226,6 +248,20 @@ PRESETS: dict[str, dict[str, Any]] = {
     "drawers-pointcloud": {
         "suite.name": "drawers",
         "suite.obs_mode": "pointcloud",
+        "suite.num_points": 512,
+        "dagger.rounds": 10,
+        "dagger.initial_demos": 10,
+        "dagger.budget_per_task": 5,
+        "training.steps_per_round": 1500,
+        "rollout.eval_episodes": 5,
+        "scheduler.n_min": 2,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 64,
+    },
+    "drawers-pointcloud-paper": {
+        "suite.name": "drawers",
+        "suite.obs_mode": "pointcloud",
+        "suite.num_points": DEFAULT_NUM_POINTS,
         "dagger.rounds": 10,
         "dagger.initial_demos": 30,
         "dagger.budget_per_task": 30,
