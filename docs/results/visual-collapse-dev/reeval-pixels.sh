@@ -31,5 +31,7 @@ evaluate() {
 }
 export -f evaluate
 export OUT
-ls -d outputs/visual-dev/{pixels,pixels-balanced}-seed10{0,1,2}/policies/round-00{0,1,2} 2>/dev/null \
-  | xargs -P "${JOBS:-1}" -I{} bash -c 'evaluate {}'
+# The primary outcome's policies (uniform sampling) first, then balanced sampling's.
+for name in pixels pixels-balanced; do
+  ls -d outputs/visual-dev/$name-seed10{0,1,2}/policies/round-00{0,1,2} 2>/dev/null || true
+done | xargs -P "${JOBS:-1}" -I{} bash -c 'evaluate {}'
