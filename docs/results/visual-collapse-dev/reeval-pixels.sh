@@ -25,9 +25,9 @@ evaluate() {
   [ -f "$target" ] && return 0
   echo "$(date -u +%H:%M:%S) start $run $round"
   PYTHONPATH=$PWD OMP_NUM_THREADS=1 MUJOCO_GL=egl .venv/bin/python -m lerobot_mtdagger.cli eval --policy_path="$policy" \
-    --suite.name=metaworld-mt10 --episodes=20 --seed=9000 --workers=0 --output="$target.partial" > /dev/null
-  mv "$target.partial" "$target"
-  echo "$(date -u +%H:%M:%S) done $run $round"
+    --suite.name=metaworld-mt10 --episodes=20 --seed=9000 --workers=0 --output="$target.partial" > /dev/null \
+    && mv "$target.partial" "$target" && echo "$(date -u +%H:%M:%S) done $run $round" \
+    || echo "$(date -u +%H:%M:%S) FAILED $run $round"
 }
 export -f evaluate
 export OUT
