@@ -13,6 +13,8 @@
 #   git worktree add --detach ../study-code-reeval a4bae9a; cd ../study-code-reeval
 #   ln -sf ../main/.venv .venv && ln -sfn ../main/outputs outputs
 #   JOBS=2 nohup bash ../main/docs/results/visual-collapse-dev/reeval-pixels.sh >> outputs/reeval-pixels.log 2>&1 &
+# (A second instance with REVERSE=1 takes the list from its end, beside a first one; an evaluation in
+# progress leaves NAME.json.partial, which both skip: delete stale .partial files after a kill.)
 set -euo pipefail
 OUT=outputs/visual-dev/reeval
 mkdir -p "$OUT"
@@ -23,6 +25,7 @@ evaluate() {
   round=$(basename "$policy")
   target="$OUT/$run-$round.json"
   [ -f "$target" ] && return 0
+  [ -f "$target.partial" ] && return 0  # being evaluated by another instance (delete stale ones first)
   echo "$(date -u +%H:%M:%S) start $run $round"
   PYTHONPATH=$PWD OMP_NUM_THREADS=1 MUJOCO_GL=egl .venv/bin/python -m lerobot_mtdagger.cli eval --policy_path="$policy" \
     --suite.name=metaworld-mt10 --episodes=20 --seed=9000 --workers=0 --output="$target.partial" > /dev/null \
@@ -34,4 +37,4 @@ export OUT
 # The primary outcome's policies (uniform sampling) first, then balanced sampling's.
 for name in pixels pixels-balanced; do
   ls -d outputs/visual-dev/$name-seed10{0,1,2}/policies/round-00{0,1,2} 2>/dev/null || true
-done | xargs -P "${JOBS:-1}" -I{} bash -c 'evaluate {}'
+done | if [ -n "${REVERSE:-}" ]; then tac; else cat; fi | xargs -P "${JOBS:-1}" -I{} bash -c 'evaluate {}'
