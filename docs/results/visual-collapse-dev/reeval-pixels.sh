@@ -27,6 +27,7 @@ evaluate() {
   [ -f "$target" ] && return 0
   [ -f "$target.partial" ] && return 0  # being evaluated by another instance (delete stale ones first)
   echo "$(date -u +%H:%M:%S) start $run $round"
+  touch "$target.partial"  # marks the evaluation as in progress (eval writes the file only at its end)
   PYTHONPATH=$PWD OMP_NUM_THREADS=1 MUJOCO_GL=egl .venv/bin/python -m lerobot_mtdagger.cli eval --policy_path="$policy" \
     --suite.name=metaworld-mt10 --episodes=20 --seed=9000 --workers=0 --output="$target.partial" > /dev/null \
     && mv "$target.partial" "$target" && echo "$(date -u +%H:%M:%S) done $run $round" \
