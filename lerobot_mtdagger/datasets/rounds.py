@@ -255,7 +255,8 @@ class ExperimentDir:
             raise NotAnExperimentError(
                 f"Nothing to resume: {self.root} does not exist (drop --resume to start)."
             )
-        stored = result_options(self.read_config(), ignore)
+        stored_config = self.read_config()
+        stored = result_options(stored_config, ignore)
         given = result_options(config, ignore)
         fill_added_options(stored, given, added_defaults or {})
         if adds_dagger_rounds(stored, given):
@@ -271,8 +272,8 @@ class ExperimentDir:
                 )
             elif "suite.placement" in differing and "suite.placement" not in stored:
                 hint = " (drawer runs made before --suite.placement existed used --suite.placement=narrow)"
-            elif self.read_config().get("preset") in RESCALED_PRESETS:
-                name = self.read_config()["preset"]
+            elif stored_config.get("preset") in RESCALED_PRESETS:
+                name = stored_config["preset"]
                 hint = (
                     f" (a run made before 2026-11-26 with --preset={name} has the values of today's "
                     f"--preset={RESCALED_PRESETS[name]}: resume it with that preset)"
