@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Copies the small JSON records of each run (round records, phase records) from outputs/visual-dev/
-# into records/<run>/ here, so the numbers outlive outputs/ (not in git). Run from the repository root.
+# into records/<run>/ here, with the run's rounds_summary.py table, so the numbers outlive outputs/ (not
+# in git); rounds_summary.txt joins the tables of every run in records/. Run from the repository root.
 set -euo pipefail
 HERE=docs/results/visual-collapse-dev
 for RUN in outputs/visual-dev/*-seed*/; do
@@ -15,5 +16,12 @@ for RUN in outputs/visual-dev/*-seed*/; do
     mkdir -p "$HERE/records/$NAME/policies/$(basename "$K")"
     cp "$K/training.json" "$HERE/records/$NAME/policies/$(basename "$K")/training.json"
   done
+  # This run's table, kept beside its records: the joined file below also keeps the runs whose
+  # outputs/ are gone (a new checkout has none).
+  .venv/bin/python "$HERE/rounds_summary.py" "outputs/visual-dev/$NAME" | sed -e '1{/^$/d}' \
+    > "$HERE/records/$NAME/rounds_summary.txt"
 done
-.venv/bin/python "$HERE/rounds_summary.py" outputs/visual-dev/*-seed*/ > "$HERE/rounds_summary.txt"
+for SUMMARY in "$HERE"/records/*/rounds_summary.txt; do
+  echo
+  cat "$SUMMARY"
+done > "$HERE/rounds_summary.txt"
