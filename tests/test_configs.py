@@ -23,7 +23,7 @@ from lerobot_mtdagger.datasets.config_layout import (
 )
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
-from lerobot_mtdagger.runner.configs import PRESET_FIELDS, PRESETS, DAggerConfig, RunConfig
+from lerobot_mtdagger.runner.configs import PRESET_FIELDS, PRESETS, DAggerConfig, RunConfig, TrainingConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.studies.results import results_rows
 from lerobot_mtdagger.utils import parsing
@@ -47,9 +47,17 @@ def another_value(path: str, value):
         return "drawers" if value != "drawers" else "metaworld-mt25"
     if path == "suite.obs_mode":
         return "rgb" if value != "rgb" else "state"
+    if path == "training.sampling":
+        return "balanced" if value != "balanced" else "uniform"
     if isinstance(value, float):
         return value * 3
     return value + 2
+
+
+def preset_values(preset: str, mode: str = "dagger") -> dict:
+    """What ``preset`` fills in a run of ``mode`` (a mapping value is keyed by the run mode)."""
+    values = PRESETS[preset].items()
+    return {path: value[mode] if isinstance(value, dict) else value for path, value in values}
 
 
 def test_every_preset_fills_the_same_options():
@@ -58,19 +66,20 @@ def test_every_preset_fills_the_same_options():
 
 @pytest.mark.parametrize("preset", list(PRESETS))
 def test_presets_fill_every_option_left_unset(preset):
-    config = parse(f"--preset={preset}")
-    assert {path: value_of(config, path) for path in PRESET_FIELDS} == PRESETS[preset]
+    for mode in ("dagger", "bc"):
+        config = parse(f"--preset={preset}", f"--mode={mode}")
+        assert {path: value_of(config, path) for path in PRESET_FIELDS} == preset_values(preset, mode)
 
 
 @pytest.mark.parametrize("index", range(len(PRESET_FIELDS)))
 def test_a_command_line_value_wins_over_the_preset(index):
     path = PRESET_FIELDS[index]
     preset = list(PRESETS)[index % len(PRESETS)]  # every field once, every preset in turn
-    wanted = another_value(path, PRESETS[preset][path])
+    wanted = another_value(path, preset_values(preset)[path])
     config = parse(f"--preset={preset}", f"--{path}={wanted}")
     assert value_of(config, path) == wanted
     others = {p: value_of(config, p) for p in PRESET_FIELDS if p != path}
-    assert others == {p: v for p, v in PRESETS[preset].items() if p != path}
+    assert others == {p: v for p, v in preset_values(preset).items() if p != path}
 
 
 @pytest.mark.parametrize("preset", list(PRESETS))
@@ -103,6 +112,18 @@ def test_the_cpu_visual_presets_keep_the_papers_rounds_with_less_data_and_comput
         cpu_samples = cpu.training.steps_per_round * cpu.policy.batch_size
         assert cpu_samples < paper.training.steps_per_round * paper.policy.batch_size
     assert RunConfig(preset="drawers-pointcloud").suite.num_points == 512
+
+
+def test_presets_sample_uniformly_except_pixel_dagger_runs_and_an_explicit_choice_wins():
+    assert RunConfig(preset="metaworld-pixels").training.sampling == "balanced"
+    assert RunConfig(preset="metaworld-pixels", mode="bc").training.sampling == "uniform"
+    for name in ("small", "metaworld-state", "metaworld-pixels-paper", "drawers-pointcloud"):
+        assert RunConfig(preset=name).training.sampling == "uniform", name
+    assert parse("--preset=metaworld-pixels", "--training.sampling=uniform").training.sampling == "uniform"
+    bc_balanced = parse("--preset=metaworld-pixels", "--mode=bc", "--training.sampling=balanced")
+    assert bc_balanced.training.sampling == "balanced"
+    with pytest.raises(ValueError, match=r"training.sampling must be one of \['uniform', 'balanced'\]"):
+        RunConfig(preset="metaworld-pixels", training=TrainingConfig(sampling="per-task"))
 
 
 def test_bc_is_a_run_mode():

@@ -22,7 +22,7 @@ from lerobot_mtdagger.datasets.checkpoints import UntrustedCheckpointError
 from lerobot_mtdagger.datasets.rounds import LOCK_FILE, ExperimentDir, ExperimentLockedError
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.runner import dagger as dagger_module
-from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.configs import RunConfig, TrainingConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
@@ -331,6 +331,23 @@ def test_a_drawer_run_made_before_placements_existed_resumes_only_with_the_narro
         experiment.check_resumable(given, added_defaults=defaults)
 
 
+def test_a_run_made_before_sampling_existed_resumes_with_uniform_sampling(finished, tmp_path):
+    """Before ``training.sampling`` existed every batch was drawn uniformly over frames."""
+    older_root = tmp_path / "older-sampling"
+    shutil.copytree(finished, older_root)
+    older = json.loads((older_root / "config.json").read_text())
+    del older["training"]["sampling"]
+    (older_root / "config.json").write_text(json.dumps(older))
+    experiment = ExperimentDir(older_root)
+    defaults = RunConfig.option_defaults()
+    given = copy.deepcopy(older)
+    given["training"]["sampling"] = "uniform"
+    experiment.check_resumable(given, added_defaults=defaults)
+    given["training"]["sampling"] = "balanced"
+    with pytest.raises(UserError, match=r"training.sampling: None -> 'balanced'"):
+        experiment.check_resumable(given, added_defaults=defaults)
+
+
 def test_resume_refuses_a_policy_changed_after_commit_that_still_loads(finished, tmp_path):
     copy = damaged_copy(finished, tmp_path, nudge_weights)
     with pytest.raises(CorruptExperimentError, match=r"policies/round-001.*model.safetensors"):
@@ -522,3 +539,24 @@ def test_a_run_of_a_rescaled_preset_resumes_with_its_paper_preset(finished, tmp_
     with pytest.raises(UserError, match=expected) as info:
         experiment.check_resumable(rescaled)
     assert "--preset=drawers-pointcloud-paper" in str(info.value)
+
+
+def test_a_pixel_run_made_before_balanced_sampling_is_told_to_add_uniform(finished, tmp_path):
+    """``metaworld-pixels``' DAgger runs sample balanced since 2026-11-26; older runs resume uniform."""
+    older_root = tmp_path / "older-pixels"
+    shutil.copytree(finished, older_root)
+    uniform = TrainingConfig(sampling="uniform")
+    before = RunConfig(preset="metaworld-pixels", training=uniform, output_dir=older_root).to_dict()
+    (older_root / "config.json").write_text(json.dumps(before))
+    experiment = ExperimentDir(older_root)
+    experiment.check_resumable(before)
+    today = RunConfig(preset="metaworld-pixels", output_dir=older_root).to_dict()
+    with pytest.raises(UserError) as info:
+        experiment.check_resumable(today)
+    message = str(info.value)
+    assert "training.sampling: 'uniform' -> 'balanced'" in message, message
+    assert "used --training.sampling=uniform: add it" in message and "-paper" not in message, message
+    paper_values = RunConfig(preset="metaworld-pixels-paper", output_dir=older_root).to_dict()
+    (older_root / "config.json").write_text(json.dumps(paper_values | {"preset": "metaworld-pixels"}))
+    with pytest.raises(UserError, match=r"resume it with that preset\)"):
+        experiment.check_resumable(today)

@@ -59,6 +59,29 @@ RESCALED_PRESETS: dict[str, str] = {
 """Presets whose values changed (scaled to a 2-core CPU on 2026-11-26) -> the preset that keeps the
 former values. A stored config holds the values themselves, so only resuming is affected."""
 
+PRESET_VALUE_CHANGES: dict[str, dict[str, Any]] = {
+    "metaworld-pixels": {"training.sampling": "uniform"},
+}
+"""Options a preset set differently later (after its rescaling) -> the value runs made before had:
+``metaworld-pixels``' DAgger runs sample ``balanced`` since 2026-11-26 (a resume names the fix)."""
+
+
+def later_preset_values(preset: str | None, differing: list[str]) -> dict[str, Any]:
+    """The former values of ``preset`` when they explain every differing option, else empty.
+
+    Args:
+        preset: The preset a stored run config names (None for a config without one).
+        differing: Dotted paths of the options where the stored and the given config differ.
+
+    Returns:
+        ``PRESET_VALUE_CHANGES[preset]`` restricted to ``differing`` when every differing option
+        is one the preset changed, else ``{}``.
+    """
+    changed = PRESET_VALUE_CHANGES.get(preset or "", {})
+    if not differing or not set(differing) <= set(changed):
+        return {}
+    return {key: changed[key] for key in differing}
+
 
 def is_flat(config: Mapping[str, Any]) -> bool:
     """Whether ``config`` was stored before the options were grouped (its ``suite`` is a name)."""

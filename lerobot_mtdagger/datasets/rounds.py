@@ -44,7 +44,12 @@ import pyarrow.parquet as pq
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import update_chunk_file_indices
 
-from lerobot_mtdagger.datasets.config_layout import RESCALED_PRESETS, flatten, migrate_run_config
+from lerobot_mtdagger.datasets.config_layout import (
+    RESCALED_PRESETS,
+    flatten,
+    later_preset_values,
+    migrate_run_config,
+)
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.datasets.records import (
     FORMAT_VERSION,
@@ -272,6 +277,10 @@ class ExperimentDir:
                 )
             elif "suite.placement" in differing and "suite.placement" not in stored:
                 hint = " (drawer runs made before --suite.placement existed used --suite.placement=narrow)"
+            elif changed := later_preset_values(stored_config.get("preset"), differing):
+                name = stored_config["preset"]
+                options = " ".join(f"--{key}={value}" for key, value in changed.items())
+                hint = f" (a run made before 2026-11-26 with --preset={name} used {options}: add it)"
             elif stored_config.get("preset") in RESCALED_PRESETS:
                 name = stored_config["preset"]
                 hint = (

@@ -19,7 +19,9 @@ drawers-pointcloud         pointcloud  10      10       5           1500   2    
 drawers-pointcloud-paper   pointcloud  10      30       30          3000   5      1e-4  256    1024
 =========================  ==========  ======  =======  ==========  =====  =====  ====  =====  ======
 
-(initial and per round: expert demonstrations per task; steps: ``training.steps_per_round``.)
+(initial and per round: expert demonstrations per task; steps: ``training.steps_per_round``. Every
+preset samples batches ``uniform``ly except ``metaworld-pixels``, whose DAgger runs sample
+``balanced``: ``PIXELS_SAMPLING``.)
 
 The DAgger mixing coefficient ``beta`` is the probability that the EXPERT's action is executed at
 a step (classic DAgger; the paper's text is ambiguous): 0.5 in the first DAgger round, decayed by
@@ -192,6 +194,13 @@ WORKER_BACKENDS: tuple[str, ...] = ("local", "ray")
 GAIN_SPLITS: tuple[str, ...] = ("train", "heldout")
 """Where the performance-gain scheduler measures per-task loss: the training data or held-out episodes."""
 
+PIXELS_SAMPLING: dict[str, str] = {"dagger": "balanced", "bc": "uniform"}
+"""``metaworld-pixels``' batch sampling by run mode, chosen on development seeds 100-102 (200
+evaluation episodes per phase, ``docs/results/visual-collapse-dev`` 6c): with uniform sampling the
+DAgger rounds lowered success (0.680 -> 0.678 -> 0.630), with balanced sampling they raised it (0.627
+-> 0.678 -> 0.685); BC on round 0's demonstrations did better with uniform sampling (0.680 against
+0.627)."""
+
 PRESETS: dict[str, dict[str, Any]] = {
     "small": {
         "suite.name": "metaworld-mt10",
@@ -205,6 +214,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "scheduler.n_min": 1,
         "policy.lr": 3e-4,
         "policy.batch_size": 256,
+        "training.sampling": "uniform",
     },
     "metaworld-state": {
         "suite.name": "metaworld-mt50",
@@ -218,6 +228,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "scheduler.n_min": 1,
         "policy.lr": 3e-4,
         "policy.batch_size": 1024,
+        "training.sampling": "uniform",
     },
     "metaworld-pixels": {
         "suite.name": "metaworld-mt10",
@@ -231,6 +242,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "scheduler.n_min": 2,
         "policy.lr": 3e-4,
         "policy.batch_size": 64,
+        "training.sampling": PIXELS_SAMPLING,
     },
     "metaworld-pixels-paper": {
         "suite.name": "metaworld-mt10",
@@ -244,6 +256,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "scheduler.n_min": 1,
         "policy.lr": 3e-4,
         "policy.batch_size": 1024,
+        "training.sampling": "uniform",
     },
     "drawers-pointcloud": {
         "suite.name": "drawers",
@@ -257,6 +270,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "scheduler.n_min": 2,
         "policy.lr": 3e-4,
         "policy.batch_size": 64,
+        "training.sampling": "uniform",
     },
     "drawers-pointcloud-paper": {
         "suite.name": "drawers",
@@ -270,11 +284,12 @@ PRESETS: dict[str, dict[str, Any]] = {
         "scheduler.n_min": 5,
         "policy.lr": 1e-4,
         "policy.batch_size": 256,
+        "training.sampling": "uniform",
     },
 }
 """Preset values by option path (the command-line spelling without ``--``). Each option filled by a
 preset has ONE home: its field (None there means "from the preset"); a value given on the command
-line or in Python always wins."""
+line or in Python always wins. A value that is a mapping is keyed by ``RunConfig.mode``."""
 
 PRESET_FIELDS: tuple[str, ...] = tuple(PRESETS["small"])
 """The options every preset fills."""
@@ -417,7 +432,7 @@ class TrainingConfig:
         normalisation: ``fixed`` (statistics of round 0's training frames for every phase: a warm
             start sees inputs normalised as before) or ``recompute`` (statistics of D(k) each phase).
         sampling: ``uniform`` (frames uniformly) or ``balanced`` (a task uniformly, then one of its
-            frames).
+            frames); None: from the preset (``uniform`` except ``metaworld-pixels``' DAgger runs).
         lr_schedule: ``constant`` or ``cosine`` (the ``mtdagger`` policy's learning rate decayed to 0
             over each phase's steps; a LeRobot student follows its config's scheduler preset).
         gain_split: ``train`` (per-task loss on the training data) or ``heldout`` (on held-out episodes).
@@ -434,7 +449,7 @@ class TrainingConfig:
     plateau_patience: int = 5
     plateau_max_steps: int = 20_000
     normalisation: str = "fixed"
-    sampling: str = "uniform"
+    sampling: str | None = None
     lr_schedule: str = "constant"
     gain_split: str = "train"
     heldout_fraction: float = 0.2
@@ -514,7 +529,7 @@ class RunConfig:
             if not hasattr(owner, name):  # policy.lr: a LeRobot student's is its optimizer_lr
                 continue
             if getattr(owner, name) is None:
-                setattr(owner, name, value)
+                setattr(owner, name, value[self.mode] if isinstance(value, Mapping) else value)
         if self.output_dir is None:
             self.output_dir = Path("outputs") / "mtdagger" / f"{self.preset}-{self.method}-seed{self.seed}"
         self.suite.fill_defaults()
@@ -602,8 +617,9 @@ class RunConfig:
     def option_defaults(cls) -> dict[str, Any]:
         """What each option was before it existed, by dotted path (e.g. ``training.plateau_every: 200``).
 
-        Its plain default, except ``suite.placement``: drawer runs made before it existed used
-        ``narrow``. Policy options are those of ``mtdagger`` (the only student then).
+        Its plain default, except ``suite.placement`` (drawer runs made before it existed used
+        ``narrow``) and ``training.sampling`` (``uniform`` before presets filled it). Policy options
+        are those of ``mtdagger`` (the only student then).
         """
         defaults: dict[str, Any] = {}
         for group, options in (
@@ -617,7 +633,7 @@ class RunConfig:
                 if option.default is not dataclasses.MISSING:
                     defaults[f"{group}.{option.name}"] = option.default
         top = {f.name: f.default for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
-        return top | defaults | {"suite.placement": LEGACY_PLACEMENT}
+        return top | defaults | {"suite.placement": LEGACY_PLACEMENT, "training.sampling": "uniform"}
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (stored in every round's record; ``migrate_run_config``'s layout)."""
