@@ -316,6 +316,8 @@ def test_a_checkpoint_written_before_encoders_were_keyed_by_input_still_loads():
     policy = MTDAggerPolicy.from_pretrained(LEGACY)
     assert set(policy.encoders) == {"observation_state", "observation_image", "observation_pointcloud"}
     expected = torch.load(LEGACY / "expected_actions.pt")
+    # Not bit-exact across CPUs (another machine's kernels differ by ~1e-8); a weight left at its
+    # initial value or loaded into the wrong encoder moves the actions by ~0.1.
     torch.testing.assert_close(
-        policy.select_action(dict(expected["batch"])), expected["actions"], rtol=0, atol=0
+        policy.select_action(dict(expected["batch"])), expected["actions"], rtol=0, atol=1e-5
     )
