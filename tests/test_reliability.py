@@ -313,39 +313,45 @@ def test_a_run_made_before_an_option_existed_resumes_with_its_default(finished, 
         run(toy_config(older_root, "--dagger.rounds=1", "--resume=true", "--policy.pointnet_layer_norm=true"))
 
 
+def older_run_without(finished: Path, root: Path, path: str, **changes: str) -> tuple[ExperimentDir, dict]:
+    """A copy of ``finished`` whose stored config lacks option ``path`` (a run made before it existed).
+
+    ``changes`` set other stored options first (``group="value"``, e.g. ``suite_name="drawers"``).
+    """
+    shutil.copytree(finished, root)
+    older = json.loads((root / "config.json").read_text())
+    for key, value in changes.items():
+        group, name = key.split("_", 1)
+        older[group][name] = value
+    group, name = path.split(".")
+    del older[group][name]
+    (root / "config.json").write_text(json.dumps(older))
+    return ExperimentDir(root), older
+
+
+def resume_with(experiment: ExperimentDir, older: dict, path: str, value: str) -> None:
+    """``check_resumable`` with the stored config plus ``path`` given as ``value``."""
+    given = copy.deepcopy(older)
+    group, name = path.split(".")
+    given[group][name] = value
+    experiment.check_resumable(given, added_defaults=RunConfig.option_defaults())
+
+
 def test_a_drawer_run_made_before_placements_existed_resumes_only_with_the_narrow_one(finished, tmp_path):
     """Those runs used today's ``narrow`` ranges; resuming them with the new default would mix settings."""
-    older_root = tmp_path / "older-drawers"
-    shutil.copytree(finished, older_root)
-    older = json.loads((older_root / "config.json").read_text())
-    older["suite"]["name"] = "drawers"
-    del older["suite"]["placement"]
-    (older_root / "config.json").write_text(json.dumps(older))
-    experiment = ExperimentDir(older_root)
-    defaults = RunConfig.option_defaults()
-    given = copy.deepcopy(older)
-    given["suite"]["placement"] = "narrow"
-    experiment.check_resumable(given, added_defaults=defaults)
-    given["suite"]["placement"] = "kitchen"
+    root = tmp_path / "older-drawers"
+    experiment, older = older_run_without(finished, root, "suite.placement", suite_name="drawers")
+    resume_with(experiment, older, "suite.placement", "narrow")
     with pytest.raises(UserError, match=r"suite.placement: None -> 'kitchen'\) \(drawer runs made before"):
-        experiment.check_resumable(given, added_defaults=defaults)
+        resume_with(experiment, older, "suite.placement", "kitchen")
 
 
 def test_a_run_made_before_sampling_existed_resumes_with_uniform_sampling(finished, tmp_path):
     """Before ``training.sampling`` existed every batch was drawn uniformly over frames."""
-    older_root = tmp_path / "older-sampling"
-    shutil.copytree(finished, older_root)
-    older = json.loads((older_root / "config.json").read_text())
-    del older["training"]["sampling"]
-    (older_root / "config.json").write_text(json.dumps(older))
-    experiment = ExperimentDir(older_root)
-    defaults = RunConfig.option_defaults()
-    given = copy.deepcopy(older)
-    given["training"]["sampling"] = "uniform"
-    experiment.check_resumable(given, added_defaults=defaults)
-    given["training"]["sampling"] = "balanced"
+    experiment, older = older_run_without(finished, tmp_path / "older-sampling", "training.sampling")
+    resume_with(experiment, older, "training.sampling", "uniform")
     with pytest.raises(UserError, match=r"training.sampling: None -> 'balanced'"):
-        experiment.check_resumable(given, added_defaults=defaults)
+        resume_with(experiment, older, "training.sampling", "balanced")
 
 
 def test_resume_refuses_a_policy_changed_after_commit_that_still_loads(finished, tmp_path):
