@@ -5,10 +5,11 @@ imitation loss at the start and at the end of the phase, on the training data it
 split of episodes; the gain is ``max(0, L_start - L_end)`` per task.
 
 Committed rounds are immutable, so a run reads each one once (``load_round``, straight from the
-dataset's parquet files) and keeps it in memory; a phase concatenates them (``TrainingData.concat``)
-and normalises the frames with LeRobot's own pre-processor built from their statistics, the same
-processor that is saved with the checkpoint; so what we train, what we roll out and what
-``lerobot-eval`` loads agree.
+dataset's parquet files) and keeps it in memory; a phase joins them (``TrainingData.concat``: the
+vectors concatenated, the images and point clouds left in their rounds as ``FrameParts``, so the
+largest inputs are held once) and normalises the frames with LeRobot's own pre-processor built from
+their statistics, the same processor that is saved with the checkpoint; so what we train, what we
+roll out and what ``lerobot-eval`` loads agree.
 
 The training loop is lean: tasks are indices mapped once, the loss is the policy's
 ``imitation_loss`` and the loss history stays on the device until a log interval.
@@ -39,6 +40,7 @@ from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE
 from lerobot_mtdagger.runner.configs import UNSEEN_TASK_DROPOUT, PolicyOptions, RunConfig
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.frame_parts import FrameParts, FrameTensor, join_frames, materialise
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 from lerobot_mtdagger.utils.sampling import systematic_picks
@@ -47,6 +49,16 @@ from lerobot_mtdagger.utils.seeds import HELDOUT_STREAM, TRAINING_STREAM, stream
 logger = logging.getLogger(__name__)
 
 LOSS_SAMPLES_PER_TASK = 1024
+
+STATS_CHUNK = 8192
+"""Frames read at a time for the normalisation statistics."""
+
+MEASURE_CHUNK = 4096
+"""Frames per forward pass when measuring per-task losses on vector inputs."""
+
+MEASURE_CHUNK_VISUAL = 256
+"""The same with an image or point-cloud input: 4 096 frames of 84 px RGB made about 3 GB of float
+images and convolution activations at once (the pixel run's peak memory)."""
 
 LOG_INTERVAL = 100
 """Steps between two syncs of the training loss (finiteness check, progress callback, debug log)."""
@@ -64,12 +76,13 @@ class TrainingData:
 
     Attributes:
         inputs: Observation tensors by feature key; images stay uint8 (N, H, W, 3), the rest float32.
+            Images and point clouds of several rounds are ``FrameParts`` (indexed like one tensor).
         action: Expert labels, (N, action_dim) float32.
         task_index: (N,) int64.
         episode_id: (N,) int64, unique per (round, episode).
     """
 
-    inputs: dict[str, torch.Tensor]
+    inputs: dict[str, FrameTensor]
     action: torch.Tensor
     task_index: torch.Tensor
     episode_id: torch.Tensor
@@ -90,6 +103,9 @@ class TrainingData:
     def concat(parts: Sequence[TrainingData]) -> TrainingData:
         """The frames of ``parts`` one after the other (e.g. rounds loaded once and kept in memory).
 
+        Vectors (one row per frame) are concatenated; inputs with more dimensions (images, point
+        clouds) are joined without a copy (``join_frames``): a phase holds its rounds' images once.
+
         Raises:
             ValueError: If ``parts`` is empty or the parts hold different input keys.
         """
@@ -100,11 +116,24 @@ class TrainingData:
             if set(part.inputs) != set(keys):
                 raise ValueError(f"Cannot concatenate inputs {sorted(part.inputs)} with {sorted(keys)}.")
         return TrainingData(
-            inputs={k: torch.cat([p.inputs[k] for p in parts]) for k in keys},
+            inputs={k: _join_input([p.inputs[k] for p in parts]) for k in keys},
             action=torch.cat([p.action for p in parts]),
             task_index=torch.cat([p.task_index for p in parts]),
             episode_id=torch.cat([p.episode_id for p in parts]),
         )
+
+
+def _join_input(tensors: Sequence[FrameTensor]) -> FrameTensor:
+    """One input of several parts: vectors concatenated, images and point clouds as ``FrameParts``."""
+    if len(tensors[0].shape) <= 2:
+        return torch.cat([materialise(tensor) for tensor in tensors])
+    pieces = [piece for tensor in tensors for piece in _pieces(tensor)]
+    return join_frames(pieces)
+
+
+def _pieces(tensor: FrameTensor) -> list[torch.Tensor]:
+    """The tensors ``tensor`` is made of (itself, or the parts of a ``FrameParts``)."""
+    return list(tensor.parts) if isinstance(tensor, FrameParts) else [tensor]
 
 
 def load_round(root: Path, round_position: int, input_keys: Sequence[str]) -> TrainingData:
@@ -199,19 +228,51 @@ def load_rounds(roots: Sequence[Path], input_keys: Sequence[str]) -> TrainingDat
     return TrainingData.concat([load_round(root, i, input_keys) for i, root in enumerate(roots)])
 
 
-def compute_stats(data: TrainingData, image_keys: Sequence[str]) -> dict[str, dict[str, np.ndarray]]:
-    """Mean/std/min/max of the vector inputs and the action (point clouds per channel)."""
-    stats = {}
+def compute_stats(
+    data: TrainingData, image_keys: Sequence[str], index: torch.Tensor | None = None
+) -> dict[str, dict[str, np.ndarray]]:
+    """Mean/std/min/max of the vector inputs and the action (point clouds per channel).
+
+    Args:
+        data: The frames.
+        image_keys: Inputs without statistics (never read, so never copied).
+        index: The frames the statistics come from (None: all).
+    """
+    frames = torch.arange(len(data)) if index is None else index
     tensors = {k: v for k, v in data.inputs.items() if k not in image_keys} | {"action": data.action}
-    for key, tensor in tensors.items():
-        flat = tensor.reshape(-1, tensor.shape[-1]).double()
-        stats[key] = {
-            "mean": flat.mean(0).float().numpy(),
-            "std": flat.std(0, unbiased=False).float().numpy(),
-            "min": flat.min(0).values.float().numpy(),
-            "max": flat.max(0).values.float().numpy(),
-        }
-    return stats
+    return {key: channel_stats(tensor, frames) for key, tensor in tensors.items()}
+
+
+def channel_stats(tensor: FrameTensor, frames: torch.Tensor) -> dict[str, np.ndarray]:
+    """Mean/std/min/max over the last axis' channels of ``tensor[frames]``, in float64 then float32.
+
+    Read STATS_CHUNK frames at a time, twice (the sum, then the squared deviations from the mean),
+    so a phase's point clouds are never copied whole.
+    """
+    chunks = torch.split(frames, STATS_CHUNK)
+    channels = tensor.shape[-1]
+
+    def values(chunk: torch.Tensor) -> torch.Tensor:
+        return materialise(tensor[chunk]).reshape(-1, channels).double()
+
+    count, total = 0, torch.zeros(channels, dtype=torch.float64)
+    low = torch.full((channels,), math.inf, dtype=torch.float64)
+    high = torch.full((channels,), -math.inf, dtype=torch.float64)
+    for chunk in chunks:
+        block = values(chunk)
+        count += len(block)
+        total += block.sum(0)
+        low, high = torch.minimum(low, block.min(0).values), torch.maximum(high, block.max(0).values)
+    mean = total / count
+    squares = torch.zeros(channels, dtype=torch.float64)
+    for chunk in chunks:
+        squares += ((values(chunk) - mean) ** 2).sum(0)
+    return {
+        "mean": mean.float().numpy(),
+        "std": (squares / count).sqrt().float().numpy(),
+        "min": low.float().numpy(),
+        "max": high.float().numpy(),
+    }
 
 
 def policy_config(
@@ -264,10 +325,15 @@ class NormalisedData:
             )
         vector = {k: v for k, v in data.inputs.items() if k not in self.image_keys} | {"action": data.action}
         self.preprocessor = preprocessor
-        normalised = preprocessor(dict(vector))
-        self.vector = {k: normalised[k] for k in vector}
+        self.vector = normalise_inputs(preprocessor, vector)
         self.device = self.vector["action"].device
         self.task_index = data.task_index.to(self.device, dtype=torch.long)
+
+    @property
+    def measure_chunk(self) -> int:
+        """Frames per forward pass of a loss measurement (fewer with images or point clouds)."""
+        visual = any(len(tensor.shape) > 2 for tensor in self.data.inputs.values())
+        return MEASURE_CHUNK_VISUAL if visual else MEASURE_CHUNK
 
     def normalise_actions(self, actions: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
         """Unnormalised actions for the frames at ``index``, normalised like the labels."""
@@ -288,6 +354,23 @@ class NormalisedData:
             batch[key] = images.permute(0, 3, 1, 2).float() / 255.0
         batch["task_index"] = self.task_index[index]
         return batch
+
+
+def normalise_inputs(preprocessor: Any, vector: dict[str, FrameTensor]) -> dict[str, FrameTensor]:
+    """``vector`` through the pre-processor: tensors at once, ``FrameParts`` part by part (never joined).
+
+    Args:
+        preprocessor: The policy's pre-processor (normalisation of each key is per feature, so parts
+            normalise as the whole would).
+        vector: The action and the non-image inputs by key.
+    """
+    whole = {k: v for k, v in vector.items() if not isinstance(v, FrameParts)}
+    normalised = preprocessor(dict(whole))
+    result: dict[str, FrameTensor] = {k: normalised[k] for k in whole}
+    for key, parts in vector.items():
+        if isinstance(parts, FrameParts):
+            result[key] = parts.map(lambda part, key=key: preprocessor({key: part})[key])
+    return result
 
 
 @dataclass
@@ -394,7 +477,7 @@ def per_task_loss(
     policy.eval()
     sums = torch.zeros(num_tasks, dtype=torch.float64, device=data.device)
     counts = torch.zeros(num_tasks, dtype=torch.float64, device=data.device)
-    for chunk in torch.split(index, 4096):
+    for chunk in torch.split(index, data.measure_chunk):
         batch = data.batch(chunk)
         prediction = policy.predict(batch, task_index=batch["task_index"])
         errors = ((prediction - batch["action"]) ** 2).mean(dim=1).double()
@@ -430,7 +513,7 @@ def per_task_loss_of(
     """
     sums = torch.zeros(num_tasks, dtype=torch.float64)
     counts = torch.zeros(num_tasks, dtype=torch.float64)
-    for chunk in torch.split(index, 4096):
+    for chunk in torch.split(index, data.measure_chunk):
         inputs = {key: tensor[chunk] for key, tensor in data.data.inputs.items()}
         task_index = data.data.task_index[chunk]
         raw = predict(inputs, [data.task_names[i] for i in task_index.tolist()])
@@ -939,7 +1022,7 @@ def train_on_rounds(
         config.seed,
         hold_out=config.training.steps_rule == "plateau",
     )
-    stats = compute_stats(data.subset(normalisation_frames(config, data, split.train)), image_keys)
+    stats = compute_stats(data, image_keys, normalisation_frames(config, data, split.train))
     torch.manual_seed(phase_seed)
     policy, preprocessor, postprocessor = _new_student(policy_cfg, stats)
     runner = None if previous is None else PolicyRunner.from_pretrained(previous, config.policy.device)

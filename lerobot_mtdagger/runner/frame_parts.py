@@ -1,0 +1,111 @@
+"""Per-round tensors of one observation read as one tensor along the frame axis, without joining them.
+
+A run keeps every committed round in memory (``train.RoundCache``) and trains on all of them. Joining
+the rounds' images or point clouds with ``torch.cat`` made a second full copy of the largest inputs
+for the whole phase (about 3 GB of uint8 images by the fifth MT10 pixel round). ``FrameParts`` holds
+the rounds' tensors as they are and gathers only the frames a batch asks for.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import torch
+
+
+class FrameParts:
+    """Tensors of the same trailing shape, dtype and device, indexed as their concatenation on dim 0.
+
+    Indexing with an integer tensor (any shape) gives a new tensor of ``index.shape + trailing``, as
+    indexing the concatenated tensor would; nothing else is supported, so no code can copy all the
+    frames by accident (``materialise`` does it on purpose).
+    """
+
+    def __init__(self, parts: Sequence[torch.Tensor]) -> None:
+        """Keeps ``parts`` (not copied).
+
+        Raises:
+            ValueError: If ``parts`` is empty or the parts differ in trailing shape, dtype or device.
+        """
+        if not parts:
+            raise ValueError("FrameParts needs at least one tensor.")
+        first = parts[0]
+        for part in parts[1:]:
+            if part.shape[1:] != first.shape[1:] or part.dtype != first.dtype or part.device != first.device:
+                raise ValueError(
+                    f"Cannot join a {part.dtype} {tuple(part.shape)} tensor on {part.device} with a "
+                    f"{first.dtype} {tuple(first.shape)} one on {first.device}."
+                )
+        self.parts = list(parts)
+        sizes = torch.tensor([len(part) for part in self.parts], dtype=torch.long)
+        self.ends = torch.cumsum(sizes, 0)
+        self.starts = self.ends - sizes
+
+    def __len__(self) -> int:
+        return int(self.ends[-1])
+
+    @property
+    def shape(self) -> torch.Size:
+        """``(frames, *trailing)``, as the concatenated tensor's."""
+        return torch.Size([len(self), *self.parts[0].shape[1:]])
+
+    @property
+    def dtype(self) -> torch.dtype:
+        """The parts' dtype."""
+        return self.parts[0].dtype
+
+    @property
+    def device(self) -> torch.device:
+        """The parts' device."""
+        return self.parts[0].device
+
+    def __getitem__(self, index: torch.Tensor) -> torch.Tensor:
+        """The frames at ``index`` (integer tensor of any shape, on any device), on the parts' device.
+
+        Raises:
+            TypeError: If ``index`` is not an integer tensor.
+            IndexError: If an index is outside ``[-len(self), len(self))``.
+        """
+        if not isinstance(index, torch.Tensor) or index.dtype not in (torch.int32, torch.int64):
+            raise TypeError(f"FrameParts is indexed with an integer tensor, got {type(index).__name__}.")
+        flat = index.reshape(-1).to(device="cpu", dtype=torch.long)
+        total = len(self)
+        if len(flat) and (int(flat.min()) < -total or int(flat.max()) >= total):
+            raise IndexError(f"Frame index out of range for {total} frames.")
+        flat = torch.where(flat < 0, flat + total, flat)
+        out = torch.empty((len(flat), *self.parts[0].shape[1:]), dtype=self.dtype, device=self.device)
+        owner = torch.searchsorted(self.ends, flat, right=True)
+        for part_index in torch.unique(owner).tolist():
+            rows = torch.nonzero(owner == part_index).squeeze(1)
+            local = flat[rows] - self.starts[part_index]
+            out[rows.to(self.device)] = self.parts[part_index][local.to(self.device)]
+        return out.reshape(*index.shape, *out.shape[1:])
+
+    def map(self, function: Callable[[torch.Tensor], torch.Tensor]) -> FrameParts:
+        """``function`` applied to each part (e.g. normalisation), joined the same way."""
+        return FrameParts([function(part) for part in self.parts])
+
+    def materialise(self) -> torch.Tensor:
+        """All frames as one new tensor (a full copy)."""
+        return torch.cat(self.parts)
+
+
+FrameTensor = torch.Tensor | FrameParts
+"""A frame-indexed input: a tensor, or per-round tensors read as one (``FrameParts``)."""
+
+
+def join_frames(tensors: Sequence[torch.Tensor]) -> FrameTensor:
+    """The frames of ``tensors`` one after the other: the tensor itself when there is one, else parts.
+
+    Raises:
+        ValueError: If ``tensors`` is empty or they differ in trailing shape, dtype or device.
+    """
+    nonempty = [tensor for tensor in tensors if len(tensor)] or list(tensors[:1])
+    if len(nonempty) == 1:
+        return nonempty[0]
+    return FrameParts(nonempty)
+
+
+def materialise(tensor: FrameTensor) -> torch.Tensor:
+    """``tensor`` as one ``torch.Tensor`` (``FrameParts.materialise`` for parts)."""
+    return tensor.materialise() if isinstance(tensor, FrameParts) else tensor
