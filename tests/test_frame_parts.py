@@ -42,8 +42,9 @@ def random_parts(sizes: list[int], seed: int = 0) -> list[torch.Tensor]:
         torch.tensor([[11, 0, 7], [2, 9, 5]]),
         torch.tensor([-1, -12, 6], dtype=torch.int32),
         torch.tensor([], dtype=torch.long),
+        torch.randint(-12, 12, (40, 20), generator=torch.Generator().manual_seed(0)),
     ],
-    ids=["flat", "2-d", "negative-int32", "empty"],
+    ids=["flat", "2-d", "negative-int32", "empty", "more-than-the-row-copy-limit"],
 )
 def test_frame_parts_index_like_the_concatenated_tensor(index):
     parts = random_parts([5, 0, 4, 3])

