@@ -21,7 +21,8 @@
 # phase; 200 per phase add about 17 min): about 50-60 min per DAgger run and 12-30 min per BC run on
 # one core: ~15 core-hours, ~7.5 h at --jobs=2 (three sessions). Memory: two pixel runs at once need
 # the training-side fix of 2026-11-26 (docs/benchmarks.md, "Peak memory of a visual run's training
-# phases"); check `free -g` while two DAgger runs are in their last rounds.
+# phases"); check `free -g` while two DAgger runs are in their last rounds. (Added after the freeze,
+# a comment only: ../queue.sh runs it with JOBS=1 beside another study.)
 #
 # Run ONCE, from a frozen worktree at the commit that added this file:
 #   git worktree add --detach ../study-code-pixels-eval <commit>; cd ../study-code-pixels-eval
