@@ -8,7 +8,7 @@ run's ``--output_dir``; and the machine's lowest ``MemAvailable``. The peaks are
 A study's own runs are measured where they run, with their neighbours: for example two pixel runs at
 ``--jobs=2`` on 24 GB. Usage::
 
-    nohup .venv/bin/python benchmarks/watch_memory.py --output outputs/pixels-eval-memory.json &
+    nohup .venv/bin/python benchmarks/watch_memory.py --output outputs/study-memory.json --match outputs/ &
 """
 
 from __future__ import annotations
@@ -56,14 +56,17 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--output", type=Path, required=True)
     parser.add_argument("--every", type=float, default=5.0, help="Seconds between samples.")
+    parser.add_argument("--match", default="", help="Watch only runs whose --output_dir contains this.")
     args = parser.parse_args()
     peaks: dict[str, int] = {}
     lowest = None
     if args.output.exists():  # a watch started again goes on from the peaks it wrote
         stored = json.loads(args.output.read_text())
         peaks, lowest = stored.get("peak_pss_mib", {}), stored.get("lowest_available_mib")
+        peaks = {output: pss for output, pss in peaks.items() if args.match in output}
     while True:
-        for output, pid in run_processes().items():
+        watched = {output: pid for output, pid in run_processes().items() if args.match in output}
+        for output, pid in watched.items():
             pss = sum(_memory_kb(p, "Pss") for p in _tree(pid)) // 1024
             peaks[output] = max(peaks.get(output, 0), pss)
         available = available_mib()
