@@ -10,6 +10,12 @@
 # Each worktree: `git worktree add --detach ../<name> <commit>`, then in it
 # `ln -sf ../main/.venv .venv && ln -sfn ../main/outputs outputs`. Run from ../main.
 set -euo pipefail
+# Each run's peak memory (with its env workers) and the machine's lowest available memory, kept in
+# outputs/study-memory.json (benchmarks/watch_memory.py; one watcher at a time).
+if ! pgrep -f benchmarks/watch_memory.py > /dev/null; then
+  nohup .venv/bin/python benchmarks/watch_memory.py --output outputs/study-memory.json --match outputs/ \
+    > /dev/null 2>&1 &
+fi
 (cd ../study-code-pixels-bc && PYTHONPATH=$PWD bash docs/results/pixels-bc-dev/run.sh)
 mkdir -p docs/results/pixels-bc-dev/report
 cp -r ../study-code-pixels-bc/docs/results/pixels-bc-dev/report/. docs/results/pixels-bc-dev/report/
