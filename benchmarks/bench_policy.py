@@ -1,6 +1,7 @@
-"""Training throughput and batch-1 inference latency of the ``mtdagger`` policy on the CPU.
+"""Training throughput and batch-1 inference latency of the ``mtdagger`` policy (CPU, or ``--device``).
 
-Run: ``.venv/bin/python benchmarks/bench_policy.py``. Default model sizes; inputs as the suites emit
+Run: ``.venv/bin/python benchmarks/bench_policy.py`` (``--device=cuda`` on a GPU; the timings then
+wait for the device after each timed loop). Default model sizes; inputs as the suites emit
 them: state (39-d), RGB 84 px + 7-d state, point cloud 1024 x 3 + 7-d state. The modes are measured
 in interleaved rounds in one run, so their ratios are side by side. The DAgger loop queries the
 policy every step, so the batch-1 latency bounds the collection rate.
@@ -32,19 +33,19 @@ MODES = {
 }
 
 
-def make_policy(inputs) -> MTDAggerPolicy:
+def make_policy(inputs, device: str = "cpu") -> MTDAggerPolicy:
     config = MTDAggerConfig(
-        device="cpu",
+        device=device,
         task_names=TASKS,
         input_features=inputs,
         output_features={"action": PolicyFeature(type=FeatureType.ACTION, shape=(4,))},
     )
-    return MTDAggerPolicy(config)
+    return MTDAggerPolicy(config).to(device)
 
 
-def make_batch(inputs, batch_size: int) -> dict:
-    batch = {k: torch.randn(batch_size, *ft.shape) for k, ft in inputs.items()}
-    batch["action"] = torch.randn(batch_size, 4)
+def make_batch(inputs, batch_size: int, device: str = "cpu") -> dict:
+    batch = {k: torch.randn(batch_size, *ft.shape, device=device) for k, ft in inputs.items()}
+    batch["action"] = torch.randn(batch_size, 4, device=device)
     batch["task"] = [TASKS[i % len(TASKS)] for i in range(batch_size)]
     return batch
 
@@ -56,7 +57,14 @@ def train_rate(policy, optimizer, batch, steps: int) -> float:
         optimizer.zero_grad()
         loss.backward()
         optimizer.step()
+    synchronize(batch["action"].device)
     return steps * len(batch["task"]) / (time.perf_counter() - start)
+
+
+def synchronize(device: torch.device) -> None:
+    """Waits for the device's queued work (CUDA runs asynchronously)."""
+    if device.type == "cuda":
+        torch.cuda.synchronize(device)
 
 
 def latency_ms(policy, batch, repeats: int) -> float:
@@ -64,6 +72,7 @@ def latency_ms(policy, batch, repeats: int) -> float:
     for _ in range(repeats):
         start = time.perf_counter()
         policy.select_action(batch)
+        synchronize(batch["action"].device)
         times.append(time.perf_counter() - start)
     return statistics.median(times) * 1e3
 
@@ -74,14 +83,16 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=10)
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--threads", type=int, default=torch.get_num_threads())
+    parser.add_argument("--device", default="cpu", help="cpu, cuda or cuda:N")
     args = parser.parse_args()
     torch.manual_seed(0)
     torch.set_num_threads(args.threads)
     setups = {}
     for name, inputs in MODES.items():
-        policy = make_policy(inputs)
+        policy = make_policy(inputs, args.device)
         optimizer = torch.optim.AdamW(policy.parameters(), lr=3e-4)
-        setups[name] = (policy, optimizer, make_batch(inputs, args.batch_size), make_batch(inputs, 1))
+        batches = make_batch(inputs, args.batch_size, args.device), make_batch(inputs, 1, args.device)
+        setups[name] = (policy, optimizer, *batches)
         train_rate(policy, optimizer, setups[name][2], 1)  # warm-up
     rates = {name: [] for name in MODES}
     latencies = {name: [] for name in MODES}
@@ -91,7 +102,7 @@ def main() -> None:
             rates[name].append(train_rate(policy, optimizer, batch, args.steps))
             latencies[name].append(latency_ms(policy, single, 50))
     print(
-        f"torch {torch.__version__}, {args.threads} threads, batch {args.batch_size}, "
+        f"torch {torch.__version__}, {args.device}, {args.threads} threads, batch {args.batch_size}, "
         f"median of {args.rounds} rounds"
     )
     header = ["input", "params", "train samples/s", "vs state", "batch-1 latency ms"]
