@@ -32,17 +32,11 @@ import sys
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_run import _rss_kb  # noqa: E402
+
 TARGET = 0.7
 REPO = Path(__file__).resolve().parents[1]
-
-
-def _rss_mib() -> float:
-    """The process's resident memory now (MiB)."""
-    with open("/proc/self/status") as status:
-        for line in status:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024
-    raise RuntimeError("VmRSS not found in /proc/self/status")
 
 
 def replay(experiment: Path, run_options: list[str], steps: int, rounds: int | None) -> dict:
@@ -73,7 +67,7 @@ def replay(experiment: Path, run_options: list[str], steps: int, rounds: int | N
                 "round": k,
                 "frames": len(data),
                 "load_and_prepare_s": round(time.perf_counter() - start - trained.train_s, 1),
-                "rss_after_mib": round(_rss_mib()),
+                "rss_after_mib": round(_rss_kb(os.getpid()) / 1024),
                 "peak_so_far_mib": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024),
             }
         )

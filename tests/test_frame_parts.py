@@ -12,6 +12,7 @@ import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
+from lerobot_mtdagger.runner import train
 from lerobot_mtdagger.runner.frame_parts import FrameParts, join_frames, materialise
 from lerobot_mtdagger.runner.train import (
     EPISODE_ID_STRIDE,
@@ -79,6 +80,21 @@ def test_join_frames_keeps_a_single_tensor_and_drops_empty_parts():
     joined = join_frames(random_parts([3, 0, 2]))
     assert isinstance(joined, FrameParts) and [len(p) for p in joined.parts] == [3, 2]
     assert materialise(parts[1]) is parts[1]
+    nested = join_frames([joined, *random_parts([2], seed=1)])
+    assert [len(p) for p in nested.parts] == [3, 2, 2], "the parts of a FrameParts are taken as they are"
+
+
+def test_statistics_read_in_chunks_equal_those_of_all_the_frames_at_once(monkeypatch):
+    monkeypatch.setattr(train, "STATS_CHUNK", 7)  # 40 frames: six chunks, the last one short
+    generator = torch.Generator().manual_seed(0)
+    parts = [torch.randn(n, 5, 3, generator=generator) * (1 + n) + n for n in (12, 20, 18)]
+    frames = torch.randperm(50, generator=generator)[:40]
+    stats = train.channel_stats(FrameParts(parts), frames)
+    flat = torch.cat(parts)[frames].reshape(-1, 3).double()
+    assert stats["mean"] == pytest.approx(flat.mean(0).float().numpy(), rel=1e-6)
+    assert stats["std"] == pytest.approx(flat.std(0, unbiased=False).float().numpy(), rel=1e-6)
+    assert (stats["min"] == flat.min(0).values.float().numpy()).all()
+    assert (stats["max"] == flat.max(0).values.float().numpy()).all()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -168,6 +184,13 @@ def test_a_phase_on_rounds_kept_apart_trains_exactly_as_on_their_concatenation(s
     for key in stats_ref:
         for name in stats_ref[key]:
             assert (stats[key][name] == stats_ref[key][name]).all(), (key, name)
+        # ... and they are the statistics of the training frames (float64 over all of them at once).
+        tensor = joined.action if key == "action" else materialise(joined.inputs[key])
+        flat = tensor[train_index].reshape(-1, tensor.shape[-1]).double()
+        expected = {"mean": flat.mean(0), "std": flat.std(0, unbiased=False)}
+        expected |= {"min": flat.min(0).values, "max": flat.max(0).values}
+        for name, value in expected.items():
+            assert stats[key][name] == pytest.approx(value.float().numpy(), rel=1e-6, abs=1e-7), (key, name)
     assert isinstance(normalised.vector["observation.pointcloud"], FrameParts)
     for key, tensor in normalised_ref.vector.items():
         assert torch.equal(materialise(normalised.vector[key]), tensor), key

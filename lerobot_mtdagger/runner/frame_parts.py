@@ -103,13 +103,17 @@ FrameTensor = torch.Tensor | FrameParts
 """A frame-indexed input: a tensor, or per-round tensors read as one (``FrameParts``)."""
 
 
-def join_frames(tensors: Sequence[torch.Tensor]) -> FrameTensor:
-    """The frames of ``tensors`` one after the other: the tensor itself when there is one, else parts.
+def join_frames(tensors: Sequence[FrameTensor]) -> FrameTensor:
+    """The frames of ``tensors`` (tensors or ``FrameParts``) one after the other, without a copy.
+
+    Empty tensors are dropped; a single tensor left is returned itself, else ``FrameParts`` over all
+    the tensors (those of a ``FrameParts`` taken as they are).
 
     Raises:
         ValueError: If ``tensors`` is empty or they differ in trailing shape, dtype or device.
     """
-    nonempty = [tensor for tensor in tensors if len(tensor)] or list(tensors[:1])
+    pieces = [p for t in tensors for p in (t.parts if isinstance(t, FrameParts) else [t])]
+    nonempty = [piece for piece in pieces if len(piece)] or pieces[:1]
     if len(nonempty) == 1:
         return nonempty[0]
     return FrameParts(nonempty)

@@ -125,15 +125,7 @@ class TrainingData:
 
 def _join_input(tensors: Sequence[FrameTensor]) -> FrameTensor:
     """One input of several parts: vectors concatenated, images and point clouds as ``FrameParts``."""
-    if len(tensors[0].shape) <= 2:
-        return torch.cat([materialise(tensor) for tensor in tensors])
-    pieces = [piece for tensor in tensors for piece in _pieces(tensor)]
-    return join_frames(pieces)
-
-
-def _pieces(tensor: FrameTensor) -> list[torch.Tensor]:
-    """The tensors ``tensor`` is made of (itself, or the parts of a ``FrameParts``)."""
-    return list(tensor.parts) if isinstance(tensor, FrameParts) else [tensor]
+    return torch.cat(tensors) if len(tensors[0].shape) <= 2 else join_frames(tensors)
 
 
 def load_round(root: Path, round_position: int, input_keys: Sequence[str]) -> TrainingData:
@@ -246,27 +238,24 @@ def compute_stats(
 def channel_stats(tensor: FrameTensor, frames: torch.Tensor) -> dict[str, np.ndarray]:
     """Mean/std/min/max over the last axis' channels of ``tensor[frames]``, in float64 then float32.
 
-    Read STATS_CHUNK frames at a time, twice (the sum, then the squared deviations from the mean),
-    so a phase's point clouds are never copied whole.
+    Read STATS_CHUNK frames at a time in one pass, each chunk's mean and squared deviations merged
+    into the running ones (Chan et al.'s pairwise update), so a phase's point clouds are never
+    copied whole.
     """
-    chunks = torch.split(frames, STATS_CHUNK)
     channels = tensor.shape[-1]
-
-    def values(chunk: torch.Tensor) -> torch.Tensor:
-        return materialise(tensor[chunk]).reshape(-1, channels).double()
-
-    count, total = 0, torch.zeros(channels, dtype=torch.float64)
+    count = 0
+    mean = torch.zeros(channels, dtype=torch.float64)
+    squares = torch.zeros(channels, dtype=torch.float64)
     low = torch.full((channels,), math.inf, dtype=torch.float64)
     high = torch.full((channels,), -math.inf, dtype=torch.float64)
-    for chunk in chunks:
-        block = values(chunk)
-        count += len(block)
-        total += block.sum(0)
+    for chunk in torch.split(frames, STATS_CHUNK):
+        block = materialise(tensor[chunk]).reshape(-1, channels).double()
+        block_mean = block.mean(0)
+        delta, total = block_mean - mean, count + len(block)
+        squares += ((block - block_mean) ** 2).sum(0) + delta**2 * count * len(block) / total
+        mean += delta * len(block) / total
+        count = total
         low, high = torch.minimum(low, block.min(0).values), torch.maximum(high, block.max(0).values)
-    mean = total / count
-    squares = torch.zeros(channels, dtype=torch.float64)
-    for chunk in chunks:
-        squares += ((values(chunk) - mean) ** 2).sum(0)
     return {
         "mean": mean.float().numpy(),
         "std": (squares / count).sqrt().float().numpy(),
