@@ -1,13 +1,10 @@
 #!/usr/bin/env bash
-# Copies each finished run's training record (its evaluation included) from
-# outputs/bc-past-plateau-dev/ into records/<training>/<run>/training.json here, so the numbers
-# outlive outputs/ (not in git). Run from the repository root at any time (finished runs only).
+# Copies every run's records from outputs/bc-past-plateau-dev/<training>/runs/ into
+# records/<training>/<run>/ here (../save_run_records.sh), so the numbers outlive outputs/ (not in
+# git). Run from the repository root at any time.
 set -euo pipefail
-HERE=docs/results/bc-past-plateau-dev
-for RECORD in outputs/bc-past-plateau-dev/*/runs/*/policies/round-000/training.json; do
-  [ -f "$RECORD" ] || continue
-  RUN_DIR=$(dirname "$(dirname "$(dirname "$RECORD")")")
-  TRAINING=$(basename "$(dirname "$(dirname "$RUN_DIR")")")
-  mkdir -p "$HERE/records/$TRAINING/$(basename "$RUN_DIR")"
-  cp "$RECORD" "$HERE/records/$TRAINING/$(basename "$RUN_DIR")/training.json"
+for TRAINING in outputs/bc-past-plateau-dev/*/; do
+  [ -d "$TRAINING/runs" ] || continue
+  bash docs/results/save_run_records.sh "$TRAINING/runs" \
+    "docs/results/bc-past-plateau-dev/records/$(basename "$TRAINING")"
 done

@@ -1,7 +1,8 @@
 """The pixel BC samplings' success by budget and seed, and the decision rule of ``run.sh``, applied.
 
 Usage: ``.venv/bin/python docs/results/pixels-bc-dev/table.py docs/results/pixels-bc-dev/records``
-(the folder ``save_records.sh`` fills: ``<sampling>/bc-<budget>demos-seed<seed>/training.json``).
+(the folder ``save_records.sh`` fills:
+``<sampling>/bc-<budget>demos-seed<seed>/policies/round-000/training.json``).
 
 The rule, as fixed in ``run.sh`` before any run: the evaluation study's BC takes the sampling with
 the highest 3-seed mean success over the three budgets among those whose mean at 60 is not below
@@ -27,13 +28,14 @@ RUN_NAME = re.compile(r"bc-(\d+)demos-seed(\d+)")
 def read_records(folder: Path) -> dict[str, dict[tuple[int, int], float]]:
     """Mean success by sampling, then (budget, seed)."""
     results: dict[str, dict[tuple[int, int], float]] = {}
-    for path in sorted(folder.glob("*/*/training.json")):
-        match = RUN_NAME.fullmatch(path.parent.name)
+    for path in sorted(folder.glob("*/*/policies/round-000/training.json")):
+        run = path.parents[2]
+        match = RUN_NAME.fullmatch(run.name)
         if match is None:
             continue
         budget, seed = int(match.group(1)), int(match.group(2))
         success = json.loads(path.read_text())["eval"]["mean"]
-        results.setdefault(path.parent.parent.name, {})[(budget, seed)] = float(success)
+        results.setdefault(run.parent.name, {})[(budget, seed)] = float(success)
     return results
 
 

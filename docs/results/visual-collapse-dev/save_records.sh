@@ -1,21 +1,12 @@
 #!/usr/bin/env bash
-# Copies the small JSON records of each run (round records, phase records) from outputs/visual-dev/
+# Copies the small JSON records of each run (../save_run_records.sh) from outputs/visual-dev/
 # into records/<run>/ here, with the run's rounds_summary.py table, so the numbers outlive outputs/ (not
 # in git); rounds_summary.txt joins the tables of every run in records/. Run from the repository root.
 set -euo pipefail
 HERE=docs/results/visual-collapse-dev
+bash docs/results/save_run_records.sh outputs/visual-dev "$HERE/records"
 for RUN in outputs/visual-dev/*-seed*/; do
   NAME=$(basename "$RUN")
-  for K in "$RUN"/rounds/round-*; do
-    [ -d "$K" ] || continue
-    mkdir -p "$HERE/records/$NAME/rounds/$(basename "$K")"
-    cp "$K/meta/info.json" "$HERE/records/$NAME/rounds/$(basename "$K")/info.json"
-  done
-  for K in "$RUN"/policies/round-*; do
-    [ -d "$K" ] || continue
-    mkdir -p "$HERE/records/$NAME/policies/$(basename "$K")"
-    cp "$K/training.json" "$HERE/records/$NAME/policies/$(basename "$K")/training.json"
-  done
   # This run's table, kept beside its records: the joined file below also keeps the runs whose
   # outputs/ are gone (a new checkout has none).
   .venv/bin/python "$HERE/rounds_summary.py" "outputs/visual-dev/$NAME" | sed -e '1{/^$/d}' \
