@@ -60,3 +60,21 @@ def kill_9_and_check_workers_end(process: subprocess.Popen, workers: int | None 
     while any(is_running(pid) for pid in children) and time.time() < deadline:
         time.sleep(0.05)
     assert not any(is_running(pid) for pid in children), "env workers outlived the run"
+
+
+def small_drawer_cloud_args(output_dir: Path) -> list[str]:
+    """``run`` options of a two-drawer point-cloud run (one DAgger round, 128 points) in seconds."""
+    return [
+        "--preset=drawers-pointcloud",
+        "--suite.tasks=[drawer-bar-wide,drawer-lip-shallow]",
+        "--dagger.rounds=1",
+        "--dagger.initial_demos=1",
+        "--dagger.budget_per_task=1",
+        "--scheduler.n_min=1",
+        "--training.steps_per_round=20",
+        "--rollout.eval_episodes=1",
+        "--suite.num_points=128",
+        "--rollout.max_steps=80",
+        "--progress=false",
+        f"--output_dir={output_dir}",
+    ]

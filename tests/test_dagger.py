@@ -23,7 +23,7 @@ from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.utils.errors import UserError
 from tests.conftest import lerobot_train
-from tests.helpers import edit_round_record, kill_9_and_check_workers_end
+from tests.helpers import edit_round_record, kill_9_and_check_workers_end, small_drawer_cloud_args
 
 TASKS = ["reach-v3", "button-press-topdown-v3", "push-v3"]
 TINY = [
@@ -230,20 +230,7 @@ def test_foreign_dataset_in_the_output_dir_is_refused(tmp_path):
 def test_drawer_suite_runs_with_point_clouds_and_evaluates_the_unseen_drawers(tmp_path):
     import draccus
 
-    args = [
-        "--preset=drawers-pointcloud",
-        "--suite.tasks=[drawer-bar-wide,drawer-lip-shallow]",
-        "--dagger.rounds=1",
-        "--dagger.initial_demos=1",
-        "--dagger.budget_per_task=1",
-        "--scheduler.n_min=1",
-        "--training.steps_per_round=20",
-        "--rollout.eval_episodes=1",
-        "--suite.num_points=128",
-        "--rollout.max_steps=80",
-        "--progress=false",
-        f"--output_dir={tmp_path / 'drawers'}",
-    ]
+    args = small_drawer_cloud_args(tmp_path / "drawers")
     run(draccus.parse(RunConfig, args=args))
     experiment = ExperimentDir(tmp_path / "drawers")
     assert experiment.committed_rounds() == [0, 1]

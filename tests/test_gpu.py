@@ -18,6 +18,7 @@ from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.frame_parts import FrameParts
 from lerobot_mtdagger.runner.train import load_round
+from tests.helpers import small_drawer_cloud_args
 
 pytestmark = [
     pytest.mark.gpu,
@@ -39,28 +40,14 @@ def test_frame_parts_on_cuda_gather_as_on_the_cpu():
 
 
 def test_a_point_cloud_drawer_run_trains_collects_and_evaluates_on_cuda(tmp_path):
-    args = [
-        "--preset=drawers-pointcloud",
-        "--suite.tasks=[drawer-bar-wide,drawer-lip-shallow]",
-        "--dagger.rounds=1",
-        "--dagger.initial_demos=2",
-        "--dagger.budget_per_task=2",
-        "--scheduler.n_min=1",
-        "--training.steps_per_round=50",
-        "--rollout.eval_episodes=2",
-        "--suite.num_points=128",
-        "--rollout.max_steps=80",
-        "--policy.device=cuda",
-        "--progress=false",
-        f"--output_dir={tmp_path / 'drawers'}",
-    ]
+    args = [*small_drawer_cloud_args(tmp_path / "drawers"), "--policy.device=cuda"]
     run(draccus.parse(RunConfig, args=args))
     experiment = ExperimentDir(tmp_path / "drawers")
     assert experiment.committed_phases() == [0, 1]
     assert verify_experiment(experiment) == (2, 2, [])
     for phase in (0, 1):  # evaluated on the training and on the unseen drawers, on the GPU policy
         record = experiment.read_phase_record(phase)
-        assert record.eval["episodes"] == [2, 2] and record.heldout_eval is not None
+        assert record.eval["episodes"] == [1, 1] and record.heldout_eval is not None
 
     # The checkpoint acts the same on the GPU and, loaded there, on the CPU (to float tolerance).
     on_gpu = PolicyRunner.from_pretrained(experiment.policy_root(1), "cuda")
