@@ -23,11 +23,15 @@ bash docs/results/pixels-bc-dev/save_records.sh
 cp docs/results/pixels-bc-dev/table.txt ../study-code-pixels-eval/docs/results/pixels-bc-dev/table.txt
 (cd ../study-code-bc-plateau && PYTHONPATH=$PWD JOBS=1 bash docs/results/bc-past-plateau-dev/run.sh) \
   >> outputs/bc-past-plateau-dev.log 2>&1 &
+PLATEAU_PID=$!
 (cd ../study-code-pixels-eval && PYTHONPATH=$PWD JOBS=1 bash docs/results/pixels-eval/run.sh) \
   >> outputs/pixels-eval.log 2>&1 &
-wait
+PIXELS_PID=$!
+# Only the two studies: a plain `wait` would also wait on the memory watcher, which never ends.
+wait "$PLATEAU_PID" "$PIXELS_PID"
 for STUDY in pixels-eval:study-code-pixels-eval bc-past-plateau-dev:study-code-bc-plateau; do
   mkdir -p "docs/results/${STUDY%%:*}/report"
   cp -r "../${STUDY##*:}/docs/results/${STUDY%%:*}/report/." "docs/results/${STUDY%%:*}/report/"
 done
 bash docs/results/pixels-eval/save_records.sh
+bash docs/results/bc-past-plateau-dev/save_records.sh
