@@ -56,6 +56,8 @@ from lerobot_mtdagger.utils.parsing import parse_options
 from lerobot_mtdagger.utils.ray_session import import_ray
 
 HELDOUT_TASKS = "heldout"
+UNSEEN_RULES: tuple[str, ...] = ("shared", "nearest")
+"""``eval --unseen_rule``: how a policy acts on a task it was not trained on (``EvalConfig``)."""
 """``--suite.tasks='[heldout]'``: the suite's unseen tasks (``eval``, ``shift``)."""
 
 if TYPE_CHECKING:
@@ -231,6 +233,11 @@ class EvalConfig:
         ray_address: The Ray cluster of ``worker_backend=ray`` (None: start a local Ray).
         trust_checkpoint: Let the policy's processor configs name Python classes, which LeRobot's
             loader imports and calls (default: only LeRobot registry names are accepted).
+        unseen_rule: How the policy acts on a task it was not trained on (an unseen drawer):
+            ``shared`` with its shared "any task" embedding (a policy trained with task dropout;
+            what a run's unseen-drawer evaluation does), ``nearest`` with the task input of the
+            training task most like it (the drawers: the same handle type, the nearest handle size
+            and height; ``docs/drawers.md``).
     """
 
     policy_path: str | None = None
@@ -242,6 +249,7 @@ class EvalConfig:
     worker_backend: str = "local"
     ray_address: str | None = None
     trust_checkpoint: bool = False
+    unseen_rule: str = "shared"
 
     @property
     def worker_count(self) -> int:
@@ -266,6 +274,8 @@ class EvalConfig:
             raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
         if self.episodes <= 0:
             raise ValueError(f"episodes must be > 0, got {self.episodes}.")
+        if self.unseen_rule not in UNSEEN_RULES:
+            raise ValueError(f"unseen_rule must be one of {list(UNSEEN_RULES)}, got {self.unseen_rule!r}.")
         if self.suite.name is None:  # draccus builds a SuiteConfig of class defaults when one field is given
             self.suite.name = _eval_suite().name
         self.suite.check()
@@ -292,6 +302,11 @@ def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
             logger.info("Evaluating the %d tasks of %s the policy knows", len(trained), suite_config.name)
             suite = suite_from_config(suite_config, tasks=trained)
     runner.check_inputs(suite.features, suite_config.obs_mode)
+    if config.unseen_rule == "nearest":
+        unseen = [name for name in suite.task_names if name not in runner.task_names]
+        runner.act_as({name: suite.nearest_training_task(name, runner.task_names) for name in unseen})
+        for name, proxy in runner.task_aliases.items():
+            logger.info("Unseen task %r: the policy acts with the task input of %r.", name, proxy)
     runner.check_tasks(suite.task_names)
     return suite, runner
 
@@ -324,12 +339,17 @@ def eval_command(config: EvalConfig) -> dict:
         result, _ = evaluate(workers, runner, config.episodes, config.seed)
     progress = result.progress or [None] * len(result.task_names)
     for task, success, score in zip(result.task_names, result.success, progress, strict=True):
-        print(f"{task:<32} {success:.3f}" + ("" if score is None else f"  progress {score:.2f}/3"))
+        line = f"{task:<32} {success:.3f}" + ("" if score is None else f"  progress {score:.2f}/3")
+        proxy = runner.task_aliases.get(task)
+        print(line + ("" if proxy is None else f"  (acting as {proxy})"))
     mean_progress = "" if result.progress is None else f"  progress {np.mean(result.progress):.2f}/3"
     print(f"{'mean':<32} {result.mean:.3f}{mean_progress}")
+    values = result.to_dict() | {"unseen_rule": config.unseen_rule}
+    if runner.task_aliases:
+        values["acted_as"] = dict(runner.task_aliases)
     if config.output is not None:
-        config.output.write_text(json.dumps(result.to_dict(), indent=2))
-    return result.to_dict()
+        config.output.write_text(json.dumps(values, indent=2))
+    return values
 
 
 @dataclass

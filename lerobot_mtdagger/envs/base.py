@@ -26,6 +26,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from lerobot_mtdagger.utils.errors import UserError
+
 OBS_MODES: tuple[str, ...] = ("state", "rgb", "pointcloud")
 
 STATE_KEY = "observation.state"
@@ -145,6 +147,17 @@ class TaskSuite(abc.ABC):
     def heldout_suite(self) -> TaskSuite | None:
         """A suite whose tasks are this suite's held-out tasks (same observations), or None without any."""
         return None
+
+    def nearest_training_task(self, task_name: str, training_tasks: Sequence[str]) -> str:
+        """The training task most like the unseen ``task_name``, whose task input a policy may act with.
+
+        Raises:
+            UserError: Always here: a suite without a notion of task likeness (the drawers have one).
+        """
+        raise UserError(
+            f"Suite {self.name!r} has no rule for the training task most like {task_name!r}: evaluate "
+            "it with --unseen_rule=shared (a policy trained with --policy.task_dropout > 0)."
+        )
 
     def task_index(self, task_name: str) -> int:
         """Index of ``task_name`` in ``task_names``.

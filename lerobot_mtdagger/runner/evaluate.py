@@ -44,6 +44,8 @@ class PolicyRunner:
         self.postprocessor = postprocessor
         self.input_keys = [key for key in policy.config.input_features if key != TASK_FEATURE]
         self.image_keys = set(policy.config.image_features)
+        self.task_aliases: dict[str, str] = {}
+        """Task name -> the training task whose input the policy acts with instead (``act_as``)."""
 
     @classmethod
     def from_pretrained(
@@ -83,6 +85,20 @@ class PolicyRunner:
             return self.policy.any_task_index is not None
         return True
 
+    def act_as(self, aliases: dict[str, str]) -> None:
+        """Makes the policy act on each key task with the task input of its value (a training task).
+
+        What ``eval --unseen_rule=nearest`` does for an unseen drawer: the policy sees the task of the
+        training drawer most like it instead of its shared "any task" embedding.
+
+        Raises:
+            UserError: If a value is not a task the policy was trained on.
+        """
+        unknown = sorted({task for task in aliases.values() if task not in self.task_names})
+        if unknown:
+            raise UserError(f"Cannot act as {unknown}: the policy was trained on {self.task_names}.")
+        self.task_aliases = dict(aliases)
+
     def check_tasks(self, task_names: Sequence[str]) -> None:
         """Refuses tasks the policy cannot act on (not trained on them and no shared embedding).
 
@@ -90,7 +106,7 @@ class PolicyRunner:
             UserError: Naming the unknown tasks, the policy's tasks and the options to change.
         """
         known = self.task_names
-        unknown = [name for name in task_names if name not in known]
+        unknown = [name for name in task_names if name not in known and name not in self.task_aliases]
         if unknown and known and not self.acts_on_unseen_tasks:
             raise UserError(
                 f"The policy was trained on {known}, not on {unknown}: pass --suite.tasks with tasks it "
@@ -153,7 +169,7 @@ class PolicyRunner:
             if key in self.image_keys:
                 tensor = tensor.permute(0, 3, 1, 2).float() / 255.0
             batch[key] = tensor.float()
-        batch["task"] = list(tasks)
+        batch["task"] = [self.task_aliases.get(task, task) for task in tasks]
         with torch.inference_mode():
             return self.preprocessor(batch)
 

@@ -21,10 +21,12 @@ from lerobot_mtdagger.envs.drawers.variants import (
     STATE_INDEX,
     DrawerVariant,
     Placement,
+    nearest_variant,
     placement_named,
 )
 from lerobot_mtdagger.envs.metaworld import ACTION_DIM, ACTION_NAMES, PROPRIO_NAMES, MetaWorldTaskEnv
 from lerobot_mtdagger.envs.rendering import CropBox
+from lerobot_mtdagger.utils.errors import UserError
 
 DRAWER_CROP = CropBox(low=(-0.62, 0.3, 0.005), high=(0.62, 0.975, 0.55))
 
@@ -121,6 +123,26 @@ class DrawerSuite(TaskSuite):
             variants=self._user_variants,
             placement=self.placement,
         )
+
+    def nearest_training_task(self, task_name: str, training_tasks: Sequence[str]) -> str:
+        """The training drawer whose handle is most like ``task_name``'s (``nearest_variant``).
+
+        Args:
+            task_name: An unseen drawer of the suite.
+            training_tasks: The drawers the policy was trained on (those the suite knows count).
+
+        Raises:
+            UserError: If no training drawer has the unseen drawer's handle type.
+        """
+        variant = self.variants[task_name]
+        known = [self.variants[name] for name in training_tasks if name in self.variants]
+        nearest = nearest_variant(variant, known)
+        if nearest is None:
+            raise UserError(
+                f"No training drawer has a {variant.handle} handle like {task_name!r} (trained on "
+                f"{list(training_tasks)}): evaluate it with --unseen_rule=shared."
+            )
+        return nearest.name
 
     @property
     def action_dim(self) -> int:

@@ -9,6 +9,7 @@ MuJoCo, MetaWorld or gymnasium, so the scripted expert and the catalogue depend 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -345,3 +346,25 @@ class DrawerVariant:
             self.elevation,
         ]
         return np.asarray(one_hot + numbers + list(self.front_rgba), dtype=np.float64)
+
+    def handle_distance(self, other: DrawerVariant) -> float:
+        """How unlike ``other``'s handle this drawer's is (what the ``nearest`` unseen-task rule ranks by).
+
+        Infinite across handle types; else the relative difference of ``handle_size`` plus the
+        difference of ``handle_height`` (fractions of half the front height).
+        """
+        if self.handle != other.handle:
+            return math.inf
+        size = abs(self.handle_size - other.handle_size) / max(self.handle_size, other.handle_size)
+        return size + abs(self.handle_height - other.handle_height)
+
+
+def nearest_variant(variant: DrawerVariant, candidates: Sequence[DrawerVariant]) -> DrawerVariant | None:
+    """The candidate whose handle is most like ``variant``'s (``handle_distance``; the first on a tie).
+
+    None when no candidate has ``variant``'s handle type.
+    """
+    ranked = sorted(candidates, key=variant.handle_distance)  # stable: ties keep the given order
+    if not ranked or math.isinf(variant.handle_distance(ranked[0])):
+        return None
+    return ranked[0]
