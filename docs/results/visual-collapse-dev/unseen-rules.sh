@@ -11,7 +11,8 @@
 #   git worktree add --detach ../study-code-unseen 31ab8b9; cd ../study-code-unseen
 #   ln -sf ../main/.venv .venv && ln -sfn ../main/outputs outputs
 #   nohup bash ../main/docs/results/visual-collapse-dev/unseen-rules.sh >> outputs/unseen-rules.log 2>&1 &
-# Rerun after a stop: finished evaluations are kept, policies not yet trained are skipped.
+# Rerun after a stop: finished evaluations are kept, policies not yet trained are skipped, and an
+# evaluation another instance is running (its .partial file) is left to it (delete stale ones first).
 set -euo pipefail
 OUT=outputs/visual-dev/unseen-rules
 mkdir -p "$OUT"
@@ -21,7 +22,8 @@ for SEED in 100 101 102; do
     [ -d "$POLICY" ] || continue
     for RULE in shared nearest; do
       TARGET="$OUT/kitchen-seed$SEED-phase$PHASE-$RULE.json"
-      [ -f "$TARGET" ] && continue
+      [ -f "$TARGET" ] || [ -f "$TARGET.partial" ] && continue
+      touch "$TARGET.partial"
       echo "$(date -u +%H:%M:%S) start seed $SEED phase $PHASE $RULE"
       PYTHONPATH=$PWD OMP_NUM_THREADS=1 MUJOCO_GL=egl .venv/bin/python -m lerobot_mtdagger.cli eval \
         --policy_path="$POLICY" --suite.name=drawers --suite.tasks='[heldout]' --unseen_rule="$RULE" \
