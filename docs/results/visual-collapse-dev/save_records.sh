@@ -16,3 +16,9 @@ for SUMMARY in "$HERE"/records/*/rounds_summary.txt; do
   echo
   cat "$SUMMARY"
 done > "$HERE/rounds_summary.txt"
+# The unseen-rules evaluations (unseen-rules.sh) and their table.
+if ls outputs/visual-dev/unseen-rules/*.json > /dev/null 2>&1; then
+  mkdir -p "$HERE/unseen-rules"
+  cp outputs/visual-dev/unseen-rules/*.json "$HERE/unseen-rules/"
+  .venv/bin/python "$HERE/unseen_rules_summary.py" "$HERE/unseen-rules" > "$HERE/unseen-rules/table.txt"
+fi
