@@ -4,9 +4,9 @@
 # before any variant run (2026-11-26), each on seeds 100-102:
 #   balanced: --training.sampling=balanced (each drawer an equal share of every batch; what stopped
 #             the MT10 pixel rounds from lowering success, section 6c);
-#   epochs:   --training.steps_rule=epochs --training.epochs=12.4 (every phase 12.4 passes over its
-#             frames, warm-started: round 0's compute per frame kept as the data grow, about 1 500 /
-#             1 800 / 2 200 steps instead of 1 500 each).
+#   epochs:   --training.steps_rule=epochs --training.epochs=12.4 (every phase 12.4 passes over all
+#             its rounds' frames, warm-started: round 0's compute per frame kept as the data grow,
+#             about 1 500 / 3 300 / 5 400 steps instead of 1 500 each).
 # A variant keeps the issue's criterion if its mean success over the 3 seeds at phases 1 and 2 is not
 # below its phase 0 (5 episodes per drawer, as the other runs here; noisy: about +-0.05 per mean).
 # Usage, from the kitchen runs' frozen worktree (../study-code-kitchen at a4d22ce):
