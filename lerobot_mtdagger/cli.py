@@ -56,9 +56,9 @@ from lerobot_mtdagger.utils.parsing import parse_options
 from lerobot_mtdagger.utils.ray_session import import_ray
 
 HELDOUT_TASKS = "heldout"
+"""``--suite.tasks='[heldout]'``: the suite's unseen tasks (``eval``, ``shift``)."""
 UNSEEN_RULES: tuple[str, ...] = ("shared", "nearest")
 """``eval --unseen_rule``: how a policy acts on a task it was not trained on (``EvalConfig``)."""
-"""``--suite.tasks='[heldout]'``: the suite's unseen tasks (``eval``, ``shift``)."""
 
 if TYPE_CHECKING:
     from lerobot_mtdagger.envs.base import TaskSuite
