@@ -22,3 +22,9 @@ if ls outputs/visual-dev/unseen-rules/*.json > /dev/null 2>&1; then
   cp outputs/visual-dev/unseen-rules/*.json "$HERE/unseen-rules/"
   .venv/bin/python "$HERE/unseen_rules_summary.py" "$HERE/unseen-rules" > "$HERE/unseen-rules/table.txt"
 fi
+# The kitchen re-evaluations (reeval-kitchen.sh) and their table.
+if ls outputs/visual-dev/reeval-kitchen/*.json > /dev/null 2>&1; then
+  mkdir -p "$HERE/reeval-kitchen"
+  cp outputs/visual-dev/reeval-kitchen/*.json "$HERE/reeval-kitchen/"
+  .venv/bin/python "$HERE/reeval_summary.py" "$HERE/reeval-kitchen" > "$HERE/reeval-kitchen/table.txt"
+fi
