@@ -32,7 +32,7 @@ done | if [ -n "${REVERSE:-}" ]; then tac; else cat; fi | while read -r POLICY; 
   echo "$(date -u +%H:%M:%S) start $RUN $(basename "$POLICY")"
   PYTHONPATH=$PWD OMP_NUM_THREADS=1 MUJOCO_GL=egl .venv/bin/python -m lerobot_mtdagger.cli eval \
     --policy_path="$POLICY" --suite.name=drawers --episodes=20 --seed=9000 --workers=0 \
-    --output="$TARGET.partial" > /dev/null
+    --output="$TARGET.partial" > /dev/null < /dev/null
   mv "$TARGET.partial" "$TARGET"
 done
 echo "$(date -u +%H:%M:%S) done"
