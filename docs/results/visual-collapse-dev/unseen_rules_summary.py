@@ -20,7 +20,8 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
+
+from lerobot_mtdagger.studies.stats import mean_interval
 
 NAME = re.compile(r"^kitchen-seed(?P<seed>\d+)-phase(?P<phase>\d)-(?P<rule>shared|nearest)\.json$")
 PHASES = (0, 1, 2)
@@ -38,13 +39,12 @@ def load(folder: Path) -> dict[tuple[int, int, str], dict]:
 
 
 def t_interval(values: list[float]) -> str:
-    """Mean and 95% t interval over the values (the mean alone for one value)."""
-    mean = float(np.mean(values))
-    if len(values) < 2:
-        return f"{mean:+.3f} (n=1)"
-    half = stats.t.ppf(0.975, len(values) - 1) * np.std(values, ddof=1) / np.sqrt(len(values))
+    """Mean and 95% t interval over the values (``mean_interval``; the mean alone for one value)."""
+    interval = mean_interval(values)
+    if interval.n < 2:
+        return f"{interval.mean:+.3f} (n=1)"
     per_seed = " / ".join(f"{v:+.3f}" for v in values)
-    return f"{mean:+.3f} [{mean - half:+.3f}, {mean + half:+.3f}] ({per_seed})"
+    return f"{interval.mean:+.3f} [{interval.low:+.3f}, {interval.high:+.3f}] ({per_seed})"
 
 
 def main(folder: Path) -> None:
