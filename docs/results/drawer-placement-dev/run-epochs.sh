@@ -6,8 +6,8 @@
 # episodes per training drawer (110) and per unseen drawer (40). Steps: --training.steps_rule=epochs
 # --training.epochs=12.4, the compute per frame of 1 500 steps on the kitchen 10-demo data (7 748
 # frames): about 1 500 / 4 500 / 9 000 steps at 10 / 30 / 60 demos per drawer.
-# Runs, one at a time on one core: kitchen 10, 30, 60 on seed 100, narrow 30 and 60 on seed 100 (narrow at
-# 10 demos is 1 500 steps already: the hold run's phase 0), then kitchen 10, 30, 60 on seeds 101 and 102.
+# Runs, one at a time on one core: kitchen 10, 30, 60 on seeds 100, 101, 102, then narrow 30 and 60 on
+# seed 100 (narrow at 10 demos is 1 500 steps already: the hold run's phase 0).
 # Decision, fixed 2026-11-26 before any of these runs: the drawer evaluation-seed study trains BC with
 # this rule if kitchen BC's mean success over seeds 100-102 at 60 demos is at least its mean at 10
 # demos minus 0.02 (it does not lose success with more data); otherwise it is under-tuned too and the
@@ -30,8 +30,9 @@ run_bc() {  # run_bc PLACEMENT DEMOS SEED
     --rollout.eval_episodes=10 --rollout.workers=1 --seed="$3" --progress=false \
     --output_dir="$out" --resume="$resume" > "$out.log" 2>&1
 }
-for JOB in "kitchen 10 100" "kitchen 30 100" "kitchen 60 100" "narrow 30 100" "narrow 60 100" \
-  "kitchen 10 101" "kitchen 30 101" "kitchen 60 101" "kitchen 10 102" "kitchen 30 102" "kitchen 60 102"; do
+# (Order changed before any run, 2026-11-26: the kitchen runs the decision needs come first.)
+for JOB in "kitchen 10 100" "kitchen 30 100" "kitchen 60 100" "kitchen 10 101" "kitchen 30 101" \
+  "kitchen 60 101" "kitchen 10 102" "kitchen 30 102" "kitchen 60 102" "narrow 30 100" "narrow 60 100"; do
   # shellcheck disable=SC2086
   run_bc $JOB
 done
