@@ -1,12 +1,13 @@
-"""Mean success of every re-evaluated MT10 pixel policy, and the phases' paired changes over seeds.
+"""Mean success of every re-evaluated pixel or drawer policy, and the phases' paired changes over seeds.
 
     .venv/bin/python docs/results/visual-collapse-dev/reeval_summary.py outputs/visual-dev/reeval
 
-Reads the ``eval`` JSONs that ``reeval-pixels.sh`` writes (``<run>-seed<S>-round-00<k>.json``, 20
-episodes per task, evaluation seed 9000 for every policy). Prints per run and phase the mean success
-with its binomial standard error over the 200 episodes, then per run name the change from phase 0 to
-each later phase, per seed and as a mean with its 95% t interval over the seeds that have both, and
-the per-task success of each phase averaged over seeds.
+Reads the ``eval`` JSONs that ``reeval-pixels.sh`` and ``reeval-kitchen.sh`` write
+(``<run>-seed<S>-round-00<k>.json``, 20 episodes per task, evaluation seed 9000 for every policy).
+Prints per run and phase the mean success with its binomial standard error over its episodes, then
+per run name the mean success of each phase over the seeds that have every phase, the change from
+phase 0 to each later phase, per seed and as a mean with its 95% t interval over the seeds that have
+both, and the per-task success of each phase averaged over seeds.
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
+
+from lerobot_mtdagger.studies.stats import mean_interval
 
 NAME = re.compile(r"^(?P<run>.+)-seed(?P<seed>\d+)-round-(?P<round>\d+)\.json$")
 
@@ -35,12 +37,22 @@ def load(folder: Path) -> dict[tuple[str, int, int], dict]:
 
 
 def t_interval(values: list[float]) -> str:
-    """Mean and 95% t interval (the mean alone for one value)."""
-    mean = float(np.mean(values))
-    if len(values) < 2:
-        return f"{mean:+.3f} (1 seed)"
-    half = stats.t.ppf(0.975, len(values) - 1) * np.std(values, ddof=1) / np.sqrt(len(values))
-    return f"{mean:+.3f} [{mean - half:+.3f}, {mean + half:+.3f}] ({len(values)} seeds)"
+    """Mean and 95% t interval (``mean_interval``; the mean alone for one value)."""
+    interval = mean_interval(values)
+    if interval.n < 2:
+        return f"{interval.mean:+.3f} (1 seed)"
+    return f"{interval.mean:+.3f} [{interval.low:+.3f}, {interval.high:+.3f}] ({interval.n} seeds)"
+
+
+def phase_means(results: dict[tuple[str, int, int], dict], run: str) -> str:
+    """The run's mean success per phase over the seeds that have every phase (what the rules read)."""
+    phases = sorted({p for (name, _, p) in results if name == run})
+    seeds = sorted({s for (name, s, _) in results if name == run})
+    complete = [s for s in seeds if all((run, s, p) in results for p in phases)]
+    if not complete:
+        return "no seed has every phase"
+    means = [np.mean([results[(run, s, p)]["mean"] for s in complete]) for p in phases]
+    return " -> ".join(f"{m:.3f}" for m in means) + f" (phases {phases[0]}-{phases[-1]}, seeds {complete})"
 
 
 def main(folder: Path) -> None:
@@ -54,7 +66,8 @@ def main(folder: Path) -> None:
         error = np.sqrt(mean * (1 - mean) / episodes)
         print(f"| {run} | {seed} | {phase} | {mean:.3f} | {error:.3f} | {episodes} |")
     for run in sorted({key[0] for key in results}):
-        print(f"\n{run}: change of mean success from phase 0")
+        print(f"\n{run}: mean success by phase {phase_means(results, run)}")
+        print(f"{run}: change of mean success from phase 0")
         for phase in (1, 2):
             changes = {
                 seed: results[(run, seed, phase)]["mean"] - results[(run, seed, 0)]["mean"]
