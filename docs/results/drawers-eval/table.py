@@ -20,8 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.studies.figures import format_difference
-from lerobot_mtdagger.studies.stats import paired_difference
+from lerobot_mtdagger.studies.figures import paired_line
 
 DEFAULT = Path("docs/results/drawers-eval/report/results.csv")
 METHODS = ("bc", "uniform", "need", "need_raw", "gain")
@@ -54,12 +53,7 @@ def window_mean(curve: dict[float, float]) -> float:
 def difference_line(table: Curves, method: str, baseline: str, seeds: list[int]) -> str:
     """``method - baseline``: per-seed window differences and their mean with the 95% t interval."""
     pairs = [(window_mean(table[method].get(s, {})), window_mean(table[baseline].get(s, {}))) for s in seeds]
-    complete = [(a, b) for a, b in pairs if not (np.isnan(a) or np.isnan(b))]
-    if len(complete) < 2:
-        return f"{method} - {baseline}: fewer than 2 seeds have both"
-    first, second = zip(*complete, strict=True)
-    per_seed = " / ".join(f"{a - b:+.3f}" for a, b in complete)
-    return f"{method} - {baseline}: {per_seed}; {format_difference(paired_difference(first, second))}"
+    return paired_line(f"{method} - {baseline}", pairs)
 
 
 def success_table(table: Curves, seeds: list[int]) -> list[str]:

@@ -21,8 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.studies.figures import format_difference
-from lerobot_mtdagger.studies.stats import paired_difference
+from lerobot_mtdagger.studies.figures import paired_line
 
 DEFAULT = Path("docs/results/pixels-eval/report/results.csv")
 METHODS = ("bc", "uniform", "need", "gain")
@@ -54,16 +53,6 @@ def hardest_tasks(curve: dict[float, list[float]]) -> list[int]:
     return sorted(range(len(first)), key=lambda t: (first[t], t))[:HARDEST]
 
 
-def difference_line(name: str, pairs: list[tuple[float, float]]) -> str:
-    """``name``: per-seed differences and their mean with the 95% t interval (seeds with both)."""
-    complete = [(a, b) for a, b in pairs if not (np.isnan(a) or np.isnan(b))]
-    if len(complete) < 2:
-        return f"{name}: fewer than 2 seeds have both"
-    first, second = zip(*complete, strict=True)
-    per_seed = " / ".join(f"{a - b:+.3f}" for a, b in complete)
-    return f"{name}: {per_seed}; {format_difference(paired_difference(first, second))}"
-
-
 def main(path: Path) -> None:
     """Prints the success table, the primary and the secondary outcomes."""
     table = load(path)
@@ -86,7 +75,7 @@ def main(path: Path) -> None:
             )
             for s in seeds
         ]
-        print(difference_line(f"{method} - {baseline}", pairs))
+        print(paired_line(f"{method} - {baseline}", pairs))
     print(f"\nThe {HARDEST} hardest tasks of each seed (uniform's phase 0), at {WINDOW[1]:g} demos per task:")
     for method in ("need", "gain"):
         pairs = []
@@ -102,7 +91,7 @@ def main(path: Path) -> None:
                     mean_success(uniform, *at_end, tasks),
                 )
             )
-        print(difference_line(f"{method} - uniform", pairs))
+        print(paired_line(f"{method} - uniform", pairs))
 
 
 if __name__ == "__main__":
