@@ -618,3 +618,51 @@ def test_a_paired_line_gives_each_seed_s_difference_and_skips_seeds_missing_a_si
     pairs = [(0.9, 0.6), (0.8, 0.6), (nan, 0.5), (0.7, 0.6)]
     assert paired_line("need - bc", pairs) == "need - bc: +0.300 / +0.200 / +0.100; +0.200 [-0.048, +0.448]"
     assert paired_line("need - bc", [(0.9, 0.6), (0.8, nan)]) == "need - bc: fewer than 2 seeds have both"
+
+
+@pytest.mark.parametrize(
+    ("cores", "jobs", "environ", "run_args", "expected"),
+    [
+        (None, None, {}, [], (2, 1, 0)),  # default: one run per core of this process, in-process envs
+        (None, 1, {}, [], (1, 2, 2)),  # one run gets both cores: 2 threads, 2 env workers
+        (1, 1, {}, [], (1, 1, 0)),  # --cores=1 leaves the other core to other work
+        (None, 1, {"OMP_NUM_THREADS": "1"}, [], (1, 1, 0)),  # compare's OMP_NUM_THREADS caps each run
+        (None, 1, {}, ["--rollout.workers=1"], (1, 2, None)),  # the run options' workers hold
+    ],
+)
+def test_runs_get_the_cores_they_are_given_and_no_more(monkeypatch, cores, jobs, environ, run_args, expected):
+    """Two threads per run beside another job made point-cloud training about 20x slower."""
+    from lerobot_mtdagger.studies import compare as compare_module
+
+    monkeypatch.setattr(compare_module, "default_worker_count", lambda: 2)
+    config = CompareConfig(cores=cores, jobs=jobs)
+    assert compare_module.run_resources(config, run_args, environ) == expected
+
+
+def test_a_run_launched_with_the_run_options_workers_keeps_them(tmp_path):
+    from lerobot_mtdagger.studies.launchers import Job, job_command
+
+    job = Job("uniform-seed0", ("--rollout.workers=1",), last_phase=1)
+    command, variables = job_command(job, tmp_path / "uniform-seed0", threads=1, workers=None)
+    assert [arg for arg in command if arg.startswith("--rollout.workers")] == ["--rollout.workers=1"]
+    assert variables == {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+    command, _ = job_command(job, tmp_path / "uniform-seed0", threads=2, workers=2)
+    assert command[-2:] == ["--rollout.workers=2", "--progress=false"]
+
+
+@pytest.mark.parametrize(
+    ("option", "environ", "message"),
+    [
+        ("--cores=0", {}, "--cores must be >= 1, got 0."),
+        ("--jobs=1", {"OMP_NUM_THREADS": "two"}, "OMP_NUM_THREADS='two' is not a positive whole number"),
+    ],
+)
+def test_bad_core_or_thread_counts_are_refused_naming_the_fix(
+    tmp_path, monkeypatch, capsys, option, environ, message
+):
+    for name, value in environ.items():
+        monkeypatch.setenv(name, value)
+    code = main(["compare", option, "--methods=[bc]", "--seeds=[0]", f"--output_dir={tmp_path}", *TINY])
+    assert code != 0
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "runs").exists()

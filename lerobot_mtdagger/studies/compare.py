@@ -15,7 +15,9 @@ where DAgger has one; BC at the budget of round k is ``run --mode=bc --dagger.ro
 trains it by the same rule as DAgger's phase k (``RunConfig.phase_steps``).
 
 Runs are independent processes (``--jobs`` at once, default one per core); each gets
-``cores / jobs`` torch threads and env workers so the jobs do not oversubscribe the cores. A
+``cores / jobs`` torch threads and env workers so the jobs do not oversubscribe the cores
+(``run_resources``: ``--cores``, ``taskset``, ``OMP_NUM_THREADS`` and an explicit ``--rollout.workers``
+are respected, so a study can share the machine with other work). A
 finished run is skipped, a cut-off run is resumed (``--resume=true``), so ``compare`` itself resumes.
 A run started by ``compare`` ends itself within a second of ``compare`` ending (``follow_parent``), so a
 ``compare`` that is killed leaves no run writing on into its folder.
@@ -31,7 +33,7 @@ import os
 import signal
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -58,6 +60,9 @@ class CompareConfig:
         seeds: Seeds; every method runs every seed.
         bc_budgets: BC expert demos per task (empty: DAgger's cumulative demos after each round).
         jobs: Runs at once with ``launcher=local`` (None: one per core).
+        cores: Cores the local runs share (None: the cores this process may run on, so
+            ``taskset -c 1 lerobot-mtdagger compare ...`` keeps a study on core 1); each run gets
+            ``cores // jobs`` torch threads (``run_resources``).
         output_dir: The compare folder (on storage every Ray node sees, with ``launcher=ray``).
         launcher: ``local`` (each run a process on this machine) or ``ray`` (each run a Ray task
             on the cluster at ``ray_address``, ``studies/launchers.py``).
@@ -73,6 +78,7 @@ class CompareConfig:
     seeds: list[int] = field(default_factory=lambda: [0, 1, 2])
     bc_budgets: list[int] = field(default_factory=list)
     jobs: int | None = None
+    cores: int | None = None
     output_dir: Path = Path("outputs/compare")
     launcher: str = "local"
     ray_address: str | None = None
@@ -209,6 +215,49 @@ def _end_when_orphaned(parent: int, poll_s: float) -> None:
     os.kill(os.getpid(), signal.SIGTERM)
 
 
+def run_resources(
+    compare_config: CompareConfig, run_args: Sequence[str], environ: Mapping[str, str]
+) -> tuple[int, int, int | None]:
+    """Runs at once, torch threads per run and env workers per run of a local ``compare``.
+
+    The cores are ``--cores`` or those this process may run on (``taskset``). Each of the ``--jobs``
+    runs gets ``cores // jobs`` threads, fewer if ``OMP_NUM_THREADS`` is set for ``compare``: a run
+    given more threads than it has cores trains many times slower (a point-cloud training phase beside
+    one other job: 1.4 steps/s with 2 threads, 16.5 with 1; ``docs/benchmarks.md``). Env
+    workers match the threads (0, in-process, below 2) unless the run options set
+    ``--rollout.workers``, which then holds.
+
+    Args:
+        compare_config: ``compare``'s options.
+        run_args: The options passed to every run.
+        environ: ``compare``'s environment.
+
+    Returns:
+        ``(parallel, threads, workers)``; ``workers`` is None when the run options choose it.
+
+    Raises:
+        UserError: If ``OMP_NUM_THREADS`` is not a positive whole number.
+    """
+    cores = compare_config.cores or default_worker_count()
+    parallel = compare_config.jobs or cores
+    threads = max(1, cores // parallel)
+    asked = environ.get("OMP_NUM_THREADS", "").strip()
+    if asked:
+        if not asked.isdigit() or int(asked) < 1:
+            raise UserError(f"OMP_NUM_THREADS={asked!r} is not a positive whole number; unset it or fix it.")
+        threads = min(threads, int(asked))
+    chosen = any(arg.split("=", 1)[0] == "--rollout.workers" for arg in run_args)
+    workers = None if chosen else (0 if threads < 2 else threads)
+    logger.info(
+        "%d run(s) at once on %d core(s): %d torch thread(s) and %s env worker(s) each",
+        parallel,
+        cores,
+        threads,
+        "the run options'" if workers is None else workers,
+    )
+    return parallel, threads, workers
+
+
 def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict]:
     """Runs every job and writes the results table; returns its rows.
 
@@ -219,6 +268,8 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     """
     if compare_config.jobs is not None and compare_config.jobs < 1:
         raise UserError(f"--jobs must be >= 1, got {compare_config.jobs}.")
+    if compare_config.cores is not None and compare_config.cores < 1:
+        raise UserError(f"--cores must be >= 1, got {compare_config.cores}.")
     if not compare_config.methods or not compare_config.seeds:
         raise UserError("--methods and --seeds must not be empty.")
     known = ("bc", *scheduling_methods())
@@ -230,10 +281,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
 
     task_names = suite_from_config(base_run_config(run_args).suite).task_names
     jobs = jobs_for(compare_config, run_args, len(task_names))
-    cores = default_worker_count()
-    parallel = compare_config.jobs or cores
-    threads = max(1, cores // parallel)
-    workers = 0 if threads < 2 else threads
+    parallel, threads, workers = run_resources(compare_config, run_args, os.environ)
     runs_dir = compare_config.output_dir / RUNS_DIR
     runs_dir.mkdir(parents=True, exist_ok=True)
     (compare_config.output_dir / COMPARE_FILE).write_text(

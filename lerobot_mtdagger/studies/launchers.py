@@ -54,10 +54,13 @@ def is_finished(folder: Path, last_phase: int) -> bool:
     return last_phase in ExperimentDir(folder).committed_phases()
 
 
-def job_command(job: Job, folder: Path, threads: int, workers: int) -> tuple[list[str], dict[str, str]]:
+def job_command(
+    job: Job, folder: Path, threads: int, workers: int | None
+) -> tuple[list[str], dict[str, str]]:
     """One job's ``lerobot-mtdagger run`` command (resumed if started) and its environment variables.
 
     The variables are the thread counts; the pid the run must not outlive is the launcher's to add.
+    ``workers`` None leaves ``--rollout.workers`` to the job's own options.
     """
     from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
 
@@ -69,7 +72,7 @@ def job_command(job: Job, folder: Path, threads: int, workers: int) -> tuple[lis
         "run",
         *job.args,
         f"--output_dir={folder}",
-        f"--rollout.workers={workers}",
+        *([] if workers is None else [f"--rollout.workers={workers}"]),
         "--progress=false",
         *resume,
     ]
@@ -83,14 +86,14 @@ class RunPool:
     thread) starts no further run and ends the running ones, which the next ``compare`` resumes.
     """
 
-    def __init__(self, runs_dir: Path, parallel: int, threads: int, workers: int) -> None:
+    def __init__(self, runs_dir: Path, parallel: int, threads: int, workers: int | None) -> None:
         """Prepares the pool; nothing runs before ``run_all``.
 
         Args:
             runs_dir: The compare folder's ``runs/``.
             parallel: Runs at once.
             threads: Torch threads per run.
-            workers: Env worker processes per run.
+            workers: Env worker processes per run (None: the run options choose).
         """
         self.runs_dir = runs_dir
         self.parallel = parallel
