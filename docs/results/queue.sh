@@ -2,7 +2,9 @@
 # The #31 studies queued on ONE core of the 2-core machine (the other core runs the drawer studies of
 # the visual issue), each from its frozen worktree, each resumable; run again after any stop (a
 # finished study is only re-reported):
-#   nohup bash docs/results/queue.sh >> outputs/queue.log 2>&1 &
+#   nohup taskset -c 0 bash docs/results/queue.sh >> outputs/queue.log 2>&1 &
+# (`taskset -c 0`: the studies' frozen `compare --jobs=1` would otherwise give each run 2 torch threads
+# beside the other core's study, about 10x slower training; docs/benchmarks.md, "Threads per run").
 # (run a copy, e.g. `cp docs/results/queue.sh outputs/queue-running.sh`, so that editing this file
 # cannot change a running queue). In this order, one job at a time:
 # 1. pixels-bc-dev (../study-code-pixels-bc at af74c16), then its records and its decision copied
