@@ -631,7 +631,7 @@ def test_a_paired_line_gives_each_seed_s_difference_and_skips_seeds_missing_a_si
     ],
 )
 def test_runs_get_the_cores_they_are_given_and_no_more(monkeypatch, cores, jobs, environ, run_args, expected):
-    """Two threads per run beside another job made point-cloud training about 20x slower."""
+    """Two threads per run beside another job trained point clouds over 10x slower (1.4 vs 16.5 steps/s)."""
     from lerobot_mtdagger.studies import compare as compare_module
 
     monkeypatch.setattr(compare_module, "default_worker_count", lambda: 2)
