@@ -895,12 +895,18 @@ def student_config(
 
 
 def _new_student(policy_cfg: Any, stats: dict[str, dict[str, np.ndarray]]) -> tuple[Any, Any, Any]:
-    """A freshly initialised student and its processors for ``stats``."""
-    if isinstance(policy_cfg, MTDAggerConfig):
-        return MTDAggerPolicy(policy_cfg), *build_processors(policy_cfg, stats)
-    from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
+    """A freshly initialised student on its config's device, and its processors for ``stats``.
 
-    return make_lerobot_student(policy_cfg), *make_lerobot_processors(policy_cfg, stats)
+    The weights are drawn on the CPU and then moved, so a seed gives the same initial weights on
+    every device (LeRobot's policy constructors leave a policy on the CPU; its ``make_policy`` moves it).
+    """
+    if isinstance(policy_cfg, MTDAggerConfig):
+        policy, processors = MTDAggerPolicy(policy_cfg), build_processors(policy_cfg, stats)
+    else:
+        from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
+
+        policy, processors = make_lerobot_student(policy_cfg), make_lerobot_processors(policy_cfg, stats)
+    return policy.to(policy_cfg.device), *processors
 
 
 def _previous_losses(
