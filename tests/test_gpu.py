@@ -59,3 +59,21 @@ def test_a_point_cloud_drawer_run_trains_collects_and_evaluates_on_cuda(tmp_path
     torch.testing.assert_close(
         on_gpu.predict(inputs, tasks), on_cpu.predict(inputs, tasks), atol=1e-4, rtol=1e-4
     )
+
+
+@pytest.mark.parametrize("student", ["act", "diffusion"])
+def test_a_lerobot_student_run_trains_collects_and_evaluates_on_cuda(tmp_path, student):
+    """The learner seam on the GPU: LeRobot's ACT and Diffusion Policy as the student, every round."""
+    from tests.test_students import TINY_ACT, TINY_DIFFUSION, TOY_STUDENT_RUN
+
+    tiny = {"act": TINY_ACT, "diffusion": TINY_DIFFUSION}[student]
+    args = [*TOY_STUDENT_RUN, *tiny, f"--output_dir={tmp_path / 'run'}", "--policy.device=cuda"]
+    run(draccus.parse(RunConfig, args=args))
+    experiment = ExperimentDir(tmp_path / "run")
+    assert experiment.committed_phases() == [0, 1, 2]
+    assert verify_experiment(experiment) == (3, 3, [])
+    phase = experiment.read_phase_record(2)
+    assert phase.eval is not None and len(phase.eval["success"]) == 3
+    assert all(loss is not None and torch.isfinite(torch.tensor(loss)) for loss in phase.loss_end)
+    loaded = PolicyRunner.from_pretrained(experiment.policy_root(2), "cuda")
+    assert next(loaded.policy.parameters()).device.type == "cuda"

@@ -91,8 +91,11 @@ def lerobot_student_config(
 
 
 def make_lerobot_student(spec: LeRobotStudentConfig) -> Any:
-    """A freshly initialised LeRobot policy of ``spec`` (seed torch before for reproducible weights)."""
-    return get_policy_class(spec.policy.type)(spec.policy)
+    """A freshly initialised LeRobot policy of ``spec`` on its config's device, as LeRobot's ``make_policy``.
+
+    Seed torch before for reproducible weights (drawn on the CPU, then moved).
+    """
+    return get_policy_class(spec.policy.type)(spec.policy).to(spec.policy.device)
 
 
 def make_lerobot_processors(spec: LeRobotStudentConfig, stats: dict[str, dict[str, Any]]) -> tuple[Any, Any]:

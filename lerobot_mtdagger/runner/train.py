@@ -901,12 +901,10 @@ def _new_student(policy_cfg: Any, stats: dict[str, dict[str, np.ndarray]]) -> tu
     every device (LeRobot's policy constructors leave a policy on the CPU; its ``make_policy`` moves it).
     """
     if isinstance(policy_cfg, MTDAggerConfig):
-        policy, processors = MTDAggerPolicy(policy_cfg), build_processors(policy_cfg, stats)
-    else:
-        from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
+        return MTDAggerPolicy(policy_cfg).to(policy_cfg.device), *build_processors(policy_cfg, stats)
+    from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
 
-        policy, processors = make_lerobot_student(policy_cfg), make_lerobot_processors(policy_cfg, stats)
-    return policy.to(policy_cfg.device), *processors
+    return make_lerobot_student(policy_cfg), *make_lerobot_processors(policy_cfg, stats)
 
 
 def _previous_losses(
