@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import torch
 
+from benchmarks.bench_cloud import former_cloud
 from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, SUITE_NAMES, make_suite
 from lerobot_mtdagger.envs.metaworld import METAWORLD_CROP, MT10_TASKS, MT25_TASKS, MT50_TASKS
 from lerobot_mtdagger.experts import CallableExpert, LeRobotPolicyExpert, make_expert
@@ -129,6 +130,30 @@ def test_point_cloud_is_exact_finite_and_inside_the_crop():
     assert np.all(np.isfinite(cloud))
     assert np.all(METAWORLD_CROP.contains(cloud.astype(np.float64)))
     assert cloud[:, 2].min() >= METAWORLD_CROP.low[2], "the table top must be cropped away"
+    env.close()
+
+
+@pytest.mark.parametrize(
+    ("suite_name", "task", "color"),
+    [
+        ("metaworld-mt10", "push-v3", False),
+        ("drawers", "drawer-kitchen", False),
+        ("drawers", "drawer-knob-deep", True),
+    ],
+)
+def test_the_cloud_is_the_former_row_by_row_back_projection(suite_name, task, color):
+    """Back-projecting per coordinate plane (fast) keeps the points, their order and the sampling."""
+    suite = make_suite(suite_name, obs_mode="pointcloud", num_points=600, pointcloud_color=color)
+    env = suite.make_env(task, seed=2)
+    env.reset(seed=2)
+    camera, data = env.unwrapped._cloud, env.unwrapped._env.data
+    for step in range(4):
+        env.step(np.array([0.6, -0.4, -0.8, 0.3]) * (-1) ** step)
+        seed = np.random.default_rng(step).integers(1 << 30)
+        new = camera.capture(data, np.random.default_rng(seed))
+        old = former_cloud(camera, data, np.random.default_rng(seed))
+        assert new.shape == old.shape == (600, 6 if color else 3)
+        np.testing.assert_allclose(new, old, rtol=0, atol=1e-6)
     env.close()
 
 

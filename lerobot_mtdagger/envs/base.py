@@ -57,7 +57,19 @@ class CropBox:
 
     def contains(self, points: np.ndarray) -> np.ndarray:
         """Boolean mask of the rows of ``points`` (..., 3) inside the box."""
-        return np.all((points >= np.asarray(self.low)) & (points <= np.asarray(self.high)), axis=-1)
+        return self.contains_planes(np.moveaxis(points, -1, 0))
+
+    def contains_planes(self, planes: np.ndarray) -> np.ndarray:
+        """Boolean mask (...) of the points given as coordinate planes ``planes`` (3, ...) inside the box.
+
+        One comparison per face on each (contiguous) plane: several times faster than comparing
+        (N, 3) rows for the back-projected depth images of a point-cloud camera.
+        """
+        inside = (planes[0] >= self.low[0]) & (planes[0] <= self.high[0])
+        for axis in (1, 2):
+            inside &= planes[axis] >= self.low[axis]
+            inside &= planes[axis] <= self.high[axis]
+        return inside
 
     @property
     def center(self) -> np.ndarray:
