@@ -196,6 +196,18 @@ def test_a_learning_rate_schedule_is_checked_and_refused_for_a_lerobot_student(c
     assert "follows its own scheduler preset" in capsys.readouterr().err and not out.exists()
 
 
+@pytest.mark.parametrize(
+    ("student", "message"),
+    [("act", "--policy.use_amp is not supported by run"), ("mtdagger", "`use_amp` are not valid")],
+)
+def test_mixed_precision_is_refused_not_ignored(capsys, tmp_path, student, message):
+    """A LeRobot student's config has ``use_amp`` (read by lerobot-eval); the runner trains in float32."""
+    out = tmp_path / "out"
+    assert main(["run", f"--policy.type={student}", "--policy.use_amp=true", f"--output_dir={out}"]) == 2
+    assert message in capsys.readouterr().err and not out.exists()
+    assert parse("--policy.type=act", "--policy.use_amp=false").policy.use_amp is False
+
+
 def test_the_run_config_has_at_most_twelve_top_level_options():
     assert len(dataclasses.fields(RunConfig)) <= 12
 

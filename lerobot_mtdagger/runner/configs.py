@@ -558,6 +558,11 @@ class RunConfig:
                 f"got {self.policy.batch_size}, {lr}."
             )
         check_device(self.policy.device)
+        if getattr(self.policy, "use_amp", False):  # LeRobot's option, read by lerobot-eval only
+            raise ValueError(
+                "--policy.use_amp is not supported by run: its training, collection and evaluation "
+                "run in float32; drop the option (lerobot-eval honours it for a saved policy)."
+            )
         self._check_student()
 
     def _check_student(self) -> None:
