@@ -197,14 +197,21 @@ def test_a_learning_rate_schedule_is_checked_and_refused_for_a_lerobot_student(c
 
 
 @pytest.mark.parametrize(
-    ("student", "message"),
-    [("act", "--policy.use_amp is not supported by run"), ("mtdagger", "`use_amp` are not valid")],
+    ("option", "message"),
+    [
+        ("--policy.use_amp=true", "--policy.use_amp is not supported by run: its training, collection"),
+        ("--policy.use_peft=true", "--policy.use_peft is not supported by run"),
+        ("--policy.push_to_hub=true", "`lerobot-mtdagger push` uploads"),
+        ("--policy.pretrained_path=outputs/some/policy", "--policy.pretrained_path is not supported"),
+    ],
 )
-def test_mixed_precision_is_refused_not_ignored(capsys, tmp_path, student, message):
-    """A LeRobot student's config has ``use_amp`` (read by lerobot-eval); the runner trains in float32."""
+def test_lerobot_options_the_runner_would_ignore_are_refused(capsys, tmp_path, option, message):
+    """A LeRobot student's config has them (read by lerobot-train and lerobot-eval); run does not."""
     out = tmp_path / "out"
-    assert main(["run", f"--policy.type={student}", "--policy.use_amp=true", f"--output_dir={out}"]) == 2
+    assert main(["run", "--policy.type=act", option, f"--output_dir={out}"]) == 2
     assert message in capsys.readouterr().err and not out.exists()
+    assert main(["run", "--policy.use_amp=true", f"--output_dir={out}"]) == 2  # mtdagger has no such option
+    assert "`use_amp` are not valid" in capsys.readouterr().err and not out.exists()
     assert parse("--policy.type=act", "--policy.use_amp=false").policy.use_amp is False
 
 

@@ -112,6 +112,16 @@ def _lerobot_student(config_class: type) -> type:
     return student
 
 
+UNSUPPORTED_STUDENT_OPTIONS: dict[str, str] = {
+    "use_amp": "its training, collection and evaluation run in float32 (lerobot-eval honours it for a "
+    "saved policy)",
+    "use_peft": "the student is trained in full",
+    "push_to_hub": "`lerobot-mtdagger push` uploads a run's rounds and policies",
+    "pretrained_path": "each phase starts from the previous phase's policy (training.warm_start) or afresh",
+}
+"""Options of LeRobot's policy configs that ``run`` would otherwise ignore: refused, naming why."""
+
+
 LEROBOT_STUDENT_TYPES: tuple[str, ...] = ("act", "diffusion")
 """``--policy.type`` values other than ``mtdagger``: LeRobot's own policies as the student."""
 
@@ -558,11 +568,9 @@ class RunConfig:
                 f"got {self.policy.batch_size}, {lr}."
             )
         check_device(self.policy.device)
-        if getattr(self.policy, "use_amp", False):  # LeRobot's option, read by lerobot-eval only
-            raise ValueError(
-                "--policy.use_amp is not supported by run: its training, collection and evaluation "
-                "run in float32; drop the option (lerobot-eval honours it for a saved policy)."
-            )
+        for name, reason in UNSUPPORTED_STUDENT_OPTIONS.items():
+            if getattr(self.policy, name, None) not in (None, False):
+                raise ValueError(f"--policy.{name} is not supported by run: {reason}; drop the option.")
         self._check_student()
 
     def _check_student(self) -> None:
