@@ -108,6 +108,16 @@ def test_max_pool_of_winners_gives_the_dense_max_pool_and_its_gradient(layer_nor
     assert bool(dense_grads[0][:, 20:].eq(0).all()), "a tie's gradient goes to its first point only"
 
 
+def test_clouds_are_searched_in_chunks_on_a_cpu_only():
+    """Chunks keep a CPU's cache; on a GPU (here the meta device, which has no data) one pass."""
+    from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import SEARCH_CHUNK_POINTS, cloud_chunks
+
+    on_cpu = cloud_chunks(torch.zeros(256, 1024, 3))
+    assert len(on_cpu) == 256 * 1024 // SEARCH_CHUNK_POINTS and torch.cat(on_cpu).shape == (256, 1024, 3)
+    elsewhere = cloud_chunks(torch.empty(256, 1024, 3, device="meta"))
+    assert len(elsewhere) == 1 and elsewhere[0].shape == (256, 1024, 3)
+
+
 def test_the_dp3_encoder_has_dp3s_size_and_round_trips(tmp_path):
     cloud = PolicyFeature(type=FeatureType.STATE, shape=(512, 3))
     inputs = {"observation.state": STATE, "observation.pointcloud": cloud}

@@ -95,12 +95,19 @@ class PointNetEncoder(nn.Module):
 
 
 SEARCH_CHUNK_POINTS = 2048
-"""Points per chunk of a pass without gradients: a few clouds at a time keep the per-point features
-in the CPU's cache (measured: 2-3x faster than all clouds at once at 512 points)."""
+"""Points per chunk of a pass without gradients on a CPU: a few clouds at a time keep the per-point
+features in the CPU's cache (measured: 2-3x faster than all clouds at once at 512 points)."""
 
 
 def cloud_chunks(points: Tensor) -> tuple[Tensor, ...]:
-    """(B, N, C) split along B into chunks of about SEARCH_CHUNK_POINTS points."""
+    """(B, N, C) split along B into chunks of about SEARCH_CHUNK_POINTS points on a CPU, whole elsewhere.
+
+    The chunks are for a CPU's cache. On a GPU they would only multiply the kernel launches: at 1 024
+    points a batch of 256 clouds made 128 passes of the per-point MLP, and PointNet trained at a
+    tenth of the RGB encoder's samples/s on an H100 (docs/benchmarks.md, "On a GPU").
+    """
+    if points.device.type != "cpu":
+        return (points,)
     return points.split(max(1, SEARCH_CHUNK_POINTS // max(1, points.shape[1])))
 
 
