@@ -7,8 +7,8 @@ On one env's real depth renders (the suite's default two cameras, 84 x 84, 1 024
 
 - ``former``: each camera's (H * W, 3) points as ``(rays * depth) @ R.T + p``, cropped row by row
   (``former_cloud``, the code before the per-plane back-projection; also the tests' reference);
-- ``planes``: ``rendering.depth_to_world`` (one (H, W) plane per world axis) and
-  ``CropBox.contains_planes``, as ``capture`` does now.
+- ``planes``: ``PointCloudCamera.cloud_from_renders``, what ``capture`` does after its renders
+  (``rendering.depth_to_world``: one (H, W) plane per world axis; ``CropBox.contains_planes``).
 
 Both sample the same points from the same generator state. The depth renders are taken once and
 reused, so only the CPU-side work is timed; on a GPU renderer that work is a large share of a
@@ -24,7 +24,6 @@ import time
 import numpy as np
 
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.envs.rendering import depth_to_world, sample_points
 
 TARGET = 0.5
 
@@ -52,14 +51,8 @@ def former_cloud(camera, data, rng: np.random.Generator, depths: dict | None = N
 
 
 def planes_cloud(camera, data, rng: np.random.Generator, depths: dict) -> np.ndarray:
-    """``PointCloudCamera.capture`` after its renders (xyz clouds), on the given depth images."""
-    parts = []
-    for name, camera_id, rays in zip(camera.cameras, camera._ids, camera._rays, strict=True):
-        rotation = data.cam_xmat[camera_id].reshape(3, 3)
-        planes = depth_to_world(depths[name], rays, data.cam_xpos[camera_id], rotation)
-        parts.append(planes[:, camera.crop.contains_planes(planes)].T)
-    cloud = np.concatenate(parts)
-    return sample_points(cloud, camera.num_points, rng, camera.crop.center).astype(np.float32)
+    """``capture`` after its renders (xyz clouds), on the given depth images."""
+    return camera.cloud_from_renders(data, depths, rng)
 
 
 def time_per_call(function, camera, data, depths: dict, steps: int) -> float:

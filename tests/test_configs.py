@@ -208,8 +208,15 @@ def test_a_learning_rate_schedule_is_checked_and_refused_for_a_lerobot_student(c
 def test_lerobot_options_the_runner_would_ignore_are_refused(capsys, tmp_path, option, message):
     """A LeRobot student's config has them (read by lerobot-train and lerobot-eval); run does not."""
     out = tmp_path / "out"
-    assert main(["run", "--policy.type=act", option, f"--output_dir={out}"]) == 2
+    # A toy BC run, so that a refusal that went missing fails in seconds, not after a whole experiment.
+    tiny = ["--suite.name=toy", "--dagger.rounds=0", "--dagger.initial_demos=1", "--rollout.eval_episodes=1"]
+    tiny += ["--rollout.max_steps=10", "--training.steps_per_round=2", "--policy.batch_size=8"]
+    assert main(["run", *tiny, "--policy.type=act", option, f"--output_dir={out}"]) == 2
     assert message in capsys.readouterr().err and not out.exists()
+
+
+def test_mixed_precision_is_no_option_of_mtdagger_and_off_is_accepted(capsys, tmp_path):
+    out = tmp_path / "out"
     assert main(["run", "--policy.use_amp=true", f"--output_dir={out}"]) == 2  # mtdagger has no such option
     assert "`use_amp` are not valid" in capsys.readouterr().err and not out.exists()
     assert parse("--policy.type=act", "--policy.use_amp=false").policy.use_amp is False

@@ -309,16 +309,35 @@ class PointCloudCamera:
         Returns:
             (num_points, 3) float32 world-frame xyz, or (num_points, 6) with rgb in [0, 1].
         """
+        depths = {camera: self.renderer.depth(data, camera) for camera in self.cameras}
+        colors = (
+            {camera: self.renderer.rgb(data, camera) for camera in self.cameras} if self.with_color else None
+        )
+        return self.cloud_from_renders(data, depths, rng, colors)
+
+    def cloud_from_renders(
+        self,
+        data: mujoco.MjData,
+        depths: dict[str, np.ndarray],
+        rng: np.random.Generator,
+        colors: dict[str, np.ndarray] | None = None,
+    ) -> np.ndarray:
+        """``capture`` after its renders: back-projects, crops and samples the cloud.
+
+        Args:
+            data: The state the renders show (its camera poses are read).
+            depths: Each camera's (H, W) depth render.
+            rng: The seeded generator that samples the points.
+            colors: Each camera's (H, W, 3) uint8 render, when the cloud has colour.
+        """
         parts = []
         for camera, camera_id, rays in zip(self.cameras, self._ids, self._rays, strict=True):
-            depth = self.renderer.depth(data, camera)
             rotation = data.cam_xmat[camera_id].reshape(3, 3)
-            planes = depth_to_world(depth, rays, data.cam_xpos[camera_id], rotation)
+            planes = depth_to_world(depths[camera], rays, data.cam_xpos[camera_id], rotation)
             keep = self.crop.contains_planes(planes)
             points = planes[:, keep].T
-            if self.with_color:
-                colors = self.renderer.rgb(data, camera)[keep] / 255.0
-                points = np.concatenate([points, colors], axis=1)
+            if colors is not None:
+                points = np.concatenate([points, colors[camera][keep] / 255.0], axis=1)
             parts.append(points)
         cloud = np.concatenate(parts, axis=0)
         fallback = np.concatenate([self.crop.center, np.zeros(self.channels - 3)])

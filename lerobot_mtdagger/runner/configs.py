@@ -568,15 +568,18 @@ class RunConfig:
                 f"got {self.policy.batch_size}, {lr}."
             )
         check_device(self.policy.device)
-        for name, reason in UNSUPPORTED_STUDENT_OPTIONS.items():
-            if getattr(self.policy, name, None) not in (None, False):
-                raise ValueError(f"--policy.{name} is not supported by run: {reason}; drop the option.")
         self._check_student()
 
     def _check_student(self) -> None:
-        """Refuses a LeRobot student the runner cannot train (point clouds, temporal ensembling)."""
+        """Refuses what a LeRobot student cannot do here: point clouds, temporal ensembling, ignored options.
+
+        The options are those of its LeRobot config the runner would ignore (``UNSUPPORTED_STUDENT_OPTIONS``).
+        """
         if self.student_type == "mtdagger":
             return
+        for name, reason in UNSUPPORTED_STUDENT_OPTIONS.items():
+            if getattr(self.policy, name, None) not in (None, False):
+                raise ValueError(f"--policy.{name} is not supported by run: {reason}; drop the option.")
         if self.training.lr_schedule != "constant":
             raise ValueError(
                 f"--training.lr_schedule={self.training.lr_schedule} is for the mtdagger policy; "
