@@ -7,9 +7,11 @@
 #
 # Core 1: the drawers-eval DAgger stage (../study-code-drawers-eval, all 12 runs), then, once seed 2's
 #   second process is done too, the stage once more (its plan and table list all runs) and its report
-#   (report/ and table.txt copied here), then drawers-preset-dev (../study-code-drawers-preset).
+#   (report/ and table.txt copied here), then queue.sh's plateau lane (bc-past-plateau-dev, then
+#   beyond-plateau-best-bc), then drawers-preset-dev (../study-code-drawers-preset).
 # Core 0: seed 2's drawers-eval DAgger runs (the second compare process of the drawers-eval README),
-#   then the queue of pixels-bc-dev, bc-past-plateau-dev and pixels-eval (queue.sh, run from a copy).
+#   then queue.sh's pixels lane (pixels-bc-dev, then pixels-eval).
+# A lane runs from a copy (outputs/queue-running-<lane>.sh) so that editing queue.sh cannot change it.
 # Worktrees as their READMEs say: `git worktree add --detach ../<name> <commit>`, then in it
 # `ln -sf ../main/.venv .venv && ln -sfn ../main/outputs outputs`.
 set -uo pipefail
@@ -36,6 +38,14 @@ drawers_dagger() {  # drawers_dagger CORE [SEEDS]: the drawers-eval DAgger runs 
   fi
 }
 
+queue_lane() {  # queue_lane CORE LANE: queue.sh's lane, from a copy, once no copy of it runs
+  wait_while_running "outputs/queue-running-$2.sh"
+  log "core $1: queue.sh's $2 lane"
+  cp docs/results/queue.sh "outputs/queue-running-$2.sh"
+  taskset -c "$1" bash "outputs/queue-running-$2.sh" "$2" >> "outputs/queue-$2.log" 2>&1 \
+    || log "core $1: the $2 lane stopped with an error: see outputs/queue-$2.log"
+}
+
 core1() {
   wait_while_running "$STAGE_PATTERN"
   log "core 1: drawers-eval DAgger stage"
@@ -49,6 +59,7 @@ core1() {
   cp -r "$DRAWERS/docs/results/drawers-eval/report/." docs/results/drawers-eval/report/
   cp "$DRAWERS/docs/results/drawers-eval/table.txt" docs/results/drawers-eval/table.txt
   bash docs/results/drawers-eval/save_records.sh
+  queue_lane 1 plateau
   log "core 1: drawers-preset-dev"
   (cd ../study-code-drawers-preset && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c 1 \
     bash docs/results/drawers-preset-dev/run.sh >> outputs/drawers-preset-dev.log 2>&1)
@@ -59,10 +70,7 @@ core0() {
   wait_while_running "$SEED2_PATTERN"
   log "core 0: drawers-eval DAgger seed 2"
   drawers_dagger 0 '[2]' || log "core 0: seed 2's compare stopped with an error"
-  wait_while_running "outputs/queue-running.sh"
-  log "core 0: the #31 queue"
-  cp docs/results/queue.sh outputs/queue-running.sh
-  taskset -c 0 bash outputs/queue-running.sh >> outputs/queue.log 2>&1
+  queue_lane 0 pixels
   log "core 0: done"
 }
 
