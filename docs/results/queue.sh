@@ -12,7 +12,7 @@
 #   at f33425a), then its records;
 # - plateau: bc-past-plateau-dev (../study-code-bc-plateau at d274b72), then its records and its
 #   decision copied into the beyond-plateau-best-bc worktree; then beyond-plateau-best-bc
-#   (../study-code-best-bc), then its records and table.
+#   (../study-code-best-bc at 07f4028), then its records and table.
 # Each worktree: `git worktree add --detach ../<name> <commit>`, then in it
 # `ln -sf ../main/.venv .venv && ln -sfn ../main/outputs outputs`.
 # (Until 2026-11-27 the three first studies ran in one lane on core 0; the lanes change no setting.)
