@@ -215,6 +215,31 @@ def test_a_simplified_render_model_differs_only_on_the_meshes_it_simplified():
     env.close()
 
 
+@pytest.mark.parametrize("obs_mode", ["rgb", "pointcloud"])
+def test_observation_renderers_have_no_shadow_map_and_the_same_frames(obs_mode):
+    """64 MiB per env saved on Mesa: the context has no shadow map, the model keeps its size, frames agree."""
+    import mujoco
+
+    env = make_suite("metaworld-mt10", obs_mode=obs_mode, num_points=64).make_env("push-v3", seed=0)
+    env.reset()
+    for _ in range(10):
+        env.step(np.array([0.5, 0.5, -0.5, 0.0]))
+    scene, data = env.unwrapped._renderer, env.unwrapped._env.data
+    assert scene._renderer._mjr_context.shadowSize == 0
+    assert scene.model.vis.quality.shadowsize == 4096, "the model shared with the physics is unchanged"
+    with_map = mujoco.Renderer(scene.model, scene.height, scene.width)
+    assert with_map._mjr_context.shadowSize == 4096
+    frames = [scene.rgb(data, "corner"), scene.depth(data, "corner")]
+    scene._renderer, original = with_map, scene._renderer
+    try:
+        assert np.array_equal(frames[0], scene.rgb(data, "corner"))
+        assert np.array_equal(frames[1], scene.depth(data, "corner"))
+    finally:
+        scene._renderer = original
+        with_map.close()
+        env.close()
+
+
 def test_mesh_detail_gives_clouds_of_the_same_scene():
     clouds, faces = [], []
     for detail in (1.0, 0.2):

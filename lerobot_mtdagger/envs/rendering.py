@@ -5,7 +5,9 @@ unless the user chose a backend; Mesa renders on the CPU). ``MUJOCO_GL=osmesa`` 
 where EGL is missing (slower). Observation cameras render without shadows and reflections: with
 MetaWorld's 4096-pixel shadow map a CPU frame costs about four times more, and neither helps a
 policy. They also render without multisample anti-aliasing (MuJoCo's default is 4 samples), which
-halves the cost of an RGB frame on the CPU (measured: 17.6 ms -> 7.9 ms at 84 px).
+halves the cost of an RGB frame on the CPU (measured: 17.6 ms -> 7.9 ms at 84 px). As shadows are never
+drawn, their OpenGL context is made without a shadow map (MetaWorld's is 4096 x 4096: 64 MiB of memory
+per renderer on Mesa, half of one; the frames are bit-identical, ``benchmarks/bench_renderer_memory.py``).
 
 Point clouds (the paper crops the background and feeds a PointNet):
 
@@ -54,6 +56,21 @@ def _register_exit_handler() -> None:
         _EXIT_HANDLER_REGISTERED = True
 
 
+def renderer_without_shadow_map(model: mujoco.MjModel, height: int, width: int) -> mujoco.Renderer:
+    """A ``mujoco.Renderer`` whose OpenGL context has no shadow map (for scenes drawn without shadows).
+
+    MuJoCo sizes the map from ``model.vis.quality.shadowsize`` when it makes the context; it is set to
+    0 for that moment only, so the model (shared with the physics and any other renderer) keeps its
+    value. Drawing with the shadow flag on would then show no shadows: only for ``SceneRenderer``.
+    """
+    shadow_size = model.vis.quality.shadowsize
+    model.vis.quality.shadowsize = 0
+    try:
+        return mujoco.Renderer(model, height, width)
+    finally:
+        model.vis.quality.shadowsize = shadow_size
+
+
 class SceneRenderer:
     """RGB and depth rendering of one MuJoCo model with shadows and reflections turned off.
 
@@ -90,7 +107,7 @@ class SceneRenderer:
 
     def _get(self) -> mujoco.Renderer:
         if self._renderer is None:
-            self._renderer = mujoco.Renderer(self.model, self.height, self.width)
+            self._renderer = renderer_without_shadow_map(self.model, self.height, self.width)
             _register_exit_handler()
             _OPEN_RENDERERS.add(self)
         return self._renderer
