@@ -8,7 +8,10 @@
 # Core 1: the drawers-eval DAgger stage (../study-code-drawers-eval, all 12 runs), then, once seed 2's
 #   second process is done too, the stage once more (its plan and table list all runs) and its report
 #   (report/ and table.txt copied here), then queue.sh's plateau lane (bc-past-plateau-dev, then
-#   beyond-plateau-best-bc), then drawers-preset-dev (../study-code-drawers-preset).
+#   beyond-plateau-best-bc), then a second pixels-eval process beside core 0's (once pixels-bc-dev has
+#   decided; each compare skips the runs the other finished and fails at once on one the other holds),
+#   then pixels-eval once more for its table and report, then drawers-preset-dev
+#   (../study-code-drawers-preset).
 # Core 0: seed 2's drawers-eval DAgger runs (the second compare process of the drawers-eval README),
 #   then queue.sh's pixels lane (pixels-bc-dev, then pixels-eval).
 # A lane runs from a copy (outputs/queue-running-<lane>.sh) so that editing queue.sh cannot change it.
@@ -46,6 +49,27 @@ queue_lane() {  # queue_lane CORE LANE: queue.sh's lane, from a copy, once no co
     || log "core $1: the $2 lane stopped with an error: see outputs/queue-$2.log"
 }
 
+PIXELS_EVAL=../study-code-pixels-eval
+
+pixels_eval() {  # pixels_eval CORE: pixels-eval's frozen run.sh, one job pinned to CORE
+  (cd "$PIXELS_EVAL" && JOBS=1 PYTHONPATH=$PWD taskset -c "$1" bash docs/results/pixels-eval/run.sh) \
+    >> outputs/pixels-eval-second.log 2>&1
+}
+
+pixels_eval_second_process() {  # pixels_eval_second_process CORE: beside the pixels lane, then the report
+  until grep -q "^Decision: BC samples" "$PIXELS_EVAL/docs/results/pixels-bc-dev/table.txt" 2> /dev/null; do
+    sleep 300
+  done
+  log "core $1: pixels-eval, a second process beside the pixels lane's"
+  pixels_eval "$1" || log "core $1: pixels-eval's second process ended with an error (a run the other held?)"
+  wait_while_running "outputs/queue-running-pixels.sh"
+  log "core $1: pixels-eval once more (its table and report), then its records"
+  pixels_eval "$1" || { log "core $1: pixels-eval failed: see outputs/pixels-eval-second.log"; return 1; }
+  mkdir -p docs/results/pixels-eval/report
+  cp -r "$PIXELS_EVAL/docs/results/pixels-eval/report/." docs/results/pixels-eval/report/
+  bash docs/results/pixels-eval/save_records.sh
+}
+
 core1() {
   wait_while_running "$STAGE_PATTERN"
   log "core 1: drawers-eval DAgger stage"
@@ -60,6 +84,7 @@ core1() {
   cp "$DRAWERS/docs/results/drawers-eval/table.txt" docs/results/drawers-eval/table.txt
   bash docs/results/drawers-eval/save_records.sh
   queue_lane 1 plateau
+  pixels_eval_second_process 1
   log "core 1: drawers-preset-dev"
   (cd ../study-code-drawers-preset && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c 1 \
     bash docs/results/drawers-preset-dev/run.sh >> outputs/drawers-preset-dev.log 2>&1)
