@@ -18,6 +18,7 @@ import pytest
 
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
+from lerobot_mtdagger.datasets.rounds import ExperimentDir, writer_lock_holder
 from lerobot_mtdagger.envs import SuiteConfig
 from lerobot_mtdagger.runner.configs import DAggerConfig, RunConfig
 from lerobot_mtdagger.studies.compare import (
@@ -29,7 +30,8 @@ from lerobot_mtdagger.studies.compare import (
     split_arguments,
 )
 from lerobot_mtdagger.studies.figures import hardest_tasks, seed_reach
-from lerobot_mtdagger.studies.launchers import is_finished
+from lerobot_mtdagger.studies.launchers import Job, RunPool, is_finished
+from lerobot_mtdagger.utils.errors import UserError
 from tests.helpers import child_pids, is_running
 
 TINY = [
@@ -163,6 +165,42 @@ def test_one_failed_run_stops_none_of_the_runs_queued_after_it(tmp_path, capsys)
     assert "1 of 2 runs failed; the others finished" in error and "bc-1demos-seed0.log" in error
     assert is_finished(folder / "runs" / "need-seed0", 2)
     assert (blocked / "notes.txt").read_text() == "not an experiment"
+
+
+def test_a_run_another_process_is_writing_is_skipped_named_and_left_alone(tmp_path, monkeypatch):
+    """No run process starts for it, its lock and files stay, and the error says nothing failed."""
+    folder = tmp_path / "runs" / "need-seed0"
+    started = []
+    monkeypatch.setattr(subprocess, "Popen", lambda *args, **options: started.append(args))
+    pool = RunPool(tmp_path / "runs", parallel=1, threads=1, workers=None)
+    assert writer_lock_holder(folder) is None and not folder.exists(), "probing creates nothing"
+    with ExperimentDir(folder).writer_lock():
+        assert writer_lock_holder(folder) == str(os.getpid())
+        with pytest.raises(UserError) as error:
+            pool.run_all([Job("need-seed0", (), 2)])
+        assert writer_lock_holder(folder) == str(os.getpid()), "the probe leaves the writer its lock"
+    assert started == []
+    assert str(error.value) == (
+        f"1 of 1 runs are being written by another process (another compare on this folder?) and were "
+        f"skipped; nothing failed: need-seed0 (pid {os.getpid()}). Run the same compare again once that "
+        "process has ended, to tabulate every run."
+    )
+    assert writer_lock_holder(folder) is None
+
+
+@pytest.mark.slow  # two compares of two runs each, about 60 s
+def test_two_compares_on_one_folder_share_its_runs_and_a_third_tabulates_them(tmp_path, capsys):
+    folder = tmp_path / "cmp"
+    first, args, _ = _compare_in_its_first_run(folder, "[0,1]")
+    assert main(args) == 2, "the second compare skips the run the first is writing"
+    assert "runs are being written by another process" in capsys.readouterr().err
+    assert is_finished(folder / "runs" / "need-seed1", 2), "the second compare ran the other run"
+    assert first.wait(timeout=300) in (0, 2)
+    assert main(args) == 0
+    rows = list(csv.DictReader((folder / "results.csv").open()))
+    assert {(row["seed"], row["round"]) for row in rows} == {(s, r) for s in "01" for r in "012"}
+    for run in ("need-seed0", "need-seed1"):
+        assert "being written by another run" not in (folder / "runs" / f"{run}.log").read_text()
 
 
 def test_a_run_started_by_hand_follows_no_parent(monkeypatch):

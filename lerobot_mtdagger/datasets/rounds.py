@@ -93,6 +93,25 @@ class ExperimentLockedError(UserError):
 DATASET_FPS = 80
 
 
+def writer_lock_holder(root: Path) -> str | None:
+    """Who holds ``root``'s writer lock (``ExperimentDir.writer_lock``): its pid, or None if nobody does.
+
+    Probes the lock with a shared, non-blocking ``flock`` released at once, without creating anything.
+    """
+    path = root / LOCK_FILE
+    if not path.is_file():
+        return None
+    descriptor = os.open(path, os.O_RDONLY)
+    try:
+        try:
+            fcntl.flock(descriptor, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return os.pread(descriptor, 64, 0).decode(errors="replace").strip() or "unknown"
+        return None
+    finally:
+        os.close(descriptor)  # closing releases the probe's lock
+
+
 def round_name(round_index: int) -> str:
     """Folder and Hub revision name of a round: ``round-{k:03d}``."""
     return f"round-{round_index:03d}"

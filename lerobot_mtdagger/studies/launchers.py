@@ -5,6 +5,12 @@
 its share of a cluster's CPUs (and GPUs), the same command in the same folder. Both skip finished
 runs, resume cut-off ones, let one failed run stop none of the others, and on Ctrl-C start no
 further run and end the running ones (which the next ``compare`` resumes).
+
+Several ``compare`` processes may work on one folder with the same options (one per core, or per
+machine on a shared disk): each skips the runs another has finished and those another is writing
+(their writer lock, ``ExperimentDir.writer_lock``), so together they share the plan's runs. A
+``compare`` that skipped a run being written ends with an error naming it, having written no table:
+run it again once the other has ended to tabulate every run.
 """
 
 from __future__ import annotations
@@ -27,6 +33,46 @@ logger = logging.getLogger(__name__)
 
 PARENT_PID_ENV = "LEROBOT_MTDAGGER_PARENT_PID"
 """Set by ``compare`` in each run's environment: the process id the run must not outlive."""
+
+
+class RunHeldError(UserError):
+    """Another process is writing the run (a second ``compare`` on the same folder): it was skipped."""
+
+
+def check_not_held(folder: Path, name: str) -> None:
+    """Refuses to start a run another process is writing.
+
+    Raises:
+        RunHeldError: If another process holds the run folder's writer lock (naming its pid).
+    """
+    from lerobot_mtdagger.datasets.rounds import writer_lock_holder
+
+    holder = writer_lock_holder(folder)
+    if holder is not None:
+        logger.info("%s: being written by another process (pid %s), skipped", name, holder)
+        raise RunHeldError(f"{name} (pid {holder})")
+
+
+def raise_for_errors(errors: Sequence[UserError], total: int) -> None:
+    """The error a pool ends with: failed runs first, else the runs another process was writing.
+
+    Raises:
+        UserError: If any run failed or was held; each is named.
+    """
+    held = [str(error) for error in errors if isinstance(error, RunHeldError)]
+    failed = [str(error) for error in errors if not isinstance(error, RunHeldError)]
+    skipped = f" Skipped, being written by another process: {', '.join(held)}." if held else ""
+    if failed:
+        raise UserError(
+            f"{len(failed)} of {total} runs failed; the others finished. Fix the cause and run the same "
+            "compare again to resume: " + " ".join(failed) + skipped
+        )
+    if held:
+        raise UserError(
+            f"{len(held)} of {total} runs are being written by another process (another compare on this "
+            f"folder?) and were skipped; nothing failed: {', '.join(held)}. Run the same compare again "
+            "once that process has ended, to tabulate every run."
+        )
 
 
 @dataclass(frozen=True)
@@ -123,11 +169,7 @@ class RunPool:
         for error in errors:
             if not isinstance(error, UserError):
                 raise error  # a fault of this code rather than of one run: keep its traceback
-        if errors:
-            raise UserError(
-                f"{len(errors)} of {len(jobs)} runs failed; the others finished. Fix the cause and run the "
-                "same compare again to resume: " + " ".join(str(error) for error in errors)
-            )
+        raise_for_errors(errors, len(jobs))
         return [future.result() for future in futures]
 
     def run_one(self, job: Job) -> Path:
@@ -135,11 +177,13 @@ class RunPool:
 
         Raises:
             UserError: If the run fails, or the pool was interrupted before it started (its log is named).
+            RunHeldError: If another process is writing the run.
         """
         folder = self.runs_dir / job.name
         if is_finished(folder, job.last_phase):
             logger.info("%s: finished, skipped", job.name)
             return folder
+        check_not_held(folder, job.name)
         command, variables = job_command(job, folder, self.threads, self.workers)
         env = {**os.environ, **variables, PARENT_PID_ENV: str(os.getpid())}
         log_path = self.runs_dir / f"{job.name}.log"
@@ -221,10 +265,16 @@ class RayRunPool:
         task = ray.remote(num_cpus=self.cpus, num_gpus=self.gpus, max_retries=0)(run_job_process)
         workers = 0 if self.cpus < 2 else self.cpus
         submitted: dict[Any, Job] = {}
+        held: list[UserError] = []
         for job in jobs:
             folder = self.runs_dir / job.name
             if is_finished(folder, job.last_phase):
                 logger.info("%s: finished, skipped", job.name)
+                continue
+            try:
+                check_not_held(folder, job.name)
+            except RunHeldError as error:
+                held.append(error)
                 continue
             command, variables = job_command(job, folder, self.cpus, workers)
             log_path = str(self.runs_dir / f"{job.name}.log")
@@ -236,12 +286,8 @@ class RayRunPool:
                 ray.cancel(reference)
             logger.warning("compare interrupted: the Ray tasks were cancelled; the running runs ended.")
             raise
-        errors = [error for error in outcomes if error is not None]
-        if errors:
-            raise UserError(
-                f"{len(errors)} of {len(jobs)} runs failed; the others finished. Fix the cause and run the "
-                "same compare again to resume: " + " ".join(errors)
-            )
+        errors = [UserError(error) for error in outcomes if error is not None]
+        raise_for_errors([*errors, *held], len(jobs))
         return [self.runs_dir / job.name for job in jobs]
 
     def _outcome(self, reference: Any, job: Job) -> str | None:
