@@ -543,11 +543,18 @@ def report_command(config: ReportConfig) -> str:
 
 
 def _report_saved_tables(config: ReportConfig) -> str:
-    """``report --results``: the table, figures and summary of saved results tables, joined."""
+    """``report --results``: the table, figures and summary of saved results tables, joined.
+
+    Several tables joined are also saved as one (``results.csv``, ``results.json``, beside the figures),
+    as ``report`` saves the table of the runs it reads; one table is where it was read from.
+    """
     from lerobot_mtdagger.studies.report import curves_from_rows, curves_table
-    from lerobot_mtdagger.studies.results import merge_tables, read_results
+    from lerobot_mtdagger.studies.results import merge_tables, read_results, write_results
 
     saved = merge_tables([read_results(path) for path in config.results])
+    if len(config.results) > 1:
+        assert saved.configs is not None  # merge_tables refuses tables without them
+        write_results(saved.rows, config.output_dir, saved.task_names, saved.configs, saved.unfinished)
     table = _print_table(curves_table(curves_from_rows(saved.rows)), config)
     _write_figures(saved.rows, saved.task_names, config, saved.unfinished)
     return table

@@ -391,8 +391,15 @@ def test_tables_of_seeds_run_apart_join_into_the_report_of_all_runs(compared, se
         == 0
     )
 
-    assert (joined / "report.md").read_text() == (tmp_path / "of-runs" / "report.md").read_text()
     table = capsys.readouterr().out.split("figures and summary")[0]
+    assert (joined / "report.md").read_text() == (tmp_path / "of-runs" / "report.md").read_text()
+    with (joined / "results.csv").open() as handle:  # the joined table, saved beside its figures
+        rows = list(csv.DictReader(handle))
+    assert {(row["method"], row["seed"], row["round"]) for row in rows} == {
+        (row["method"], row["seed"], row["round"]) for row in csv.DictReader((folder / "results.csv").open())
+    }
+    assert main(["report", f"--results=[{joined}]", f"--output_dir={tmp_path / 'again'}"]) == 0
+    assert (tmp_path / "again" / "report.md").read_text() == (joined / "report.md").read_text()
     assert table == table_of_runs
     assert re.search(r"\| need \| 2 \| 5\.0 \| [0-9.]+ \| [0-9.]+ \| 2 \|", table)  # both seeds in each point
     assert sorted(p.name for p in seed_tables.glob("seed0/*")) == [
