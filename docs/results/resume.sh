@@ -5,41 +5,22 @@
 # Every step first waits while a process of the same step is still running (started by an earlier
 # call), then runs it: a step whose runs are finished only rewrites its tables, a cut one resumes.
 #
-# Core 1: the drawers-eval DAgger stage (../study-code-drawers-eval, all 12 runs), then, once seed 2's
-#   second process is done too, the stage once more (its plan and table list all runs) and its report
-#   (report/ and table.txt copied here), then queue.sh's plateau lane (bc-past-plateau-dev, then
-#   beyond-plateau-best-bc), then a second pixels-eval process beside core 0's (once pixels-bc-dev has
-#   decided; each compare skips the runs the other finished and fails at once on one the other holds),
-#   then pixels-eval once more for its table and report, then drawers-preset-dev
-#   (../study-code-drawers-preset).
-# Core 0: seed 2's drawers-eval DAgger runs (the second compare process of the drawers-eval README),
-#   then queue.sh's pixels lane (pixels-bc-dev, then pixels-eval).
+# Core 1: queue.sh's plateau lane (bc-past-plateau-dev, then beyond-plateau-best-bc), then a second
+#   pixels-eval process beside core 0's (once pixels-bc-dev has decided; each compare skips the runs
+#   the other finished and fails at once on one the other holds), then pixels-eval once more for its
+#   table and report, then drawers-preset-dev (../study-code-drawers-preset).
+# Core 0: queue.sh's pixels lane (pixels-bc-dev, then pixels-eval).
 # A lane runs from a copy (outputs/queue-running-<lane>.sh) so that editing queue.sh cannot change it.
+# (Until 2026-11-27 07:01 UTC both cores first ran the drawers-eval study, now complete.)
 # Worktrees as their READMEs say: `git worktree add --detach ../<name> <commit>`, then in it
 # `ln -sf ../main/.venv .venv && ln -sfn ../main/outputs outputs`.
 set -uo pipefail
-DRAWERS=../study-code-drawers-eval
-STAGE_PATTERN="seeds=\[0,1,2\].*output_dir=outputs/drawers-eval/dagger"
-SEED2_PATTERN="seeds=\[2\].*output_dir=outputs/drawers-eval/dagger"
 
 wait_while_running() {  # wait_while_running PATTERN: until no process's command line matches
   while pgrep -f -- "$1" > /dev/null; do sleep 60; done
 }
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
-
-drawers_dagger() {  # drawers_dagger CORE [SEEDS]: the drawers-eval DAgger runs (all seeds by default)
-  if [ -z "${2:-}" ]; then
-    (cd "$DRAWERS" && STAGE=dagger OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
-      bash docs/results/drawers-eval/run.sh >> outputs/drawers-eval-dagger.log 2>&1)
-  else
-    (cd "$DRAWERS" && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" .venv/bin/lerobot-mtdagger compare \
-      --methods='[uniform,need,need_raw,gain]' --seeds="$2" --jobs=1 --preset=drawers-pointcloud \
-      --dagger.rounds=2 --dagger.budget_per_task=10 --training.steps_rule=epochs --training.epochs=12.4 \
-      --rollout.eval_episodes=20 --rollout.workers=1 --progress=false \
-      --output_dir=outputs/drawers-eval/dagger >> outputs/drawers-eval-dagger-seed2.log 2>&1)
-  fi
-}
 
 queue_lane() {  # queue_lane CORE LANE: queue.sh's lane, from a copy, once no copy of it runs
   wait_while_running "outputs/queue-running-$2.sh"
@@ -71,18 +52,6 @@ pixels_eval_second_process() {  # pixels_eval_second_process CORE: beside the pi
 }
 
 core1() {
-  wait_while_running "$STAGE_PATTERN"
-  log "core 1: drawers-eval DAgger stage"
-  drawers_dagger 1 || log "core 1: the stage stopped with an error (a run another process held?)"
-  wait_while_running "$SEED2_PATTERN"
-  log "core 1: drawers-eval DAgger stage once more, then its report"
-  drawers_dagger 1 || { log "core 1: the stage failed: see outputs/drawers-eval-dagger.log"; return 1; }
-  (cd "$DRAWERS" && STAGE=report PYTHONPATH=$PWD taskset -c 1 bash docs/results/drawers-eval/run.sh) \
-    >> outputs/drawers-eval-report.log 2>&1 || { log "core 1: the report failed"; return 1; }
-  mkdir -p docs/results/drawers-eval/report
-  cp -r "$DRAWERS/docs/results/drawers-eval/report/." docs/results/drawers-eval/report/
-  cp "$DRAWERS/docs/results/drawers-eval/table.txt" docs/results/drawers-eval/table.txt
-  bash docs/results/drawers-eval/save_records.sh
   queue_lane 1 plateau
   pixels_eval_second_process 1
   log "core 1: drawers-preset-dev"
@@ -92,9 +61,6 @@ core1() {
 }
 
 core0() {
-  wait_while_running "$SEED2_PATTERN"
-  log "core 0: drawers-eval DAgger seed 2"
-  drawers_dagger 0 '[2]' || log "core 0: seed 2's compare stopped with an error"
   queue_lane 0 pixels
   log "core 0: done"
 }
