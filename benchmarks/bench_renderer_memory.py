@@ -22,18 +22,22 @@ import json
 import statistics
 import subprocess
 import sys
+from pathlib import Path
 
 import mujoco
 import numpy as np
-import psutil
 
 TARGET = 0.75
 CASES = {"drawers pointcloud": ("drawers", "pointcloud"), "mt10 rgb": ("metaworld-mt10", "rgb")}
 
 
 def unique_mib() -> float:
-    """This process's unique set size in MiB."""
-    return psutil.Process().memory_full_info().uss / 2**20
+    """This process's unique set size in MiB (its private pages, from ``/proc/self/smaps_rollup``)."""
+    private_kb = 0
+    for line in Path("/proc/self/smaps_rollup").read_text().splitlines():
+        if line.startswith(("Private_Clean:", "Private_Dirty:")):
+            private_kb += int(line.split()[1])
+    return private_kb / 1024
 
 
 def make_envs(suite_name: str, obs_mode: str, count: int) -> list:
