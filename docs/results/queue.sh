@@ -18,6 +18,10 @@
 # (Until 2026-11-27 the three first studies ran in one lane on core 0; the lanes change no setting.)
 set -euo pipefail
 LANE=${1:-pixels}
+case "$LANE" in
+  pixels | plateau) ;;
+  *) echo "Unknown lane '$LANE': give pixels or plateau." >&2; exit 1 ;;
+esac
 export JOBS=1
 # Each run's peak memory (with its env workers) and the machine's lowest available memory, kept in
 # outputs/study-memory.json (benchmarks/watch_memory.py; one watcher at a time).
@@ -49,8 +53,4 @@ plateau_lane() {
     >> outputs/beyond-plateau-best-bc.log 2>&1
   bash docs/results/beyond-plateau-best-bc/save_records.sh
 }
-case "$LANE" in
-  pixels) pixels_lane ;;
-  plateau) plateau_lane ;;
-  *) echo "Unknown lane '$LANE': give pixels or plateau." >&2; exit 1 ;;
-esac
+"${LANE}_lane"
