@@ -7,7 +7,12 @@ from pathlib import Path
 
 import pytest
 
-from lerobot_mtdagger.studies.bc_choice import choose_bc_training, read_bc_records, success_table
+from lerobot_mtdagger.studies.bc_choice import (
+    choice_report,
+    choose_bc_training,
+    read_bc_records,
+    success_table,
+)
 
 BUDGETS = (33, 45, 63)
 SEEDS = (100, 101)
@@ -86,3 +91,15 @@ def test_the_mean_is_over_seeds_not_over_runs_of_one_seed(missing_seed):
     choice = choose_bc_training(results, ("plain",), BUDGETS, SEEDS)
     assert choice.chosen == "plain" and not choice.qualified
     assert "63 - 33 demos -0.200" in choice.lines[0]
+
+
+def test_the_report_ends_with_the_decision_line_the_evaluation_scripts_read():
+    results = results_of({"plain": {33: 0.98, 45: 0.9, 63: 0.9}, "cosine": {33: 0.99, 45: 0.95, 63: 0.9}})
+    options = dict(label="training", decision="the best BC is {}", none_word="none")
+    lines = choice_report(results, ("plain", "cosine"), BUDGETS, SEEDS, **options)
+    assert lines[-1] == (
+        "Decision: the best BC is cosine (none qualified: the highest mean; BC's training needs more study)."
+    )
+    del results["plain"][(63, 101)]
+    lines = choice_report(results, ("plain", "cosine"), BUDGETS, SEEDS, **options)
+    assert lines[-1] == "Decision: not yet: 1 runs unfinished (every training needs all 6)."

@@ -129,3 +129,34 @@ def choose_bc_training(
     pool = qualified or list(trainings)
     chosen = max(pool, key=lambda training: means[training])
     return BCChoice(chosen, bool(qualified), tuple(lines))
+
+
+def choice_report(
+    results: Results,
+    trainings: Sequence[str],
+    budgets: Sequence[int],
+    seeds: Sequence[int],
+    *,
+    label: str,
+    decision: str,
+    none_word: str,
+) -> list[str]:
+    """The table, the rule's lines and the study's ``Decision:`` line, as a study's ``table.txt`` holds them.
+
+    Args:
+        results: ``{training: {(budget, seed): success}}`` (:func:`read_bc_records`).
+        trainings: The candidates the study fixed.
+        budgets: Demos per task.
+        seeds: The development seeds.
+        label: The table's first column (``training``, ``sampling``).
+        decision: The decision's wording, ``{}`` standing for the chosen training.
+        none_word: ``none`` or ``neither``, for the note when no training qualified.
+    """
+    lines = success_table(results, budgets, seeds, label)
+    choice = choose_bc_training(results, trainings, budgets, seeds)
+    if choice.chosen is None:
+        return [*lines, "", f"Decision: {choice.lines[0]}."]
+    note = ""
+    if not choice.qualified:
+        note = f" ({none_word} qualified: the highest mean; BC's training needs more study)"
+    return [*lines, "", *choice.lines, f"Decision: {decision.format(choice.chosen)}{note}."]

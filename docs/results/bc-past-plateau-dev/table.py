@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from lerobot_mtdagger.studies.bc_choice import choose_bc_training, read_bc_records, success_table
+from lerobot_mtdagger.studies.bc_choice import choice_report, read_bc_records
 
 BUDGETS = (33, 45, 63)
 SEEDS = (100, 101, 102)
@@ -24,15 +24,10 @@ TRAININGS = ("plain", "balanced", "cosine", "plateau")
 def main() -> None:
     """Prints the table and the decision for the records folder given as the only argument."""
     results = read_bc_records(Path(sys.argv[1]))
-    lines = success_table(results, BUDGETS, SEEDS)
-    choice = choose_bc_training(results, TRAININGS, BUDGETS, SEEDS)
-    if choice.chosen is None:
-        print("\n".join([*lines, "", f"Decision: {choice.lines[0]}."]))
-        return
-    note = ""
-    if not choice.qualified:
-        note = " (none qualified: the highest mean; BC's training needs more study)"
-    print("\n".join([*lines, "", *choice.lines, f"Decision: the best BC is {choice.chosen}{note}."]))
+    lines = choice_report(
+        results, TRAININGS, BUDGETS, SEEDS, label="training", decision="the best BC is {}", none_word="none"
+    )
+    print("\n".join(lines))
 
 
 if __name__ == "__main__":

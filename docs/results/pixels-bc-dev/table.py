@@ -15,7 +15,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from lerobot_mtdagger.studies.bc_choice import choose_bc_training, read_bc_records, success_table
+from lerobot_mtdagger.studies.bc_choice import choice_report, read_bc_records
 
 BUDGETS = (10, 30, 60)
 SEEDS = (100, 101, 102)
@@ -25,15 +25,10 @@ SAMPLINGS = ("balanced", "uniform")
 def main() -> None:
     """Prints the table and the decision for the records folder given as the only argument."""
     results = read_bc_records(Path(sys.argv[1]))
-    lines = success_table(results, BUDGETS, SEEDS, "sampling")
-    choice = choose_bc_training(results, SAMPLINGS, BUDGETS, SEEDS)
-    if choice.chosen is None:
-        print("\n".join([*lines, "", f"Decision: {choice.lines[0]}."]))
-        return
-    note = ""
-    if not choice.qualified:
-        note = " (neither qualified: the highest mean; BC's training needs more study)"
-    print("\n".join([*lines, "", *choice.lines, f"Decision: BC samples {choice.chosen}{note}."]))
+    lines = choice_report(
+        results, SAMPLINGS, BUDGETS, SEEDS, label="sampling", decision="BC samples {}", none_word="neither"
+    )
+    print("\n".join(lines))
 
 
 if __name__ == "__main__":
