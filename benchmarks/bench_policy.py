@@ -5,13 +5,21 @@ wait for the device after each timed loop). Default model sizes; inputs as the s
 them: state (39-d), RGB 84 px + 7-d state, point cloud 1024 x 3 + 7-d state. The modes are measured
 in interleaved rounds in one run, so their ratios are side by side. The DAgger loop queries the
 policy every step, so the batch-1 latency bounds the collection rate.
+
+``--precisions fp32,tf32,bf16`` measures each input at each arithmetic, interleaved in the same
+rounds: ``fp32`` (the default), ``tf32`` (float32 tensors, TensorFloat-32 matrix products and
+convolutions: ``torch.backends.cuda.matmul.allow_tf32`` and ``torch.backends.cudnn.allow_tf32``) and
+``bf16`` (the forward pass under ``torch.autocast(dtype=torch.bfloat16)``, float32 weights and
+optimiser). The ``vs fp32`` column is each input's rate over its rate at the first precision listed.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import statistics
 import time
+from collections.abc import Iterator
 
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
@@ -33,6 +41,28 @@ MODES = {
 }
 
 
+PRECISIONS = ("fp32", "tf32", "bf16")
+
+
+@contextlib.contextmanager
+def precision(name: str, device: str) -> Iterator[None]:
+    """Runs the block at the arithmetic ``name`` (one of ``PRECISIONS``); restores the TF32 flags."""
+    if name not in PRECISIONS:
+        raise ValueError(f"unknown precision {name!r}: choose from {', '.join(PRECISIONS)}")
+    flags = torch.backends.cuda.matmul.allow_tf32, torch.backends.cudnn.allow_tf32
+    torch.backends.cuda.matmul.allow_tf32 = torch.backends.cudnn.allow_tf32 = name == "tf32"
+    autocast = (
+        torch.autocast(torch.device(device).type, dtype=torch.bfloat16)
+        if name == "bf16"
+        else contextlib.nullcontext()
+    )
+    try:
+        with autocast:
+            yield
+    finally:
+        torch.backends.cuda.matmul.allow_tf32, torch.backends.cudnn.allow_tf32 = flags
+
+
 def make_policy(inputs, device: str = "cpu") -> MTDAggerPolicy:
     config = MTDAggerConfig(
         device=device,
@@ -50,10 +80,12 @@ def make_batch(inputs, batch_size: int, device: str = "cpu") -> dict:
     return batch
 
 
-def train_rate(policy, optimizer, batch, steps: int) -> float:
+def train_rate(policy, optimizer, batch, steps: int, arithmetic: str = "fp32") -> float:
+    device = str(batch["action"].device)
     start = time.perf_counter()
     for _ in range(steps):
-        loss, _ = policy.forward(batch)
+        with precision(arithmetic, device):
+            loss, _ = policy.forward(batch)
         optimizer.zero_grad()
         loss.backward()
         optimizer.step()
@@ -67,14 +99,24 @@ def synchronize(device: torch.device) -> None:
         torch.cuda.synchronize(device)
 
 
-def latency_ms(policy, batch, repeats: int) -> float:
+def latency_ms(policy, batch, repeats: int, arithmetic: str = "fp32") -> float:
     times = []
     for _ in range(repeats):
         start = time.perf_counter()
-        policy.select_action(batch)
+        with torch.no_grad(), precision(arithmetic, str(batch["action"].device)):
+            policy.select_action(batch)
         synchronize(batch["action"].device)
         times.append(time.perf_counter() - start)
     return statistics.median(times) * 1e3
+
+
+def parse_precisions(text: str) -> list[str]:
+    """``fp32,bf16`` -> ``["fp32", "bf16"]``, each checked against ``PRECISIONS``."""
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in PRECISIONS]
+    if not names or unknown:
+        raise argparse.ArgumentTypeError(f"--precisions takes a comma list of {', '.join(PRECISIONS)}")
+    return names
 
 
 def main() -> None:
@@ -84,36 +126,43 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--threads", type=int, default=torch.get_num_threads())
     parser.add_argument("--device", default="cpu", help="cpu, cuda or cuda:N")
+    parser.add_argument("--precisions", type=parse_precisions, default=["fp32"], help="e.g. fp32,tf32,bf16")
     args = parser.parse_args()
     torch.manual_seed(0)
     torch.set_num_threads(args.threads)
     setups = {}
     for name, inputs in MODES.items():
-        policy = make_policy(inputs, args.device)
-        optimizer = torch.optim.AdamW(policy.parameters(), lr=3e-4)
-        batches = make_batch(inputs, args.batch_size, args.device), make_batch(inputs, 1, args.device)
-        setups[name] = (policy, optimizer, *batches)
-        train_rate(policy, optimizer, setups[name][2], 1)  # warm-up
-    rates = {name: [] for name in MODES}
-    latencies = {name: [] for name in MODES}
+        for arithmetic in args.precisions:
+            policy = make_policy(inputs, args.device)
+            optimizer = torch.optim.AdamW(policy.parameters(), lr=3e-4)
+            batches = make_batch(inputs, args.batch_size, args.device), make_batch(inputs, 1, args.device)
+            setups[name, arithmetic] = (policy, optimizer, *batches)
+            train_rate(policy, optimizer, batches[0], 1, arithmetic)  # warm-up
+    rates = {key: [] for key in setups}
+    latencies = {key: [] for key in setups}
     for _ in range(args.rounds):
-        for name, (policy, optimizer, batch, single) in setups.items():
+        for (name, arithmetic), (policy, optimizer, batch, single) in setups.items():
             policy.train()
-            rates[name].append(train_rate(policy, optimizer, batch, args.steps))
-            latencies[name].append(latency_ms(policy, single, 50))
+            rates[name, arithmetic].append(train_rate(policy, optimizer, batch, args.steps, arithmetic))
+            latencies[name, arithmetic].append(latency_ms(policy, single, 50, arithmetic))
     print(
         f"torch {torch.__version__}, {args.device}, {args.threads} threads, batch {args.batch_size}, "
         f"median of {args.rounds} rounds"
     )
-    header = ["input", "params", "train samples/s", "vs state", "batch-1 latency ms"]
+    header = ["input", "precision", "params", "train samples/s", "vs state", "vs fp32", "batch-1 latency ms"]
     print("| " + " | ".join(header) + " |")
     print("|" + "|".join("---" for _ in header) + "|")
-    reference = statistics.median(rates["state"])
-    for name, (policy, *_rest) in setups.items():
+    first = args.precisions[0]
+    reference = statistics.median(rates["state", first])
+    for (name, arithmetic), (policy, *_rest) in setups.items():
         params = sum(p.numel() for p in policy.parameters())
-        rate = statistics.median(rates[name])
-        latency = statistics.median(latencies[name])
-        print(f"| {name:<16} | {params:>8} | {rate:>15.0f} | {rate / reference:>8.3f} | {latency:>18.3f} |")
+        rate = statistics.median(rates[name, arithmetic])
+        own = statistics.median(rates[name, first])
+        latency = statistics.median(latencies[name, arithmetic])
+        print(
+            f"| {name:<16} | {arithmetic:<9} | {params:>8} | {rate:>15.0f} | {rate / reference:>8.3f} "
+            f"| {rate / own:>7.3f} | {latency:>18.3f} |"
+        )
 
 
 if __name__ == "__main__":
