@@ -3,7 +3,8 @@
 # installed checkout (the README's install; `PYTHON=...` names another interpreter that has the
 # packages): which renderer MuJoCo's EGL gets, the GPU tests (`--policy.device=cuda` end to end on
 # the point-cloud drawers, FrameParts on the device), the policy's training and inference on the GPU
-# beside the CPU (batch 256 as the drawer presets, 1 024 as the paper's pixel preset), and the render
+# beside the CPU (batch 256 as the drawer presets, in float32, TF32 and bf16 autocast; 1 024 as the
+# paper's pixel preset), and the render
 # rates with MuJoCo's EGL on the GPU. Every check runs even when one before it fails; the script
 # names the failed ones at the end and exits 1. Record what it prints in docs/benchmarks.md.
 set -uo pipefail
@@ -25,7 +26,7 @@ context.free()'
 check nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv
 check "$PYTHON" -c "$gl_renderer"
 check "$PYTHON" -m pytest -q -m gpu -p no:cacheprovider tests/test_gpu.py
-check "$PYTHON" benchmarks/bench_policy.py --device=cuda --batch-size 256 --steps 20 --rounds 3
+check "$PYTHON" benchmarks/bench_policy.py --device=cuda --batch-size 256 --steps 20 --rounds 3 --precisions fp32,tf32,bf16
 check "$PYTHON" benchmarks/bench_policy.py --device=cuda --batch-size 1024 --steps 10 --rounds 2
 check "$PYTHON" benchmarks/bench_policy.py --device=cpu --batch-size 256 --steps 5 --rounds 1
 check "$PYTHON" benchmarks/bench_envs.py --suite drawers --rounds 2 --render-steps 80 --steps 300
