@@ -4,9 +4,9 @@
 # packages): which renderer MuJoCo's EGL gets, the GPU tests (`--policy.device=cuda` end to end on
 # the point-cloud drawers, FrameParts on the device), the policy's training and inference on the GPU
 # beside the CPU (batch 256 as the drawer presets, in float32, TF32 and bf16 autocast; 1 024 as the
-# paper's pixel preset), and the render
-# rates with MuJoCo's EGL on the GPU. Every check runs even when one before it fails; the script
-# names the failed ones at the end and exits 1. Record what it prints in docs/benchmarks.md.
+# paper's pixel preset), and the render rates with MuJoCo's EGL on the GPU. Every check runs even
+# when one before it fails; the script names the failed ones at the end and exits 1. Record what it
+# prints in docs/benchmarks.md.
 set -uo pipefail
 export MUJOCO_GL=egl PYTHONUNBUFFERED=1
 PYTHON=${PYTHON:-.venv/bin/python}
