@@ -484,6 +484,8 @@ def test_write_round_with_images_takes_lerobots_path_quietly(tmp_path, capfd):
     experiment = ExperimentDir(tmp_path)
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)  # LeRobot's stats on the bool flag
+        # numpy >= 2.5 raises where 2.2 warns: a one-value column handed to datasets as (N, 1) rows
+        warnings.filterwarnings("error", "Conversion of an array with ndim > 0", DeprecationWarning)
         root = experiment.commit_round(
             0, experiment.write_round(0, features, TASKS, episodes), _record_stub()
         )
@@ -493,6 +495,11 @@ def test_write_round_with_images_takes_lerobots_path_quietly(tmp_path, capfd):
     assert len(loaded) == 6 and loaded[4]["task"] == TASKS[1]
     image = (loaded[4]["observation.image"].numpy().transpose(1, 2, 0) * 255).round().astype(np.uint8)
     np.testing.assert_array_equal(image, episodes[1][1][1]["observation.image"])
+    for key, value in episodes[1][1][1].items():  # the one-value columns too, as they were given
+        if key != "observation.image":
+            np.testing.assert_array_equal(
+                np.asarray(loaded[4][key]).reshape(np.shape(value)), value, err_msg=key
+            )
 
 
 def test_write_round_refuses_bad_frames_empty_episodes_and_used_datasets(tmp_path):
@@ -508,6 +515,22 @@ def test_write_round_refuses_bad_frames_empty_episodes_and_used_datasets(tmp_pat
 
     with pytest.raises(ValueError, match="empty, freshly created"):
         write_round_episodes(dataset, good)
+
+
+def test_unsaved_frames_counts_lerobots_buffer_after_an_episode_is_saved(tmp_path):
+    """LeRobot 0.4's ``dataset.writer`` becomes a ParquetWriter once an episode is saved."""
+    from lerobot_mtdagger.utils.lerobot_compat import unsaved_frames
+
+    experiment = ExperimentDir(tmp_path)
+    dataset = experiment.create_round(0, _features(), TASKS)
+    (task, frames), second = _episodes(np.random.default_rng(6), [3, 2])
+    with quiet_third_party():
+        for frame in frames:
+            dataset.add_frame({**frame, "task": task})
+        save_episode_with_success(dataset, frames)
+        assert unsaved_frames(dataset) == 0
+        dataset.add_frame({**second[1][0], "task": second[0]})
+    assert unsaved_frames(dataset) == 1
 
 
 def test_fast_episode_stats_equal_lerobots_bit_for_bit():

@@ -27,6 +27,7 @@ from lerobot_mtdagger.datasets.records import EPISODE_SUCCESS, NEXT_SUCCESS
 from lerobot_mtdagger.utils.lerobot_compat import (
     DEFAULT_FEATURES,
     dataset_hf_features,
+    episode_data_writer,
     unsaved_frames,
     validate_frame,
 )
@@ -76,7 +77,7 @@ def write_round_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFram
             for task, frames in episodes:
                 for frame in frames:
                     dataset.add_frame({**frame, "task": task})
-                save_episode_with_success(dataset, frames)
+                save_episode_with_scalar_columns(dataset, frames)
             return
         _write_vector_episodes(dataset, episodes)
 
@@ -107,6 +108,39 @@ def save_episode_with_success(dataset: LeRobotDataset, frames: Sequence[Mapping[
         dataset.save_episode()
     finally:
         del dataset.meta.save_episode  # back to the class's method
+
+
+def save_episode_with_scalar_columns(dataset: LeRobotDataset, frames: Sequence[Mapping[str, Any]]) -> None:
+    """``save_episode_with_success`` with each one-value feature's column handed on as scalars.
+
+    LeRobot stores a feature of shape ``(1,)`` as a scalar ``datasets.Value`` column, but its
+    ``save_episode`` stacks the frames' ``(1,)`` arrays into an ``(N, 1)`` column, and ``datasets``
+    then converts each ``(1,)`` row with ``int()`` / ``float()`` / ``bool()``: deprecated since numpy
+    1.25 and an error (``only 0-dimensional arrays can be converted to Python scalars``) from numpy
+    2.5 (LeRobot issue #3343). The column is flattened to ``(N,)`` just for that conversion: the same
+    values and schema, and the statistics, computed before it, still see ``(N, 1)``. LeRobot's newer
+    dataset writer flattens these columns itself before its statistics; nothing is left to flatten
+    then.
+    """
+    owner = episode_data_writer(dataset)
+    save_data = owner._save_episode_data
+    scalar_keys = [
+        key for key, feature in dataset_hf_features(dataset).items() if isinstance(feature, datasets.Value)
+    ]
+
+    def save_data_with_scalars(episode_buffer: dict) -> dict:
+        flattened = dict(episode_buffer)
+        for key in scalar_keys:
+            column = flattened.get(key)
+            if isinstance(column, np.ndarray) and column.ndim == 2 and column.shape[1] == 1:
+                flattened[key] = column.reshape(len(column))
+        return save_data(flattened)
+
+    owner._save_episode_data = save_data_with_scalars
+    try:
+        save_episode_with_success(dataset, frames)
+    finally:
+        del owner._save_episode_data  # back to the class's method
 
 
 def _episode_buffer(

@@ -8,7 +8,10 @@ checked by reading its sources with ``scripts/check_lerobot_names.py``, not run)
 - ``DEFAULT_FEATURES``: ``lerobot.datasets.utils`` -> ``lerobot.utils.constants``;
 - ``get_hf_features_from_features``: ``lerobot.datasets.utils`` -> ``lerobot.datasets.feature_utils``,
   and a dataset no longer keeps ``hf_features`` (``dataset_hf_features`` builds them from its features);
-- a dataset's unsaved frames: ``dataset.episode_buffer`` -> ``dataset.writer.episode_buffer`` (0.5.1).
+- a dataset's unsaved frames: ``dataset.episode_buffer`` -> ``dataset.writer.episode_buffer`` (0.5.1);
+- the step of ``save_episode`` that turns an episode's columns into a ``datasets.Dataset``:
+  ``dataset._save_episode_data`` -> ``dataset.writer._save_episode_data`` (0.5.1; the dataset's
+  method of that name only forwards there, and the writer's ``save_episode`` calls its own).
 
 Everything else the package imports from LeRobot has one spelling in both lines (the script checks
 that too).
@@ -42,6 +45,7 @@ __all__ = [
     "DEFAULT_FEATURES",
     "dataset_hf_features",
     "dataset_to_policy_features",
+    "episode_data_writer",
     "unsaved_frames",
     "validate_frame",
 ]
@@ -54,6 +58,22 @@ def dataset_hf_features(dataset: Any) -> Any:
 
 def unsaved_frames(dataset: Any) -> int:
     """Frames added to a ``LeRobotDataset`` and not saved in an episode yet (its episode buffer's size)."""
-    writer = getattr(dataset, "writer", None)  # LeRobot >= 0.5.1 keeps the buffer in its writer
-    buffer = getattr(writer, "episode_buffer", None) if writer is not None else dataset.episode_buffer
+    # LeRobot >= 0.5.1 keeps the buffer in its writer; 0.4 in the dataset (whose ``writer`` is then a
+    # ParquetWriter once a data file is open, or None)
+    writer = getattr(dataset, "writer", None)
+    buffer = writer.episode_buffer if hasattr(writer, "episode_buffer") else dataset.episode_buffer
     return int((buffer or {}).get("size", 0))
+
+
+def episode_data_writer(dataset: Any) -> Any:
+    """The object whose ``_save_episode_data`` LeRobot's ``save_episode`` calls for ``dataset``.
+
+    LeRobot 0.4 writes an episode's columns in the dataset's own method (its ``writer`` attribute is
+    then a ``pyarrow`` ``ParquetWriter`` or ``None``); from 0.5.1 the dataset holds an episode writer
+    (``writer``, kept as ``_writer``) whose ``save_episode`` calls the writer's method of that name.
+    """
+    for name in ("writer", "_writer"):
+        writer = getattr(dataset, name, None)
+        if writer is not None and hasattr(writer, "_save_episode_data"):
+            return writer
+    return dataset
