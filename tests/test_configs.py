@@ -114,14 +114,14 @@ def test_the_cpu_visual_presets_keep_the_papers_rounds_with_less_data_and_comput
     assert RunConfig(preset="drawers-pointcloud").suite.num_points == 512
 
 
-def test_presets_sample_uniformly_except_pixel_dagger_runs_and_an_explicit_choice_wins():
+def test_presets_sample_uniformly_except_pixel_runs_and_an_explicit_choice_wins():
     assert RunConfig(preset="metaworld-pixels").training.sampling == "balanced"
-    assert RunConfig(preset="metaworld-pixels", mode="bc").training.sampling == "uniform"
+    assert RunConfig(preset="metaworld-pixels", mode="bc").training.sampling == "balanced"
     for name in ("small", "metaworld-state", "metaworld-pixels-paper", "drawers-pointcloud"):
         assert RunConfig(preset=name).training.sampling == "uniform", name
     assert parse("--preset=metaworld-pixels", "--training.sampling=uniform").training.sampling == "uniform"
-    bc_balanced = parse("--preset=metaworld-pixels", "--mode=bc", "--training.sampling=balanced")
-    assert bc_balanced.training.sampling == "balanced"
+    bc_uniform = parse("--preset=metaworld-pixels", "--mode=bc", "--training.sampling=uniform")
+    assert bc_uniform.training.sampling == "uniform"
     with pytest.raises(ValueError, match=r"training.sampling must be one of \['uniform', 'balanced'\]"):
         RunConfig(preset="metaworld-pixels", training=TrainingConfig(sampling="per-task"))
 

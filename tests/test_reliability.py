@@ -548,7 +548,8 @@ def test_a_run_of_a_rescaled_preset_resumes_with_its_paper_preset(finished, tmp_
 
 
 def test_a_pixel_run_made_before_balanced_sampling_is_told_to_add_uniform(finished, tmp_path):
-    """``metaworld-pixels``' DAgger runs sample balanced since 2026-11-26; older runs resume uniform."""
+    """``metaworld-pixels`` samples balanced (DAgger since 2026-11-26, BC since 2026-11-27); older runs
+    resume uniform."""
     older_root = tmp_path / "older-pixels"
     shutil.copytree(finished, older_root)
     uniform = TrainingConfig(sampling="uniform")
@@ -562,6 +563,12 @@ def test_a_pixel_run_made_before_balanced_sampling_is_told_to_add_uniform(finish
     message = str(info.value)
     assert "training.sampling: 'uniform' -> 'balanced'" in message, message
     assert "used --training.sampling=uniform: add it" in message and "-paper" not in message, message
+    bc_before = RunConfig(preset="metaworld-pixels", mode="bc", training=uniform, output_dir=older_root)
+    (older_root / "config.json").write_text(json.dumps(bc_before.to_dict()))
+    experiment.check_resumable(bc_before.to_dict())
+    bc_today = RunConfig(preset="metaworld-pixels", mode="bc", output_dir=older_root).to_dict()
+    with pytest.raises(UserError, match=r"before 2026-11-27 .* used --training.sampling=uniform: add it"):
+        experiment.check_resumable(bc_today)
     paper_values = RunConfig(preset="metaworld-pixels-paper", output_dir=older_root).to_dict()
     (older_root / "config.json").write_text(json.dumps(paper_values | {"preset": "metaworld-pixels"}))
     with pytest.raises(UserError, match=r"resume it with that preset\)"):

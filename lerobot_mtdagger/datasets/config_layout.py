@@ -63,7 +63,8 @@ PRESET_VALUE_CHANGES: dict[str, dict[str, Any]] = {
     "metaworld-pixels": {"training.sampling": "uniform"},
 }
 """Options a preset set differently later (after its rescaling) -> the value runs made before had:
-``metaworld-pixels``' DAgger runs sample ``balanced`` since 2026-11-26 (a resume names the fix)."""
+``metaworld-pixels``' DAgger runs sample ``balanced`` since 2026-11-26, its BC runs since 2026-11-27
+(a resume names the fix)."""
 
 
 def later_preset_values(preset: str | None, differing: list[str]) -> dict[str, Any]:

@@ -299,7 +299,7 @@ class ExperimentDir:
             elif changed := later_preset_values(stored_config.get("preset"), differing):
                 name = stored_config["preset"]
                 options = " ".join(f"--{key}={value}" for key, value in changed.items())
-                hint = f" (a run made before 2026-11-26 with --preset={name} used {options}: add it)"
+                hint = f" (a run made before 2026-11-27 with --preset={name} used {options}: add it)"
             elif stored_config.get("preset") in RESCALED_PRESETS:
                 name = stored_config["preset"]
                 hint = (

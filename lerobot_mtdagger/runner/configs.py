@@ -20,7 +20,7 @@ drawers-pointcloud-paper   pointcloud  10      30       30          3000   5    
 =========================  ==========  ======  =======  ==========  =====  =====  ====  =====  ======
 
 (initial and per round: expert demonstrations per task; steps: ``training.steps_per_round``. Every
-preset samples batches ``uniform``ly except ``metaworld-pixels``, whose DAgger runs sample
+preset samples batches ``uniform``ly except ``metaworld-pixels``, whose runs (DAgger and BC) sample
 ``balanced``: ``PIXELS_SAMPLING``.)
 
 The DAgger mixing coefficient ``beta`` is the probability that the EXPERT's action is executed at
@@ -204,12 +204,13 @@ WORKER_BACKENDS: tuple[str, ...] = ("local", "ray")
 GAIN_SPLITS: tuple[str, ...] = ("train", "heldout")
 """Where the performance-gain scheduler measures per-task loss: the training data or held-out episodes."""
 
-PIXELS_SAMPLING: dict[str, str] = {"dagger": "balanced", "bc": "uniform"}
-"""``metaworld-pixels``' batch sampling by run mode, chosen on development seeds 100-102 (200
-evaluation episodes per phase, ``docs/results/visual-collapse-dev`` 6c): with uniform sampling the
-DAgger rounds lowered success (0.680 -> 0.678 -> 0.630), with balanced sampling they raised it (0.627
--> 0.678 -> 0.685); BC on round 0's demonstrations did better with uniform sampling (0.680 against
-0.627)."""
+PIXELS_SAMPLING = "balanced"
+"""``metaworld-pixels``' batch sampling, DAgger and BC, chosen on development seeds 100-102. DAgger
+(200 evaluation episodes per phase, ``docs/results/visual-collapse-dev`` 6c): with uniform sampling
+the rounds lowered success (0.680 -> 0.678 -> 0.630), with balanced sampling they raised it (0.627 ->
+0.678 -> 0.685). BC (``docs/results/pixels-bc-dev``, a rule fixed before its runs): uniform BC is
+ahead at 10 demos per task (0.670 against 0.600) but loses success from 10 to 30 (0.645); balanced
+BC rises (0.762 at 30, 0.795 at 60 against uniform's 0.755) and has the higher mean."""
 
 PRESETS: dict[str, dict[str, Any]] = {
     "small": {
@@ -442,7 +443,7 @@ class TrainingConfig:
         normalisation: ``fixed`` (statistics of round 0's training frames for every phase: a warm
             start sees inputs normalised as before) or ``recompute`` (statistics of D(k) each phase).
         sampling: ``uniform`` (frames uniformly) or ``balanced`` (a task uniformly, then one of its
-            frames); None: from the preset (``uniform`` except ``metaworld-pixels``' DAgger runs).
+            frames); None: from the preset (``uniform`` except ``metaworld-pixels``: ``balanced``).
         lr_schedule: ``constant`` or ``cosine`` (the ``mtdagger`` policy's learning rate decayed to 0
             over each phase's steps; a LeRobot student follows its config's scheduler preset).
         gain_split: ``train`` (per-task loss on the training data) or ``heldout`` (on held-out episodes).
@@ -539,7 +540,7 @@ class RunConfig:
             if not hasattr(owner, name):  # policy.lr: a LeRobot student's is its optimizer_lr
                 continue
             if getattr(owner, name) is None:
-                setattr(owner, name, value[self.mode] if isinstance(value, Mapping) else value)
+                setattr(owner, name, value)
         if self.output_dir is None:
             self.output_dir = Path("outputs") / "mtdagger" / f"{self.preset}-{self.method}-seed{self.seed}"
         self.suite.fill_defaults()
