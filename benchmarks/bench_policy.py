@@ -46,9 +46,8 @@ PRECISIONS = ("fp32", "tf32", "bf16")
 
 @contextlib.contextmanager
 def precision(name: str, device: str) -> Iterator[None]:
-    """Runs the block at the arithmetic ``name`` (one of ``PRECISIONS``); restores the TF32 flags."""
-    if name not in PRECISIONS:
-        raise ValueError(f"unknown precision {name!r}: choose from {', '.join(PRECISIONS)}")
+    """Runs the block at the arithmetic ``name`` (one of ``PRECISIONS``, checked by ``parse_precisions``);
+    restores the TF32 flags."""
     flags = torch.backends.cuda.matmul.allow_tf32, torch.backends.cudnn.allow_tf32
     torch.backends.cuda.matmul.allow_tf32 = torch.backends.cudnn.allow_tf32 = name == "tf32"
     autocast = (
@@ -103,7 +102,7 @@ def latency_ms(policy, batch, repeats: int, arithmetic: str = "fp32") -> float:
     times = []
     for _ in range(repeats):
         start = time.perf_counter()
-        with torch.no_grad(), precision(arithmetic, str(batch["action"].device)):
+        with precision(arithmetic, str(batch["action"].device)):  # select_action is no_grad itself
             policy.select_action(batch)
         synchronize(batch["action"].device)
         times.append(time.perf_counter() - start)
