@@ -420,6 +420,10 @@ class ReportConfig:
             the tables alone, e.g. after the run folders are gone, with other ``--levels``, or joining
             seeds run on other machines (each point in one table only; the methods' configs must
             agree). Default ``output_dir`` for one table: its folder.
+        records: Runs' saved records (``docs/results/save_run_records.sh``: config, round and training
+            records, no frames or weights), each a run's records folder or a folder of them, reported
+            beside ``experiments`` and ``compare_dir`` as their runs are: a study whose ``outputs/`` was
+            lost keeps its finished runs. Their frames per task are known only on average.
     """
 
     experiments: list[Path] = field(default_factory=list)
@@ -429,17 +433,21 @@ class ReportConfig:
     output: Path | None = None
     levels: list[float] = field(default_factory=lambda: [0.5, 0.6, 0.7, 0.8])
     variants: dict[str, Path] = field(default_factory=dict)
+    records: list[Path] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         if self.results:
             self._check_results_options()
             return
-        if not self.experiments and self.compare_dir is None:
+        if not self.experiments and self.compare_dir is None and not self.records:
             raise ValueError(
-                "--experiments, --compare_dir or --results is required, e.g. "
-                "--experiments='[outputs/need-s0,outputs/bc-s0]', --compare_dir=outputs/compare or "
+                "--experiments, --compare_dir, --records or --results is required, e.g. "
+                "--experiments='[outputs/need-s0,outputs/bc-s0]', --compare_dir=outputs/compare, "
+                "--records='[docs/results/pixels-eval/records]' or "
                 "--results='[docs/results/mt10-state-eval/report]'."
             )
+        for folder in self.records:
+            _saved_records_runs(Path(folder))  # refuses a folder without records now, not mid-report
         if self.compare_dir is not None and not (self.compare_dir / "runs").is_dir():
             raise ValueError(f"{self.compare_dir} is not a compare folder (no runs/ in it).")
         if self.compare_dir is not None and self.output_dir is None:
@@ -455,10 +463,10 @@ class ReportConfig:
 
     def _check_results_options(self) -> None:
         """``--results`` goes without run folders; several tables need an ``--output_dir``."""
-        if self.experiments or self.compare_dir is not None or self.variants:
+        if self.experiments or self.compare_dir is not None or self.variants or self.records:
             raise ValueError(
-                "--results draws saved tables: give it alone, without --experiments, --compare_dir or "
-                "--variants (their runs are tabulated afresh instead)."
+                "--results draws saved tables: give it alone, without --experiments, --compare_dir, "
+                "--variants or --records (their runs are tabulated afresh instead)."
             )
         if self.output_dir is None and len(self.results) > 1:
             raise ValueError(
@@ -475,6 +483,8 @@ class ReportConfig:
         mine = list(self.experiments)
         if self.compare_dir is not None:
             mine += _compare_runs(self.compare_dir)
+        for folder in self.records:
+            mine += _saved_records_runs(Path(folder))
         return mine + list(self.labels)
 
     @property
@@ -499,6 +509,26 @@ class ReportConfig:
 def _compare_runs(compare_dir: Path) -> list[Path]:
     """The run folders of a ``compare`` folder."""
     return sorted(p for p in (compare_dir / "runs").iterdir() if p.is_dir())
+
+
+def _saved_records_runs(folder: Path) -> list[Path]:
+    """The runs' records in ``folder``: itself if it holds one run's records, else its subfolders that do.
+
+    Raises:
+        UserError: If it holds no run's records, naming the command that saves them.
+    """
+    from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
+
+    if (folder / CONFIG_FILE).is_file():
+        return [folder]
+    runs = sorted(p for p in folder.iterdir() if (p / CONFIG_FILE).is_file()) if folder.is_dir() else []
+    if not runs:
+        raise UserError(
+            f"--records: {folder} holds no run's records (a config.json in it or in its subfolders): "
+            "give the folder `bash docs/results/save_run_records.sh RUNS DEST` wrote (DEST), or one run's "
+            "folder in it."
+        )
+    return runs
 
 
 def report_command(config: ReportConfig) -> str:
@@ -532,11 +562,11 @@ def report_command(config: ReportConfig) -> str:
         )
     table = _print_table(curves_table(learning_curves(roots, labels)), config)
     if config.output_dir is not None:
-        from lerobot_mtdagger.datasets.rounds import ExperimentDir
+        from lerobot_mtdagger.datasets.rounds import open_run
         from lerobot_mtdagger.studies.results import results_rows, write_results
 
         rows = results_rows(roots, labels)
-        task_names = ExperimentDir(roots[0]).read_round_record(0).task_names
+        task_names = open_run(roots[0]).read_round_record(0).task_names
         write_results(rows, config.output_dir, task_names, configs, unfinished)
         _write_figures(rows, task_names, config, unfinished)
     return table

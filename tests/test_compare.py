@@ -361,6 +361,92 @@ def test_report_results_goes_alone(compared, tmp_path, capsys):
     assert "give --output_dir for the joined report" in capsys.readouterr().err
 
 
+SAVE_RUN_RECORDS = Path(__file__).resolve().parents[1] / "docs" / "results" / "save_run_records.sh"
+
+
+def _save_records(runs: Path, dest: Path) -> Path:
+    """The runs' records as a study saves them before its ``outputs/`` may be lost (the real script)."""
+    subprocess.run(["bash", str(SAVE_RUN_RECORDS), str(runs), str(dest)], check=True)
+    return dest
+
+
+def _rows_without_paths(report: Path) -> list[dict]:
+    """A saved table's rows less what names the folder they were read from."""
+    rows = json.loads((report / "results.json").read_text())
+    dropped = ("experiment", "expert_frames_per_task")
+    return [{k: v for k, v in row.items() if k not in dropped} for row in rows]
+
+
+def test_runs_saved_as_records_report_as_their_folders_do(compared, tmp_path, capsys):
+    """``outputs/`` lost, the JSON records that ``save_run_records.sh`` kept give the same table."""
+    folder, _ = compared
+    assert main(["report", f"--compare_dir={folder}", f"--output_dir={tmp_path / 'of-runs'}"]) == 0
+    table_of_runs = capsys.readouterr().out.split("figures and summary")[0]
+    records = _save_records(folder / "runs", tmp_path / "records")
+    assert not list(records.rglob("*.parquet")) and not list(records.rglob("*.safetensors"))
+
+    assert main(["report", f"--records=[{records}]", f"--output_dir={tmp_path / 'of-records'}"]) == 0
+
+    assert capsys.readouterr().out.split("figures and summary")[0] == table_of_runs
+    assert _rows_without_paths(tmp_path / "of-records") == _rows_without_paths(tmp_path / "of-runs")
+    rows = json.loads((tmp_path / "of-records" / "results.json").read_text())
+    assert all(row["expert_frames_per_task"] is None for row in rows)  # saved in total, not per task
+    summary = (tmp_path / "of-records" / "report.md").read_text()
+    assert summary == (tmp_path / "of-runs" / "report.md").read_text()
+
+
+def test_saved_records_of_some_runs_join_the_folders_of_the_others(compared, tmp_path, capsys):
+    folder, _ = compared
+    assert main(["report", f"--compare_dir={folder}"]) == 0
+    table_of_runs = capsys.readouterr().out
+    records = _save_records(folder / "runs", tmp_path / "records")
+    study = tmp_path / "cmp"
+    shutil.copytree(folder, study, ignore=shutil.ignore_patterns("report"))
+    lost = sorted(run.name for run in (study / "runs").glob("bc-*-seed0") if run.is_dir())
+    for name in lost:  # BC seed 0 finished, then outputs/ was lost; the study goes on without them
+        shutil.rmtree(study / "runs" / name)
+        (study / "runs" / f"{name}.log").unlink()
+    kept = ",".join(str(records / name) for name in lost)
+
+    assert main(["report", f"--compare_dir={study}", f"--records=[{kept}]"]) == 0
+
+    out = capsys.readouterr().out
+    assert out.split("figures and summary")[0] == table_of_runs.split("figures and summary")[0]
+
+
+def test_a_run_in_its_folder_and_in_saved_records_is_refused(compared, tmp_path, capsys):
+    folder, _ = compared
+    records = _save_records(folder / "runs", tmp_path / "records")
+    assert main(["report", f"--compare_dir={folder}", f"--records=[{records / 'need-seed0'}]"]) == 2
+    assert "Two need experiments with seed 0" in capsys.readouterr().err
+
+
+def test_report_records_names_the_script_that_saves_them(compared, tmp_path, capsys):
+    folder, _ = compared
+    (tmp_path / "empty").mkdir()
+    for where in (tmp_path / "empty", tmp_path / "nowhere"):
+        assert main(["report", f"--records=[{where}]"]) == 2
+        assert f"--records: {where} holds no run's records" in capsys.readouterr().err
+    assert main(["report", f"--records=[{folder / 'runs'}]", f"--results=[{folder}]"]) == 2
+    assert "without --experiments, --compare_dir, --variants or --records" in capsys.readouterr().err
+
+
+def test_saved_records_of_a_restarted_run_are_replaced_whole(compared, tmp_path):
+    """A run restarted from nothing (its folder lost) must not mix with its earlier records."""
+    folder, _ = compared
+    runs = tmp_path / "runs"
+    shutil.copytree(folder / "runs" / "need-seed0", runs / "need-seed0")
+    records = _save_records(folder / "runs", tmp_path / "records")
+    for late in ("rounds/round-002", "rounds/round-001", "policies/round-002", "policies/round-001"):
+        shutil.rmtree(runs / "need-seed0" / late)  # the restarted run has reached phase 0 so far
+
+    _save_records(runs, records)
+
+    assert sorted(p.name for p in (records / "need-seed0" / "policies").iterdir()) == ["round-000"]
+    assert sorted(p.name for p in (records / "need-seed0" / "rounds").iterdir()) == ["round-000"]
+    assert (records / "gain-seed0" / "policies" / "round-002" / "training.json").is_file()  # untouched
+
+
 @pytest.fixture(scope="module")
 def seed_tables(compared, tmp_path_factory):
     """The comparison saved as two tables, one per seed, as if each seed ran on its own machine."""

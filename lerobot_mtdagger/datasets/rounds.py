@@ -183,6 +183,34 @@ def _only(frame: Mapping[str, Any], features: Mapping[str, Any]) -> dict[str, An
     return {key: value for key, value in frame.items() if key in features}
 
 
+def round_record_from_info(path: Path, info_path: Path) -> RoundRecord:
+    """The round record mirrored under ``mtdagger`` in a round's LeRobot ``info.json`` at ``info_path``.
+
+    Raises:
+        CorruptExperimentError: If the file is unreadable or holds no committed record.
+    """
+    info = read_committed_json(info_path, "restore it, or move the round out of the experiment directory")
+    return round_record_from(info.get(RECORD_KEY) if isinstance(info, dict) else None, path, info_path)
+
+
+def round_record_from(record: Any, path: Path, info_path: Path) -> RoundRecord:
+    """The committed round record ``record`` read from ``info_path`` (for the round at ``path``).
+
+    Raises:
+        CorruptExperimentError: If it is not a record of this format, or not committed.
+    """
+    if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
+        raise CorruptExperimentError(
+            f"{path} is not a lerobot-mtdagger round (no '{RECORD_KEY}' record of format "
+            f"{FORMAT_VERSION} in {info_path}); move it out of the experiment directory."
+        )
+    if not record.get("committed"):
+        raise CorruptExperimentError(
+            f"{path} holds an uncommitted round record; move it out of the experiment directory."
+        )
+    return RoundRecord.from_dict(record, where=f"The round record in {info_path}")
+
+
 class ExperimentDir:
     """The on-disk state of one experiment (see the module docstring for the layout)."""
 
@@ -429,24 +457,10 @@ class ExperimentDir:
         Raises:
             CorruptExperimentError: If ``path`` holds no readable round record.
         """
-        fix = "restore it, or move the round out of the experiment directory"
-        info_path = path / INFO_FILE
         if (path / RECORD_FILE).is_file():
-            info_path = path / RECORD_FILE
-            record = read_committed_json(info_path, fix)
-        else:
-            info = read_committed_json(info_path, fix)
-            record = info.get(RECORD_KEY) if isinstance(info, dict) else None
-        if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
-            raise CorruptExperimentError(
-                f"{path} is not a lerobot-mtdagger round (no '{RECORD_KEY}' record of format "
-                f"{FORMAT_VERSION} in {info_path}); move it out of the experiment directory."
-            )
-        if not record.get("committed"):
-            raise CorruptExperimentError(
-                f"{path} holds an uncommitted round record; move it out of the experiment directory."
-            )
-        return RoundRecord.from_dict(record, where=f"The round record in {info_path}")
+            fix = "restore it, or move the round out of the experiment directory"
+            return round_record_from(read_committed_json(path / RECORD_FILE, fix), path, path / RECORD_FILE)
+        return round_record_from_info(path, path / INFO_FILE)
 
     def read_round_record(self, round_index: int) -> RoundRecord:
         """The record of a committed round."""
@@ -582,6 +596,46 @@ class ExperimentDir:
         fix = f"delete policies/{round_name(round_index)} and every later phase, and resume to retrain them"
         values = read_committed_json(path, fix)
         return PhaseRecord.from_dict(values, where=f"The training record {path}")
+
+
+SAVED_INFO_FILE = "info.json"
+"""A round's ``meta/info.json`` where ``docs/results/save_run_records.sh`` saves it (``rounds/<round>/``)."""
+
+
+class SavedRunRecords(ExperimentDir):
+    """A run's small JSON records, saved apart from its datasets and weights, read as a run is read.
+
+    The layout ``docs/results/save_run_records.sh`` writes, so that a study's numbers outlive its run
+    folders::
+
+        <run>/config.json                       the run's options
+        <run>/rounds/round-000/info.json        the round's meta/info.json (its record, "mtdagger")
+        <run>/policies/round-000/training.json  the phase's training record, evaluation included
+
+    Enough to tabulate and report the run (``studies.results``), not to verify, resume, merge or push
+    it: there are no frames and no weights. A round's frames are known only in total (the record's
+    ``frames``), not per task.
+    """
+
+    @staticmethod
+    def read_round_record_at(path: Path) -> RoundRecord:
+        """The record of the saved round at ``path`` (its ``info.json``).
+
+        Raises:
+            CorruptExperimentError: If ``path`` holds no readable committed record.
+        """
+        return round_record_from_info(path, path / SAVED_INFO_FILE)
+
+
+def is_saved_records(root: Path) -> bool:
+    """Whether ``root`` holds a run's saved records (``SavedRunRecords``) rather than a run folder."""
+    first_round = Path(root) / ROUNDS_DIR / round_name(0)
+    return (first_round / SAVED_INFO_FILE).is_file() and not (first_round / INFO_FILE).is_file()
+
+
+def open_run(root: Path) -> ExperimentDir:
+    """The run folder or the saved records (``SavedRunRecords``) at ``root``, to read."""
+    return SavedRunRecords(root) if is_saved_records(root) else ExperimentDir(root)
 
 
 def sort_stats_file(root: Path) -> None:

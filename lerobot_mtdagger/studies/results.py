@@ -29,7 +29,7 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from lerobot_mtdagger.datasets.config_layout import flatten, migrate_run_config, option
-from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, ExperimentDir
+from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, SavedRunRecords, open_run
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.studies.report import CurvePoint, RunPoints, average_runs, curve_name
 from lerobot_mtdagger.utils.errors import UserError
@@ -80,25 +80,36 @@ def experiment_rows(root: Path, label: str | None = None) -> list[dict[str, Any]
     Raises:
         ValueError: If ``root`` is not an experiment with committed rounds.
     """
-    experiment = ExperimentDir(root)
+    experiment = open_run(root)
     rounds = experiment.committed_rounds()
     if not rounds:
         raise UserError(f"{root} has no committed round: is it a lerobot-mtdagger experiment?")
     records = [experiment.read_round_record(k) for k in rounds]
     num_tasks = len(records[0].task_names)
-    frames = np.zeros(num_tasks, dtype=np.int64)
+    frames: np.ndarray | None = np.zeros(num_tasks, dtype=np.int64)
+    total_frames = 0
     rows = []
     for k in experiment.committed_phases():
-        frames = frames + np.asarray(round_frames_per_task(experiment.round_root(k), num_tasks))
+        total_frames += records[k].frames
+        if isinstance(experiment, SavedRunRecords):
+            frames = None  # saved records count a round's frames in total only
+        else:
+            frames = frames + np.asarray(round_frames_per_task(experiment.round_root(k), num_tasks))
         phase = experiment.read_phase_record(k)
         if phase.eval is None:
             continue
-        rows.append(_row(root, records, k, phase, frames, label))
+        rows.append(_row(root, records, k, phase, frames, total_frames / num_tasks, label))
     return rows
 
 
 def _row(
-    root: Path, records: list, k: int, phase: Any, frames: np.ndarray, label: str | None
+    root: Path,
+    records: list,
+    k: int,
+    phase: Any,
+    frames: np.ndarray | None,
+    mean_frames: float,
+    label: str | None,
 ) -> dict[str, Any]:
     record = records[k]
     following = records[k + 1] if k + 1 < len(records) else None
@@ -113,8 +124,8 @@ def _row(
         "preset": config.get("preset"),
         "demos_per_task_mean": float(np.mean(demos)),
         "demos_per_task": demos,
-        "expert_frames_per_task_mean": float(frames.mean()),
-        "expert_frames_per_task": frames.tolist(),
+        "expert_frames_per_task_mean": float(mean_frames if frames is None else frames.mean()),
+        "expert_frames_per_task": None if frames is None else frames.tolist(),
         "eval_success_mean": float(phase.eval_mean),
         "eval_success": [float(s) for s in phase.eval["success"]],
         "eval_episodes_per_task": int(option(config, "rollout.eval_episodes") or 0),
@@ -392,7 +403,7 @@ def run_progress(root: Path) -> RunProgress:
     path = Path(root) / CONFIG_FILE
     if not path.is_file():
         raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
-    experiment = ExperimentDir(root)
+    experiment = open_run(root)
     config = experiment.read_config()
     last_phase = 0 if config.get("mode") == "bc" else int(option(config, "dagger.rounds") or 0)
     return RunProgress(
@@ -410,7 +421,7 @@ def experiment_curve(root: Path, label: str | None = None) -> RunPoints:
         root: The experiment folder.
         label: The method name to report it under (default: its method, ``bc`` for BC).
     """
-    experiment = ExperimentDir(root)
+    experiment = open_run(root)
     record = experiment.read_round_record(0)
     points = []
     for round_index in experiment.committed_phases():
@@ -457,7 +468,7 @@ def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = 
         path = root / CONFIG_FILE
         if not path.is_file():
             raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
-        config = ExperimentDir(root).read_config()
+        config = open_run(root).read_config()
         is_bc = config.get("mode") == "bc"
         method = (labels or {}).get(root) or ("bc" if is_bc else option(config, "scheduler.type"))
         ignored = PER_RUN_FIELDS + (BC_BUDGET_FIELDS if is_bc else ())
