@@ -264,7 +264,7 @@ def test_a_flat_config_migrates_into_the_groups():
     today = flatten(parse("--suite.name=toy").to_dict())
     added = set(today) - set(leaves)
     expected = {"suite.episode_length", "rollout.worker_backend", "rollout.ray_address"}
-    expected.add("training.lr_schedule")
+    expected |= {"training.lr_schedule", "training.seed"}
     assert added == expected, added
     assert all(today[path] == RunConfig.option_defaults()[path] for path in added)
 

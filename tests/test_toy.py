@@ -329,6 +329,37 @@ def test_the_learning_rate_schedule_reaches_the_training_phase(tmp_path):
     assert any(not torch.equal(t, weights["cosine"][n]) for n, t in weights["constant"].items())
 
 
+def _bc_weights(root):
+    from lerobot_mtdagger.policies import MTDAggerPolicy
+
+    return MTDAggerPolicy.from_pretrained(str(ExperimentDir(root).policy_root(0))).state_dict()
+
+
+def test_a_training_seed_retrains_on_the_same_data_and_the_run_seed_is_its_default(tmp_path):
+    """``--training.seed`` changes the training draws alone: another training on the very same data."""
+    for name, extra in (("default", ()), ("same", ("--training.seed=0",)), ("other", ("--training.seed=1",))):
+        run(toy_config(tmp_path / name, "--mode=bc", "--seed=0", *extra))
+    records = {
+        name: ExperimentDir(tmp_path / name).read_round_record(0) for name in ("default", "same", "other")
+    }
+    assert records["other"].files == records["default"].files  # the same frames, byte for byte
+    weights = {name: _bc_weights(tmp_path / name) for name in records}
+    for name, tensor in weights["default"].items():
+        torch.testing.assert_close(tensor, weights["same"][name], rtol=0, atol=0)  # unset = --seed
+    assert any(not torch.equal(t, weights["other"][n]) for n, t in weights["default"].items())
+
+
+def test_a_training_seed_must_be_kept_on_resume_and_be_positive(tmp_path, capsys):
+    from lerobot_mtdagger.cli import main
+
+    run(toy_config(tmp_path / "bc", "--mode=bc", "--training.seed=3"))
+    with pytest.raises(UserError, match=r"training.seed"):
+        run(toy_config(tmp_path / "bc", "--mode=bc", "--resume=true"))
+    assert main(["run", *TOY_RUN, "--training.seed=-1", f"--output_dir={tmp_path / 'other'}"]) == 2
+    assert "training.seed must be >= 0" in capsys.readouterr().err
+    assert not (tmp_path / "other").exists()
+
+
 def test_bc_mode_runs_one_round_with_the_same_budget_and_compute(tmp_path):
     lines = run(toy_config(tmp_path / "bc", "--mode=bc"))
     experiment = ExperimentDir(tmp_path / "bc")

@@ -450,6 +450,10 @@ class TrainingConfig:
         heldout_fraction: Fraction of each task's episodes held out of training when
             ``gain_split=heldout`` or ``steps_rule=plateau`` (decided once per episode, so an
             episode never changes side; a task's first episode is always trained on).
+        seed: Seed of the phases' initial weights, batch order and task dropout, where it is to
+            differ from the run's ``--seed`` (which keeps every other draw: the episodes collected,
+            evaluated and held out). A BC run repeated with other training seeds trains on the very
+            same data: the spread between trainings, apart from the data's. None: ``--seed``.
     """
 
     steps_per_round: int | None = None
@@ -464,11 +468,16 @@ class TrainingConfig:
     lr_schedule: str = "constant"
     gain_split: str = "train"
     heldout_fraction: float = 0.2
+    seed: int | None = None
 
     def check(self) -> None:
         """Refuses impossible values (one line naming the option)."""
         positive = ("steps_per_round", "epochs", "plateau_every", "plateau_patience", "plateau_max_steps")
         _require_positive(self, "training", positive)
+        if self.seed is not None and self.seed < 0:
+            raise ValueError(
+                f"training.seed must be >= 0 (or left unset: the run's --seed), got {self.seed}."
+            )
         _require_choice(self.steps_rule, "training.steps_rule", STEPS_RULES)
         _require_choice(self.normalisation, "training.normalisation", NORMALISATIONS)
         _require_choice(self.sampling, "training.sampling", SAMPLINGS)
@@ -611,6 +620,11 @@ class RunConfig:
     def method(self) -> str:
         """The experiment's method as reports name it: ``bc`` or the scheduling method."""
         return "bc" if self.is_bc else self.scheduler.type
+
+    @property
+    def training_seed(self) -> int:
+        """The seed of every training draw: ``--training.seed``, or the run's ``--seed`` when unset."""
+        return self.seed if self.training.seed is None else self.training.seed
 
     def phase_steps(self, frames: int) -> int:
         """Optimiser steps of one training phase on ``frames`` training frames.

@@ -1007,7 +1007,7 @@ def train_on_rounds(
     """
     start = time.perf_counter()
     image_keys = list(policy_cfg.image_features)
-    phase_seed = stream_seed(config.seed, TRAINING_STREAM, round_index)
+    phase_seed = stream_seed(config.training_seed, TRAINING_STREAM, round_index)
     split = split_frames(
         data,
         config.training.gain_split,

@@ -352,6 +352,7 @@ def _read_json(path: Path) -> Any:
 
 PER_RUN_FIELDS = (
     "seed",
+    "training.seed",
     "output_dir",
     "resume",
     "progress",

@@ -2,7 +2,8 @@
 
 A run has one seed (``--seed``). Each kind of random choice draws from its own stream, derived with
 numpy's ``SeedSequence`` from ``(seed, stream, *keys)``, so drawing more from one stream (more
-rounds, tasks or episodes) never shifts another.
+rounds, tasks or episodes) never shifts another. ``--training.seed``, when given, replaces the run's
+seed in ``TRAINING_STREAM`` alone (``RunConfig.training_seed``): other trainings on the same data.
 
 Streams (number; the keys after it; what it decides):
 
