@@ -349,6 +349,21 @@ def test_a_training_seed_retrains_on_the_same_data_and_the_run_seed_is_its_defau
     assert any(not torch.equal(t, weights["other"][n]) for n, t in weights["default"].items())
 
 
+def test_a_phase_records_the_environment_its_arithmetic_depends_on(tmp_path):
+    """Two trainings of the same data differ in the last bits on another CPU or torch: say which."""
+    import importlib.metadata
+
+    run(toy_config(tmp_path / "bc", "--mode=bc"))
+    stored = json.loads((ExperimentDir(tmp_path / "bc").policy_root(0) / "training.json").read_text())
+    environment = stored["environment"]
+    assert environment["packages"]["torch"] == importlib.metadata.version("torch")
+    assert environment["packages"]["lerobot"] == importlib.metadata.version("lerobot")
+    assert environment["cpu_capability"] == torch.backends.cpu.get_cpu_capability()
+    assert environment["device"] == "cpu" and environment["device_name"] is None
+    assert environment["torch_threads"] >= 1 and environment["cpu"]
+    assert ExperimentDir(tmp_path / "bc").read_phase_record(0).environment == environment
+
+
 def test_a_training_seed_must_be_kept_on_resume_and_be_positive(tmp_path, capsys):
     from lerobot_mtdagger.cli import main
 

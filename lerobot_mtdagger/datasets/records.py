@@ -270,6 +270,10 @@ class PhaseRecord:
             measurement; None otherwise.
         heldout_eval: ``EvalResult.to_dict()`` on the suite's unseen tasks (the held-out drawers),
             recorded beside ``eval`` and never given to the scheduler; None where not evaluated.
+        environment: Where the phase trained (``training_environment``: package versions, the CPU
+            and its kernel level, torch threads, device); None in phases written before it was
+            recorded. The same data and seeds give the same weights bit for bit only in the same
+            environment: elsewhere the arithmetic differs in the last bits and grows over the steps.
     """
 
     round: int
@@ -290,6 +294,7 @@ class PhaseRecord:
     best_step: int | None = None
     heldout_loss: list[list[float]] | None = None
     heldout_eval: dict[str, Any] | None = None
+    environment: dict[str, Any] | None = None
 
     @property
     def eval_mean(self) -> float | None:
