@@ -1,70 +1,78 @@
 #!/usr/bin/env bash
-# Starts (or, after a stop, restarts) the #31 studies, one sequence per core of the 2-core machine,
-# each step pinned with `taskset` (docs/benchmarks.md, "Threads per run") and resumable. From ../main:
+# Starts (or, after a stop, restarts) the #31 studies still running, one process pinned to each core of
+# the 2-core machine (`taskset`: docs/benchmarks.md, "Threads per run"), every step resumable. Works on
+# a new checkout (no outputs/, no worktrees): it makes the frozen worktrees it needs. From ../main,
+# once the README's setup command has made .venv:
 #   nohup bash docs/results/resume.sh >> outputs/resume.log 2>&1 &
-# Every step first waits while a process of the same step is still running (started by an earlier
-# call), then runs it: a step whose runs are finished only rewrites its tables, a cut one resumes.
 #
-# Core 1: queue.sh's plateau lane (bc-past-plateau-dev, then beyond-plateau-best-bc), then a second
-#   pixels-eval process beside core 0's (once pixels-bc-dev has decided; each compare skips the runs
-#   the other finished and fails at once on one the other holds), then pixels-eval once more for its
-#   table and report, then drawers-preset-dev (../study-code-drawers-preset).
-# Core 0: queue.sh's pixels lane (pixels-bc-dev, then pixels-eval).
-# A lane runs from a copy (outputs/queue-running-<lane>.sh) so that editing queue.sh cannot change it.
-# (Until 2026-11-27 07:01 UTC both cores first ran the drawers-eval study, now complete.)
-# Worktrees as their READMEs say: `git worktree add --detach ../<name> <commit>`, then in it
-# `ln -sf ../main/.venv .venv && ln -sfn ../main/outputs outputs`.
+# Both cores (unless run-rest.sh processes are already running: then it waits for them to end):
+#   pixels-eval's run-rest.sh (run.sh's plan less BC seed 0, which is saved in records/), one
+#   process each from ../study-code-pixels-eval (f33425a), sharing the plan; each skips finished runs
+#   and leaves a run the other holds to it. Once both are done: the records, the report drawn from them
+#   (`report --records`) and table.txt, here.
+# Then core 1: drawers-preset-dev (../study-code-drawers-preset at e52ef80). Core 0: nothing more.
+# (Until 2026-11-27 12:00 UTC this script ran queue.sh's two lanes: bc-past-plateau-dev and
+# beyond-plateau-best-bc, pixels-bc-dev, then pixels-eval; all but pixels-eval are complete.)
 set -uo pipefail
-
-wait_while_running() {  # wait_while_running PATTERN: until no process's command line matches
-  while pgrep -f -- "$1" > /dev/null; do sleep 60; done
-}
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
-queue_lane() {  # queue_lane CORE LANE: queue.sh's lane, from a copy, once no copy of it runs
-  wait_while_running "outputs/queue-running-$2.sh"
-  log "core $1: queue.sh's $2 lane"
-  cp docs/results/queue.sh "outputs/queue-running-$2.sh"
-  taskset -c "$1" bash "outputs/queue-running-$2.sh" "$2" >> "outputs/queue-$2.log" 2>&1 \
-    || log "core $1: the $2 lane stopped with an error: see outputs/queue-$2.log"
+worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checkout's .venv and outputs/
+  if [ ! -d "../$1" ]; then
+    git worktree prune
+    git worktree add --detach "../$1" "$2" || return 1
+  fi
+  ln -sf ../main/.venv "../$1/.venv"
+  ln -sfn ../main/outputs "../$1/outputs"
 }
 
-PIXELS_EVAL=../study-code-pixels-eval
+PIXELS=../study-code-pixels-eval
 
-pixels_eval() {  # pixels_eval CORE: pixels-eval's frozen run.sh, one job pinned to CORE
-  (cd "$PIXELS_EVAL" && JOBS=1 PYTHONPATH=$PWD taskset -c "$1" bash docs/results/pixels-eval/run.sh) \
-    >> outputs/pixels-eval-second.log 2>&1
+pixels_rest() {  # pixels_rest CORE: one run-rest.sh process pinned to CORE
+  (cd "$PIXELS" && JOBS=1 PYTHONPATH=$PWD taskset -c "$1" \
+    bash ../main/docs/results/pixels-eval/run-rest.sh) >> "outputs/pixels-eval-core$1.log" 2>&1
 }
 
-pixels_eval_second_process() {  # pixels_eval_second_process CORE: beside the pixels lane, then the report
-  until grep -q "^Decision: BC samples" "$PIXELS_EVAL/docs/results/pixels-bc-dev/table.txt" 2> /dev/null; do
-    sleep 300
-  done
-  log "core $1: pixels-eval, a second process beside the pixels lane's"
-  pixels_eval "$1" || log "core $1: pixels-eval's second process ended with an error (a run the other held?)"
-  wait_while_running "outputs/queue-running-pixels.sh"
-  log "core $1: pixels-eval once more (its table and report), then its records"
-  pixels_eval "$1" || { log "core $1: pixels-eval failed: see outputs/pixels-eval-second.log"; return 1; }
-  mkdir -p docs/results/pixels-eval/report
-  cp -r "$PIXELS_EVAL/docs/results/pixels-eval/report/." docs/results/pixels-eval/report/
+pixels_tabulate() {  # the records, the report from them and the table fixed in run.sh
   bash docs/results/pixels-eval/save_records.sh
+  .venv/bin/lerobot-mtdagger report --records='[docs/results/pixels-eval/records]' --levels='[0.6,0.7]' \
+    --output_dir=docs/results/pixels-eval/report > outputs/pixels-eval-report.log 2>&1 || return 1
+  .venv/bin/python docs/results/pixels-eval/table.py docs/results/pixels-eval/report/results.csv \
+    > docs/results/pixels-eval/table.txt
 }
 
-core1() {
-  queue_lane 1 plateau
-  pixels_eval_second_process 1
-  log "core 1: drawers-preset-dev"
-  (cd ../study-code-drawers-preset && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c 1 \
-    bash docs/results/drawers-preset-dev/run.sh >> outputs/drawers-preset-dev.log 2>&1)
-  log "core 1: done"
+drawers_preset() {  # drawers-preset-dev, one run at a time on CORE
+  (cd ../study-code-drawers-preset && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
+    bash docs/results/drawers-preset-dev/run.sh) >> outputs/drawers-preset-dev.log 2>&1
 }
 
-core0() {
-  queue_lane 0 pixels
-  log "core 0: done"
-}
+mkdir -p outputs
+worktree study-code-pixels-eval f33425a || { log "cannot make $PIXELS"; exit 1; }
+cp docs/results/pixels-bc-dev/table.txt "$PIXELS/docs/results/pixels-bc-dev/table.txt"  # the decision
+worktree study-code-drawers-preset e52ef80 || { log "cannot make ../study-code-drawers-preset"; exit 1; }
+if ! pgrep -f benchmarks/watch_memory.py > /dev/null; then  # each run's peak memory, one watcher
+  nohup .venv/bin/python benchmarks/watch_memory.py --output outputs/study-memory.json --match outputs/ \
+    > /dev/null 2>&1 &
+fi
 
-core1 &
-core0 &
-wait
+if pgrep -f "pixels-eval/run-rest.sh" > /dev/null; then  # started earlier (by hand, or by a former call)
+  log "pixels-eval run-rest.sh already running: waiting for it to end"
+  while pgrep -f "pixels-eval/run-rest.sh" > /dev/null; do sleep 60; done
+else
+  log "cores 0 and 1: pixels-eval run-rest.sh"
+  pixels_rest 0 &
+  first=$!
+  sleep 90  # the first process takes the first run; the second then starts on the next one
+  pixels_rest 1
+  wait "$first"
+fi
+# A process ends with an error when it met a run the other held; once both have ended, one more pass
+# finds every run finished (or resumes what a stop cut), so its status is the study's.
+if pixels_rest 1 && pixels_tabulate; then
+  log "pixels-eval complete: docs/results/pixels-eval/table.txt"
+else
+  log "pixels-eval: a run failed, see outputs/pixels-eval-core*.log"
+fi
+log "core 1: drawers-preset-dev"
+drawers_preset 1
+log "done"
