@@ -10,7 +10,8 @@
 #   process each from ../study-code-pixels-eval (f33425a), sharing the plan; each skips finished runs
 #   and leaves a run the other holds to it. Once both are done: the records, the report drawn from them
 #   (`report --records`) and table.txt, here.
-# Then core 1: drawers-preset-dev (../study-code-drawers-preset at e52ef80). Core 0: nothing more.
+# Then core 1: drawers-preset-dev (../study-code-drawers-preset at e52ef80); core 0:
+#   drawers-training-spread-dev (../study-code-training-spread at a5a8d2f), then its records and table.
 # (Until 2026-11-27 12:00 UTC this script ran queue.sh's two lanes: bc-past-plateau-dev and
 # beyond-plateau-best-bc, pixels-bc-dev, then pixels-eval; all but pixels-eval are complete.)
 set -uo pipefail
@@ -41,6 +42,15 @@ pixels_tabulate() {  # the records, the report from them and the table fixed in 
     > docs/results/pixels-eval/table.txt
 }
 
+training_spread() {  # drawers-training-spread-dev on CORE, then its records and table
+  (cd ../study-code-training-spread && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
+    bash docs/results/drawers-training-spread-dev/run.sh) >> outputs/drawers-training-spread-dev.log 2>&1 \
+    || return 1
+  bash docs/results/drawers-training-spread-dev/save_records.sh
+  .venv/bin/python docs/results/drawers-training-spread-dev/table.py \
+    > docs/results/drawers-training-spread-dev/table.txt
+}
+
 drawers_preset() {  # drawers-preset-dev, one run at a time on CORE
   (cd ../study-code-drawers-preset && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
     bash docs/results/drawers-preset-dev/run.sh) >> outputs/drawers-preset-dev.log 2>&1
@@ -50,6 +60,7 @@ mkdir -p outputs
 worktree study-code-pixels-eval f33425a || { log "cannot make $PIXELS"; exit 1; }
 cp docs/results/pixels-bc-dev/table.txt "$PIXELS/docs/results/pixels-bc-dev/table.txt"  # the decision
 worktree study-code-drawers-preset e52ef80 || { log "cannot make ../study-code-drawers-preset"; exit 1; }
+worktree study-code-training-spread a5a8d2f || { log "cannot make ../study-code-training-spread"; exit 1; }
 if ! pgrep -f benchmarks/watch_memory.py > /dev/null; then  # each run's peak memory, one watcher
   nohup .venv/bin/python benchmarks/watch_memory.py --output outputs/study-memory.json --match outputs/ \
     > /dev/null 2>&1 &
@@ -73,6 +84,8 @@ if pixels_rest 1 && pixels_tabulate; then
 else
   log "pixels-eval: a run failed, see outputs/pixels-eval-core*.log"
 fi
-log "core 1: drawers-preset-dev"
-drawers_preset 1
+log "core 0: drawers-training-spread-dev; core 1: drawers-preset-dev"
+(training_spread 0 || log "drawers-training-spread-dev failed: see outputs/drawers-training-spread-dev.log") &
+drawers_preset 1 || log "drawers-preset-dev failed: see outputs/drawers-preset-dev.log"
+wait
 log "done"
