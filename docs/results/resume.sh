@@ -2,8 +2,10 @@
 # Starts (or, after a stop, restarts) the #31 studies still running, one process pinned to each core of
 # the 2-core machine (`taskset`: docs/benchmarks.md, "Threads per run"), every step resumable. Works on
 # a new checkout (no outputs/, no worktrees): it makes the frozen worktrees it needs. From ../main,
-# once the README's setup command has made .venv:
-#   nohup bash docs/results/resume.sh >> outputs/resume.log 2>&1 &
+# once the README's setup command has made .venv, from a copy (bash reads a script as it runs it, so
+# editing this file would change a running one):
+#   mkdir -p outputs && cp docs/results/resume.sh outputs/resume-running.sh
+#   nohup bash outputs/resume-running.sh >> outputs/resume.log 2>&1 &
 #
 # Both cores (unless run-rest.sh processes are already running: then it waits for them to end):
 #   pixels-eval's run-rest.sh (run.sh's plan less BC seed 0, which is saved in records/), one
