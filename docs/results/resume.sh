@@ -7,10 +7,11 @@
 #   mkdir -p outputs && cp docs/results/resume.sh outputs/resume-running.sh
 #   nohup bash outputs/resume-running.sh >> outputs/resume.log 2>&1 &
 #
-# Both cores (unless run-rest.sh processes are already running: then it waits for them to end):
-#   pixels-eval's run-rest.sh (run.sh's plan less BC seed 0, which is saved in records/), one
-#   process each from ../study-code-pixels-eval (f33425a), sharing the plan; each skips finished runs
-#   and leaves a run the other holds to it. Once both are done: the records, the report drawn from them
+# Both cores (unless run-rest.sh or run-missing.sh processes are already running: then it waits for
+#   them to end): pixels-eval's run-missing.sh (run.sh's plan less every run records/ or outputs/
+#   holds finished), one process each from ../study-code-pixels-eval (f33425a), sharing the plan; each
+#   skips finished runs and leaves a run the other holds to it. (Until 2026-11-27 17:45 UTC:
+#   run-rest.sh, which reruns every run not in outputs/ but BC seed 0.) Once both are done: the records, the report drawn from them
 #   (`report --records`) and table.txt, here.
 # Then core 1: drawers-preset-dev (../study-code-drawers-preset at e52ef80); core 0:
 #   drawers-training-spread-dev (../study-code-training-spread at a5a8d2f), then its records and table.
@@ -31,9 +32,9 @@ worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checko
 
 PIXELS=../study-code-pixels-eval
 
-pixels_rest() {  # pixels_rest CORE: one run-rest.sh process pinned to CORE
+pixels_rest() {  # pixels_rest CORE: one run-missing.sh process pinned to CORE
   (cd "$PIXELS" && JOBS=1 PYTHONPATH=$PWD taskset -c "$1" \
-    bash ../main/docs/results/pixels-eval/run-rest.sh) >> "outputs/pixels-eval-core$1.log" 2>&1
+    bash ../main/docs/results/pixels-eval/run-missing.sh) >> "outputs/pixels-eval-core$1.log" 2>&1
 }
 
 pixels_tabulate() {  # the records, the report from them and the table fixed in run.sh
@@ -68,11 +69,12 @@ if ! pgrep -f benchmarks/watch_memory.py > /dev/null; then  # each run's peak me
     > /dev/null 2>&1 &
 fi
 
-if pgrep -f "pixels-eval/run-rest.sh" > /dev/null; then  # started earlier (by hand, or by a former call)
-  log "pixels-eval run-rest.sh already running: waiting for it to end"
-  while pgrep -f "pixels-eval/run-rest.sh" > /dev/null; do sleep 60; done
+RUNNING="pixels-eval/run-(rest|missing).sh"
+if pgrep -f "$RUNNING" > /dev/null; then  # started earlier (by hand, or by a former call)
+  log "pixels-eval run-rest.sh or run-missing.sh already running: waiting for it to end"
+  while pgrep -f "$RUNNING" > /dev/null; do sleep 60; done
 else
-  log "cores 0 and 1: pixels-eval run-rest.sh"
+  log "cores 0 and 1: pixels-eval run-missing.sh"
   pixels_rest 0 &
   first=$!
   sleep 90  # the first process takes the first run; the second then starts on the next one
