@@ -11,8 +11,8 @@
 #   them to end): pixels-eval's run-missing.sh (run.sh's plan less every run records/ or outputs/
 #   holds finished), one process each from ../study-code-pixels-eval (f33425a), sharing the plan; each
 #   skips finished runs and leaves a run the other holds to it. (Until 2026-11-27 17:45 UTC:
-#   run-rest.sh, which reruns every run not in outputs/ but BC seed 0.) Once both are done: the records, the report drawn from them
-#   (`report --records`) and table.txt, here.
+#   run-rest.sh, which reruns every run not in outputs/ but BC seed 0.) Once both are done: the
+#   records, the report drawn from them (`report --records`) and table.txt, here.
 # Then core 1: drawers-preset-dev (../study-code-drawers-preset at e52ef80); core 0:
 #   drawers-training-spread-dev (../study-code-training-spread at a5a8d2f), then its records and table.
 # (Until 2026-11-27 12:00 UTC this script ran queue.sh's two lanes: bc-past-plateau-dev and
