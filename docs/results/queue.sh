@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # No longer started by resume.sh (since 2026-11-27 12:00 UTC): every study of both lanes is complete but
-# pixels-eval, which resume.sh now runs from run-rest.sh. Kept as the record of how those studies ran.
+# pixels-eval, which resume.sh then ran from run-rest.sh (complete 2026-11-27 19:56 UTC). Kept as the
+# record of how those studies ran.
 # The #31 studies queued in two lanes, one per core of the 2-core machine, each study from its frozen
 # worktree, each resumable; run again after any stop (a finished study is only re-reported). From
 # ../main (resume.sh starts both, each lane once its core's drawer study is done):
