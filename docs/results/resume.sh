@@ -8,7 +8,8 @@
 #   nohup bash outputs/resume-running.sh >> outputs/resume.log 2>&1 &
 #
 # Core 0: drawers-preset-dev (../study-code-drawers-preset at e52ef80). Core 1:
-# drawers-training-spread-dev (../study-code-training-spread at a5a8d2f), then its records and table.
+# drawers-training-spread-dev (../study-code-training-spread at a5a8d2f), then its records and table,
+# then pixels-dagger-epochs-dev (../study-code-pixels-epochs at a10a67e).
 # (Until 2026-11-27 19:56 UTC it first ran pixels-eval, complete since then, with run-missing.sh; and
 # until 12:00 UTC queue.sh's two lanes, all complete.)
 set -uo pipefail
@@ -38,19 +39,31 @@ drawers_preset() {  # drawers-preset-dev, one run at a time on CORE
     bash docs/results/drawers-preset-dev/run.sh) >> outputs/drawers-preset-dev.log 2>&1
 }
 
+pixels_epochs() {  # pixels-dagger-epochs-dev on CORE, then its records
+  (cd ../study-code-pixels-epochs && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
+    bash docs/results/pixels-dagger-epochs-dev/run.sh) >> outputs/pixels-dagger-epochs-dev.log 2>&1
+  local status=$?
+  bash docs/results/pixels-dagger-epochs-dev/save_records.sh
+  return "$status"
+}
+
 mkdir -p outputs
+worktree study-code-pixels-epochs a10a67e || { log "cannot make ../study-code-pixels-epochs"; exit 1; }
 worktree study-code-drawers-preset e52ef80 || { log "cannot make ../study-code-drawers-preset"; exit 1; }
 worktree study-code-training-spread a5a8d2f || { log "cannot make ../study-code-training-spread"; exit 1; }
 if ! pgrep -f benchmarks/watch_memory.py > /dev/null; then  # each run's peak memory, one watcher
   nohup .venv/bin/python benchmarks/watch_memory.py --output outputs/study-memory.json --match outputs/ \
     > /dev/null 2>&1 &
 fi
-if pgrep -f "drawers-(preset|training-spread)-dev/run.sh" > /dev/null; then
-  log "a drawers dev study is already running: stop it first (a second process would share its runs)"
+if pgrep -f "(drawers-preset|drawers-training-spread|pixels-dagger-epochs)-dev/run.sh" > /dev/null; then
+  log "a study is already running: stop it first (a second process would share its runs)"
   exit 1
 fi
-log "core 0: drawers-preset-dev; core 1: drawers-training-spread-dev"
-(training_spread 1 || log "drawers-training-spread-dev failed: see outputs/drawers-training-spread-dev.log") &
+log "core 0: drawers-preset-dev; core 1: drawers-training-spread-dev, then pixels-dagger-epochs-dev"
+(
+  training_spread 1 || log "drawers-training-spread-dev failed: see outputs/drawers-training-spread-dev.log"
+  pixels_epochs 1 || log "pixels-dagger-epochs-dev failed: see outputs/pixels-dagger-epochs-dev.log"
+) &
 drawers_preset 0 || log "drawers-preset-dev failed: see outputs/drawers-preset-dev.log"
 wait
 log "done"
