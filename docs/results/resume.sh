@@ -34,9 +34,12 @@ training_spread() {  # drawers-training-spread-dev on CORE, then its records and
     > docs/results/drawers-training-spread-dev/table.txt
 }
 
-drawers_preset() {  # drawers-preset-dev, one run at a time on CORE
+drawers_preset() {  # drawers-preset-dev, one run at a time on CORE, then its records
   (cd ../study-code-drawers-preset && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
     bash docs/results/drawers-preset-dev/run.sh) >> outputs/drawers-preset-dev.log 2>&1
+  local status=$?
+  bash docs/results/drawers-preset-dev/save_records.sh
+  return "$status"
 }
 
 pixels_epochs() {  # pixels-dagger-epochs-dev on CORE, then its records
