@@ -25,29 +25,18 @@ worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checko
   ln -sfn ../main/outputs "../$1/outputs"
 }
 
+run_study() {  # run_study CORE WORKTREE STUDY: ../WORKTREE's STUDY run.sh pinned to CORE, then its records
+  (cd "../$2" && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
+    bash "docs/results/$3/run.sh") >> "outputs/$3.log" 2>&1
+  local status=$?
+  bash "docs/results/$3/save_records.sh"
+  return "$status"
+}
+
 training_spread() {  # drawers-training-spread-dev on CORE, then its records and table
-  (cd ../study-code-training-spread && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
-    bash docs/results/drawers-training-spread-dev/run.sh) >> outputs/drawers-training-spread-dev.log 2>&1 \
-    || return 1
-  bash docs/results/drawers-training-spread-dev/save_records.sh
+  run_study "$1" study-code-training-spread drawers-training-spread-dev || return 1
   .venv/bin/python docs/results/drawers-training-spread-dev/table.py \
     > docs/results/drawers-training-spread-dev/table.txt
-}
-
-drawers_preset() {  # drawers-preset-dev, one run at a time on CORE, then its records
-  (cd ../study-code-drawers-preset && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
-    bash docs/results/drawers-preset-dev/run.sh) >> outputs/drawers-preset-dev.log 2>&1
-  local status=$?
-  bash docs/results/drawers-preset-dev/save_records.sh
-  return "$status"
-}
-
-pixels_epochs() {  # pixels-dagger-epochs-dev on CORE, then its records
-  (cd ../study-code-pixels-epochs && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c "$1" \
-    bash docs/results/pixels-dagger-epochs-dev/run.sh) >> outputs/pixels-dagger-epochs-dev.log 2>&1
-  local status=$?
-  bash docs/results/pixels-dagger-epochs-dev/save_records.sh
-  return "$status"
 }
 
 mkdir -p outputs
@@ -65,8 +54,10 @@ fi
 log "core 0: drawers-preset-dev; core 1: drawers-training-spread-dev, then pixels-dagger-epochs-dev"
 (
   training_spread 1 || log "drawers-training-spread-dev failed: see outputs/drawers-training-spread-dev.log"
-  pixels_epochs 1 || log "pixels-dagger-epochs-dev failed: see outputs/pixels-dagger-epochs-dev.log"
+  run_study 1 study-code-pixels-epochs pixels-dagger-epochs-dev \
+    || log "pixels-dagger-epochs-dev failed: see outputs/pixels-dagger-epochs-dev.log"
 ) &
-drawers_preset 0 || log "drawers-preset-dev failed: see outputs/drawers-preset-dev.log"
+run_study 0 study-code-drawers-preset drawers-preset-dev \
+  || log "drawers-preset-dev failed: see outputs/drawers-preset-dev.log"
 wait
 log "done"

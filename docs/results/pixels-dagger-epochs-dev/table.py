@@ -47,7 +47,9 @@ def success(per_task: list[float], tasks: list[str], only: tuple[str, ...] | Non
     return float(np.mean(chosen))
 
 
-def pairs(left: Curves, right: Curves, tasks: list[str], only=None) -> list[tuple[float, float]]:
+def pairs(
+    left: Curves, right: Curves, tasks: list[str], only: tuple[str, ...] | None = None
+) -> list[tuple[float, float]]:
     """(left, right) success at LAST demos per task on every seed both hold."""
     seeds = sorted(s for s in left if LAST in left[s] and s in right and LAST in right[s])
     return [(success(left[s][LAST], tasks, only), success(right[s][LAST], tasks, only)) for s in seeds]
