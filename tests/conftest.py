@@ -52,6 +52,17 @@ def expert_dataset_factory(tmp_path):
     return factory
 
 
+def eval_freq_option() -> str:
+    """Stock ``lerobot-train``'s option that turns evaluation off: ``--eval_freq`` on LeRobot 0.4,
+    ``--env_eval_freq`` from 0.5 on (the field was renamed)."""
+    import dataclasses
+
+    from lerobot.configs.train import TrainPipelineConfig
+
+    names = {field.name for field in dataclasses.fields(TrainPipelineConfig)}
+    return "--env_eval_freq=0" if "env_eval_freq" in names else "--eval_freq=0"
+
+
 def lerobot_train(dataset_root: Path, output_dir: Path, steps: int = 20, repo_id: str = "local/tiny") -> Path:
     """Runs stock ``lerobot-train`` on a local dataset; returns the last checkpoint's model folder."""
     command = [
@@ -66,7 +77,7 @@ def lerobot_train(dataset_root: Path, output_dir: Path, steps: int = 20, repo_id
         "--batch_size=16",
         "--num_workers=0",
         f"--save_freq={steps}",
-        "--eval_freq=0",
+        eval_freq_option(),
         "--wandb.enable=false",
         f"--output_dir={output_dir}",
     ]

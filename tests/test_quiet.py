@@ -80,11 +80,26 @@ def _state() -> dict:
 # -------------------------------------------------------------------------------------------------
 
 
-def test_the_video_codec_line_is_dropped_and_nothing_else(root_records):
-    from lerobot.datasets.video_utils import resolve_vcodec
+def _log_lerobots_codec_line() -> str:
+    """Makes LeRobot log its "Using video codec" line with its own code; returns the logger's name.
 
+    LeRobot 0.4 logs it on the root logger (``video_utils.resolve_vcodec``), LeRobot 0.6 on the named
+    logger of ``lerobot.configs.video`` (``VideoEncoderConfig`` resolves its codec when made).
+    """
+    try:
+        from lerobot.datasets.video_utils import resolve_vcodec  # LeRobot 0.4
+    except ImportError:
+        from lerobot.configs.video import VideoEncoderConfig  # LeRobot >= 0.6
+
+        VideoEncoderConfig(vcodec="libsvtav1")
+        return "lerobot.configs.video"
+    resolve_vcodec("libsvtav1")
+    return "root"
+
+
+def test_the_video_codec_line_is_dropped_and_nothing_else(root_records):
     with quiet_third_party():
-        resolve_vcodec("libsvtav1")  # LeRobot's own call: logging.info on the root logger
+        _log_lerobots_codec_line()
         logging.info("Using video codec: from somewhere else")  # root logger, another module
         logging.getLogger("lerobot_mtdagger.test").info("Using video codec: ours")
         logging.info("another root message")
@@ -93,8 +108,21 @@ def test_the_video_codec_line_is_dropped_and_nothing_else(root_records):
         "lerobot_mtdagger.test: Using video codec: ours",
         "root: another root message",
     ]
-    resolve_vcodec("libsvtav1")
-    assert root_records.messages[-1] == "root: Using video codec: libsvtav1", "back after the block"
+    logger_name = _log_lerobots_codec_line()
+    assert root_records.messages[-1] == f"{logger_name}: Using video codec: libsvtav1", "back after the block"
+
+
+def test_lerobot_06s_named_loggers_are_filtered_inside_only(root_records):
+    # LeRobot 0.6 logs the codec and merge steps through named loggers: both lines' loggers are covered
+    for name, prefixes in quiet.NAMED_MESSAGES.items():
+        with quiet_third_party():
+            logging.getLogger(name).info(prefixes[0] + "x")
+            logging.getLogger(name).info("something else")
+        logging.getLogger(name).info(prefixes[0] + "y")
+    expected = []
+    for name, prefixes in quiet.NAMED_MESSAGES.items():
+        expected += [f"{name}: something else", f"{name}: {prefixes[0]}y"]
+    assert root_records.messages == expected
 
 
 def test_lerobot_dataset_create_and_load_log_no_codec_line(tmp_path, root_records):
@@ -109,9 +137,23 @@ def test_lerobot_dataset_create_and_load_log_no_codec_line(tmp_path, root_record
     assert not [m for m in root_records.messages if "video codec" in m]
 
 
+def _lerobot_warns_on_bool_stats() -> bool:
+    """Whether this LeRobot's ``compute_episode_stats`` warns on a bool column (0.4 does; 0.6 casts to
+    float32 first and does not)."""
+    from lerobot.datasets.compute_stats import compute_episode_stats
+
+    data = {"flag": np.array([[True], [False], [True]])}
+    features = {"flag": {"dtype": "bool", "shape": (1,), "names": None}}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        compute_episode_stats(data, features)
+    return any(re.search(BOOL_WARNING, str(item.message)) for item in caught)
+
+
 def test_the_bool_histogram_warning_is_ignored_only_from_lerobots_stats():
     from lerobot.datasets.compute_stats import compute_episode_stats
 
+    warns = _lerobot_warns_on_bool_stats()
     data = {"flag": np.array([[True], [False], [True]])}
     features = {"flag": {"dtype": "bool", "shape": (1,), "names": None}}
     with warnings.catch_warnings(record=True) as caught:
@@ -122,7 +164,7 @@ def test_the_bool_histogram_warning_is_ignored_only_from_lerobots_stats():
             np.histogram(np.array([True, False]), bins=np.linspace(0, 1, 3))  # not from LeRobot
         assert len(caught) == 1 and re.search(BOOL_WARNING, str(caught[0].message))
         compute_episode_stats(data, features)
-    assert len(caught) == 2, "the same call warns again after the block"
+    assert len(caught) == 1 + int(warns), "the same call warns again after the block (where LeRobot warns)"
 
 
 def test_datasets_progress_bars_are_off_inside_and_restored(capfd):
@@ -535,7 +577,8 @@ def test_unsaved_frames_counts_lerobots_buffer_after_an_episode_is_saved(tmp_pat
 
 def test_fast_episode_stats_equal_lerobots_bit_for_bit():
     from lerobot.datasets.compute_stats import compute_episode_stats
-    from lerobot.datasets.utils import DEFAULT_FEATURES
+
+    from lerobot_mtdagger.utils.lerobot_compat import DEFAULT_FEATURES
 
     rng = np.random.default_rng(4)
     features = {

@@ -20,6 +20,7 @@ def test_the_readme_snippets_run(tmp_path):
         [sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=600
     )
     assert result.returncode == 0, result.stderr[-3000:]
+    assert "torchcodec" not in result.stderr, "no decoder probe warning (LeRobot 0.6 without FFmpeg)"
     assert "round 2:" in result.stdout
     assert (tmp_path / "outputs" / "toy-need" / "policies" / "round-002").is_dir()
 

@@ -92,6 +92,10 @@ class ExperimentLockedError(UserError):
 
 DATASET_FPS = 80
 
+VIDEO_BACKEND = "pyav"
+"""The decoder named when a round is created: rounds hold no video, and naming one keeps LeRobot >= 0.5
+from probing torchcodec, which logs a multi-line warning per dataset where FFmpeg's libraries are absent."""
+
 
 def writer_lock_holder(root: Path) -> str | None:
     """Who holds ``root``'s writer lock (``ExperimentDir.writer_lock``): its pid, or None if nobody does.
@@ -481,6 +485,9 @@ class ExperimentDir:
                 features=features,
                 root=staging,
                 use_videos=False,
+                # Rounds store images, never videos: name the decoder so that LeRobot does not probe
+                # torchcodec (a multi-line warning per dataset on a machine without FFmpeg's libraries).
+                video_backend=VIDEO_BACKEND,
             )
         dataset.meta.save_episode_tasks(list(task_names))
         return dataset

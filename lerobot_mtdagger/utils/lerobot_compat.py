@@ -1,7 +1,8 @@
 """Every LeRobot name that moved between 0.4.4 and 0.6.1, and every private attribute we read: one place.
 
-The package runs on LeRobot 0.4.x (Python 3.11, tested here) and is written for 0.6.x (Python >= 3.12,
-checked by reading its sources with ``scripts/check_lerobot_names.py``, not run). Moved in 0.5/0.6:
+The package runs on LeRobot 0.4.x (Python < 3.12) and 0.6.x (Python >= 3.12); the test suite runs on
+both (``.ci/run``), and ``scripts/check_lerobot_names.py`` checks the names against a LeRobot source tree.
+Moved in 0.5/0.6:
 
 - ``dataset_to_policy_features``: ``lerobot.datasets.utils`` -> ``lerobot.utils.feature_utils``;
 - ``validate_frame``: ``lerobot.datasets.utils`` -> ``lerobot.datasets.feature_utils``;
@@ -14,7 +15,10 @@ checked by reading its sources with ``scripts/check_lerobot_names.py``, not run)
   method of that name only forwards there, and the writer's ``save_episode`` calls its own).
 
 Everything else the package imports from LeRobot has one spelling in both lines (the script checks
-that too).
+that too). Behaviour that differs without a name moving is handled where it is used: LeRobot 0.6 logs
+through named loggers (``utils/quiet.py``), reads ``meta/info.json`` into a typed ``DatasetInfo`` that
+drops unknown keys (the round record is read from ``meta/mtdagger.json``), and probes torchcodec unless
+a dataset is created with a ``video_backend`` (``datasets/rounds.py``).
 """
 
 from __future__ import annotations

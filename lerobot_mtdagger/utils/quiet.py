@@ -1,8 +1,9 @@
 """Silencing the third-party console noise of LeRobot calls, narrowly and only around our calls.
 
-What LeRobot 0.4.4 (and the libraries under it) print while an experiment writes and reads its rounds,
-and how each is handled here (all of it only while :func:`quiet_third_party` is active, and restored on
-exit; the user's logging configuration, progress-bar setting and warning filters are left as they were):
+What LeRobot (0.4.4 and 0.6.1) and the libraries under it print while an experiment writes and reads
+its rounds, and how each is handled here (all of it only while :func:`quiet_third_party` is active, and
+restored on exit; the user's logging configuration, progress-bar setting and warning filters are left as
+they were):
 
 - ``Map: 100%|...`` progress bars of the ``datasets`` library, one per episode: ``save_episode`` runs
   ``datasets.Dataset.map`` (``lerobot.datasets.utils.embed_images``). Turned off with
@@ -10,21 +11,22 @@ exit; the user's logging configuration, progress-bar setting and warning filters
   ``SuppressProgressBars`` re-enables them unconditionally after every dataset load, which is why a
   global ``disable_progress_bars()`` at start-up stops working after the first load.)
   ``ExperimentDir.write_round`` does not call ``map`` at all for vector features.
-- ``INFO root: Using video codec: libsvtav1``: ``lerobot.datasets.video_utils.resolve_vcodec`` logs it
-  through the ROOT logger (``logging.info``) from every ``LeRobotDataset.create`` and every
-  ``LeRobotDataset(...)`` load, with or without videos. A :class:`logging.Filter` is attached to the
-  root logger itself (not to its handlers): a logger's filters only see records created on that
-  logger, so records of named loggers propagating to the root's handlers are not affected. It drops
-  only root-logger records from the module ``video_utils`` whose message starts with that text.
-  ``lerobot.datasets.aggregate`` (``merge_rounds``) logs its six step messages the same way; they are
-  dropped the same way (its two ``tqdm`` bars, one per phase, are left).
+- ``Using video codec: libsvtav1``: LeRobot logs it from every ``LeRobotDataset.create`` and every
+  ``LeRobotDataset(...)`` load, with or without videos; ``lerobot.datasets.aggregate`` (``merge_rounds``)
+  logs its six step messages alike. LeRobot 0.4 logs them through the ROOT logger (``logging.info``,
+  from the modules ``video_utils`` and ``aggregate``); LeRobot 0.6 through named loggers
+  (``lerobot.configs.video``, ``lerobot.datasets.aggregate``). A :class:`logging.Filter` is attached to
+  the root logger and to each of those named loggers (not to handlers): a logger's filters only see
+  records created on that logger, so nothing else propagating to the same handlers is affected. It
+  drops only records whose message starts with one of the known texts (its two ``tqdm`` bars, one per
+  phase, are left).
 - ``INFO OpenGL.acceleratesupport: No OpenGL_accelerate module loaded``: logged once when PyOpenGL is
   first imported (by MetaWorld's renderer, when the suite is created). That logger's level is raised
   to WARNING while active.
 - ``RuntimeWarning: Converting input from bool to <class 'numpy.uint8'>``: ``np.histogram`` in
-  ``lerobot.datasets.compute_stats`` warns on a bool feature (our ``learner_acted`` flag). Ignored by
-  message, category and module (filters other code adds inside the block are kept on exit).
-  (``ExperimentDir.write_round``
+  LeRobot 0.4's ``lerobot.datasets.compute_stats`` warns on a bool feature (our ``learner_acted``
+  flag); LeRobot 0.6 casts to float32 first and never warns. Ignored by message, category and module
+  (filters other code adds inside the block are kept on exit). (``ExperimentDir.write_round``
   computes the same statistics without calling ``np.histogram`` on bools, so it never warns.)
 - ``Loading weights from local directory``: ``PreTrainedPolicy.from_pretrained`` prints it to
   stdout. While active, ``sys.stdout`` is wrapped by a proxy that drops exactly that line and passes
@@ -48,21 +50,27 @@ from typing import Any, TextIO
 
 logger = logging.getLogger(__name__)
 
-ROOT_MESSAGES: dict[str, tuple[str, ...]] = {
-    "video_utils": ("Using video codec: ",),
-    "aggregate": (
-        "Start aggregate_datasets",
-        "Find all tasks",
-        "write tasks",
-        "write info",
-        "write stats",
-        "Aggregation complete.",
-    ),
-}
-"""Root-logger messages dropped while quiet: LeRobot module (``LogRecord.module``) -> message starts.
+AGGREGATE_MESSAGES = (
+    "Start aggregate_datasets",
+    "Find all tasks",
+    "write tasks",
+    "write info",
+    "write stats",
+    "Aggregation complete.",
+)
+"""The step messages of ``lerobot.datasets.aggregate.aggregate_datasets`` (``merge_rounds``)."""
 
-``lerobot.datasets.video_utils`` logs the codec on every dataset creation and load;
-``lerobot.datasets.aggregate`` logs its steps on every ``aggregate_datasets`` (``merge_rounds``)."""
+CODEC_MESSAGES = ("Using video codec: ",)
+"""What LeRobot logs on every dataset creation and load."""
+
+ROOT_MESSAGES: dict[str, tuple[str, ...]] = {"video_utils": CODEC_MESSAGES, "aggregate": AGGREGATE_MESSAGES}
+"""LeRobot 0.4's root-logger messages dropped while quiet: module (``LogRecord.module``) -> message starts."""
+
+NAMED_MESSAGES: dict[str, tuple[str, ...]] = {
+    "lerobot.configs.video": CODEC_MESSAGES,
+    "lerobot.datasets.aggregate": AGGREGATE_MESSAGES,
+}
+"""LeRobot 0.6's named-logger messages dropped while quiet: logger name -> message starts."""
 
 QUIETED_LOGGERS: dict[str, int] = {"OpenGL.acceleratesupport": logging.WARNING}
 """Named third-party loggers and the level they get while quiet."""
@@ -178,18 +186,42 @@ def datasets_progress_bars_disabled() -> Iterator[None]:
                 hf_tqdm.enable_progress_bars()
 
 
+class PrefixFilter(logging.Filter):
+    """Drops every record whose message starts with one of given prefixes (for one named logger)."""
+
+    def __init__(self, prefixes: Iterable[str]) -> None:
+        """Matches a record whose message starts with one of ``prefixes``."""
+        super().__init__()
+        self.prefixes = tuple(prefixes)
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        """False (drop) for a matching record, True otherwise."""
+        return not record.getMessage().startswith(self.prefixes)
+
+
 @contextlib.contextmanager
 def root_messages_filtered(
     messages: Mapping[str, Iterable[str]] = ROOT_MESSAGES,
+    named: Mapping[str, Iterable[str]] = NAMED_MESSAGES,
 ) -> Iterator[RootMessageFilter]:
-    """Drops matching root-logger records while active (see :class:`RootMessageFilter`)."""
+    """Drops matching LeRobot records while active, on the root logger and on the named loggers.
+
+    Args:
+        messages: Root-logger messages by module (LeRobot 0.4, see :class:`RootMessageFilter`).
+        named: Messages by logger name (LeRobot 0.6, see :class:`PrefixFilter`).
+    """
     root = logging.getLogger()
     message_filter = RootMessageFilter(messages)
     root.addFilter(message_filter)
+    added = [(logging.getLogger(name), PrefixFilter(prefixes)) for name, prefixes in named.items()]
+    for named_logger, prefix_filter in added:
+        named_logger.addFilter(prefix_filter)
     try:
         yield message_filter
     finally:
         root.removeFilter(message_filter)
+        for named_logger, prefix_filter in added:
+            named_logger.removeFilter(prefix_filter)
 
 
 @contextlib.contextmanager

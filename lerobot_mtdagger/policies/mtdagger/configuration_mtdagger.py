@@ -85,6 +85,10 @@ class MTDAggerConfig(PreTrainedConfig):
             "ACTION": NormalizationMode.MEAN_STD,
         }
     )
+    if "pretrained_revision" not in PreTrainedConfig.__dataclass_fields__:
+        # LeRobot >= 0.5 writes this base field into every policy config; declared here on LeRobot 0.4
+        # (which lacks it and refuses unknown fields), so a policy saved on either line loads on both
+        pretrained_revision: str | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
