@@ -60,6 +60,18 @@ def read_parquet(path: Path, columns: list[str] | None = None) -> pa.Table:
         raise CorruptExperimentError(f"{path} cannot be read ({error}).") from None
 
 
+def expert_mismatches(run_config: dict, record: RoundRecord) -> list[str]:
+    """Whether a round was collected with the run's experts (``--expert.*``, the same in every round).
+
+    A run started before the expert options existed stores none in ``config.json``; rounds it commits
+    since record them at their default, which is noise off (perfect experts, as the run began).
+    """
+    stored, recorded = run_config.get("expert"), record.config.get("expert")
+    if stored == recorded or (stored is None and recorded is not None and recorded.get("noise", 0) == 0):
+        return []
+    return [f"collected with experts {recorded}, but the run's config.json says {stored}"]
+
+
 def verify_round(
     experiment: ExperimentDir, record: RoundRecord, previous: RoundRecord | None, committed_phases: set[int]
 ) -> list[str]:
@@ -76,6 +88,7 @@ def verify_round(
     """
     name = round_name(record.round)
     problems = experiment.round_file_problems(record)
+    problems += expert_mismatches(experiment.read_config(), record)
     if record.files is None:
         problems.append("no checksums recorded (committed by an older version): files not checked")
     try:

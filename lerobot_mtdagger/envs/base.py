@@ -145,6 +145,8 @@ class TaskSuite(abc.ABC):
         self.task_names = task_names
         self.observation = observation
         self.expert_overrides: dict[str, Any] = {}
+        # How far the experts are from perfect (``experts.noise.ExpertNoise``; None: as they are)
+        self.expert_noise: Any = None
         # Unseen tasks the suite builds envs and experts for (evaluation only; no task index).
         self.heldout_task_names: list[str] = []
 
@@ -229,6 +231,16 @@ class TaskSuite(abc.ABC):
     @abc.abstractmethod
     def action_dim(self) -> int:
         """Size of the action vector."""
+
+    def with_expert_noise(self, noise: Any) -> TaskSuite:
+        """A copy of the suite whose experts act with ``noise`` (``experts.noise.ExpertNoise``).
+
+        The rollout workers add it to every expert action they execute (``runner/workers.py``); None,
+        or a noise of scale 0, leaves the experts as they are.
+        """
+        clone = self.with_observation()
+        clone.expert_noise = noise if noise is not None and noise.active else None
+        return clone
 
     def with_observation(self, **changes: Any) -> TaskSuite:
         """A copy of the suite with some observation settings changed."""

@@ -3,6 +3,7 @@
 ``make_expert(suite, task_name)`` gives the expert of a task (see ``registry``). The scripted experts
 of the built-in suites are registered by entry point and imported on first use: MetaWorld's policies
 (``metaworld``), the drawer controller (``drawers``) and the toy suite's optimal controller (``toy``).
+``ExpertNoise`` (``noise``) makes any expert imperfect, the way a stochastic RL policy acts.
 Experts depend on the suites (they read the privileged state layout); suites never import experts.
 """
 
@@ -14,14 +15,17 @@ from lerobot_mtdagger.experts.base import (
     LeRobotPolicyExpert,
     run_expert_episode,
 )
+from lerobot_mtdagger.experts.noise import ActionNoise, ExpertNoise
 from lerobot_mtdagger.experts.registry import ANY_TASK, make_expert, register_expert
 
 __all__ = [
     "ANY_TASK",
     "ActionCheckedExpert",
+    "ActionNoise",
     "CallableExpert",
     "Expert",
     "ExpertEpisode",
+    "ExpertNoise",
     "LeRobotPolicyExpert",
     "make_expert",
     "register_expert",

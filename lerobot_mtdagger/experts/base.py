@@ -148,7 +148,9 @@ class ExpertEpisode:
     steps: int
 
 
-def run_expert_episode(env: Any, expert: Expert, seed: int, stop_on_success: bool = True) -> ExpertEpisode:
+def run_expert_episode(
+    env: Any, expert: Expert, seed: int, stop_on_success: bool = True, noise: Any = None
+) -> ExpertEpisode:
     """Runs ``expert`` for one seeded episode of ``env`` (the expert always acts).
 
     Args:
@@ -156,6 +158,8 @@ def run_expert_episode(env: Any, expert: Expert, seed: int, stop_on_success: boo
         expert: The task's expert.
         seed: Reset seed.
         stop_on_success: End at the first success (MetaWorld's success does not persist).
+        noise: The episode's ``ActionNoise`` (``ExpertNoise.episode_process``), added to every action;
+            None: the expert as it is.
 
     Returns:
         The episode's outcome; ``steps`` is the episode length.
@@ -164,7 +168,10 @@ def run_expert_episode(env: Any, expert: Expert, seed: int, stop_on_success: boo
     expert.reset()
     success, steps = False, 0
     while True:
-        _, _, terminated, truncated, info = env.step(expert.act(info["privileged_state"]))
+        action = expert.act(info["privileged_state"])
+        if noise is not None:
+            action, _ = noise.perturb(action)
+        _, _, terminated, truncated, info = env.step(action)
         steps += 1
         success = success or bool(info["success"])
         if terminated or truncated or (success and stop_on_success):

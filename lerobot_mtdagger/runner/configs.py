@@ -42,6 +42,7 @@ from typing import Any
 from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
 from lerobot_mtdagger.envs.config import DEFAULT_NUM_POINTS, SuiteConfig
 from lerobot_mtdagger.envs.drawers.variants import LEGACY_PLACEMENT
+from lerobot_mtdagger.experts.noise import ExpertNoise
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
 from lerobot_mtdagger.utils.parsing import cache_dataclass_sources
 from lerobot_mtdagger.utils.ray_session import import_ray
@@ -425,6 +426,39 @@ class RolloutConfig:
 
 
 @dataclass
+class ExpertConfig:
+    """How far the experts are from perfect (``--expert.*``; ``experts/noise.py`` gives the formula).
+
+    Off by default: the experts act as they are. With ``noise > 0`` every action an expert executes
+    gets temporally correlated Gaussian noise, the way a stochastic RL policy acts (the paper's SAC
+    and PPO experts succeed on 80-95% of episodes; MetaWorld's scripted ones on about 98%).
+
+    Attributes:
+        noise: Standard deviation of the noise on each action component, in action units (actions
+            lie in [-1, 1]); 0: no noise.
+        noise_correlation: Step-to-step correlation of the noise, in [0, 1) (0: white noise).
+        noise_seed: Seed of the noise, apart from ``--seed``.
+        labels: What a frame stores as the expert's label: ``noisy`` (the executed action: the
+            expert is a stochastic policy) or ``clean`` (the expert's own action: DART-style).
+    """
+
+    noise: float = 0.0
+    noise_correlation: float = 0.0
+    noise_seed: int = 0
+    labels: str = "noisy"
+
+    def check(self) -> None:
+        """Refuses impossible values (one line naming the option)."""
+        self.settings()
+
+    def settings(self) -> ExpertNoise:
+        """The ``ExpertNoise`` these options describe."""
+        return ExpertNoise(
+            scale=self.noise, correlation=self.noise_correlation, seed=self.noise_seed, labels=self.labels
+        )
+
+
+@dataclass
 class TrainingConfig:
     """How each phase trains the student (``--training.*``; the optimiser is the policy's).
 
@@ -496,7 +530,7 @@ class TrainingConfig:
 class RunConfig:
     """Options of ``lerobot-mtdagger run`` (one Multitask DAgger experiment, or the BC baseline).
 
-    Twelve top-level options; the rest sit in their group (``--suite.obs_mode``, ``--dagger.rounds``,
+    Thirteen top-level options; the rest sit in their group (``--suite.obs_mode``, ``--dagger.rounds``,
     ``--rollout.eval_episodes``, ``--training.steps_rule``, ``--policy.lr``, ``--scheduler.n_min``).
     A flat config stored before the groups existed is migrated on reading
     (``datasets/config_layout.py``), and the old spellings are refused with the new one named.
@@ -514,6 +548,8 @@ class RunConfig:
         training: Steps per phase, sampling, held-out split (``TrainingConfig``).
         scheduler: ``--scheduler.type=uniform|need|need_raw|gain`` and its hyperparameters
             (``scheduler.n_min`` from the preset when unset).
+        expert: The experts' quality: noise on their actions, and which action is the label
+            (``ExpertConfig``; off by default).
         policy: The student and its options: ``--policy.type=mtdagger`` (default; ``PolicyOptions``)
             or a LeRobot policy (``act``, ``diffusion``) with LeRobot's own options plus
             ``batch_size`` (``StudentOptions``). ``policy.batch_size`` (and for ``mtdagger``
@@ -534,6 +570,7 @@ class RunConfig:
     training: TrainingConfig = field(default_factory=TrainingConfig)
     scheduler: SchedulerConfig = field(default_factory=NeedSchedulerConfig)
     policy: StudentOptions = field(default_factory=PolicyOptions)
+    expert: ExpertConfig = field(default_factory=ExpertConfig)
     output_dir: Path | None = None
     seed: int = 0
     resume: bool = False
@@ -570,6 +607,7 @@ class RunConfig:
         self.dagger.check()
         self.rollout.check()
         self.training.check()
+        self.expert.check()
         lr_name = "lr" if isinstance(self.policy, PolicyOptions) else "optimizer_lr"
         lr = getattr(self.policy, lr_name)
         if self.policy.batch_size <= 0 or not (math.isfinite(lr) and lr > 0):
@@ -659,6 +697,7 @@ class RunConfig:
             ("rollout", RolloutConfig),
             ("training", TrainingConfig),
             ("policy", PolicyOptions),
+            ("expert", ExpertConfig),
         ):
             for option in dataclasses.fields(options):
                 if option.default is not dataclasses.MISSING:

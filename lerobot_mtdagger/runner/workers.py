@@ -39,6 +39,7 @@ import numpy as np
 from lerobot_mtdagger.datasets.records import StepOutcome, dagger_columns
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.experts import make_expert
+from lerobot_mtdagger.experts.noise import ActionNoise
 from lerobot_mtdagger.runner.mixing import (
     RolloutRules,
     episode_ends,
@@ -148,6 +149,7 @@ class _Running:
     steps_since_success: int = -1
     expert_episode: bool = False
     max_steps: int | None = None
+    noise: ActionNoise | None = None
 
 
 class RolloutWorker:
@@ -233,6 +235,10 @@ class RolloutWorker:
             max_steps = self._expert_step_limit(env, expert, spec.reset_seed)
         observation, info = env.reset(seed=spec.reset_seed)
         rng = np.random.default_rng(np.random.SeedSequence(list(spec.beta_seed)))
+        noise = None
+        if expert is not None and self.suite.expert_noise is not None:
+            key = (self.rules.round_index, spec.task_index, spec.episode)
+            noise = self.suite.expert_noise.episode_process(key, env.action_space.low, env.action_space.high)
         return _Running(
             spec=spec,
             env=env,
@@ -243,6 +249,7 @@ class RolloutWorker:
             privileged=info["privileged_state"],
             expert_episode=expert_episode,
             max_steps=max_steps,
+            noise=noise,
         )
 
     def _expert_step_limit(self, env: Any, expert: Any, reset_seed: int) -> int | None:
@@ -282,7 +289,7 @@ class RolloutWorker:
         """Steps one episode; returns whether it ended."""
         rules = self.rules
         episode = running.episode
-        expert_action = running.expert.act(running.privileged) if running.expert is not None else None
+        expert_action, label = _expert_action(running)
         expert_acts = expert_acts_now(rules, learner_action is not None, running.expert_episode, running.rng)
         executed = expert_action if expert_acts else learner_action
         observation = running.observation
@@ -302,8 +309,23 @@ class RolloutWorker:
         if rules.record:
             outcome = StepOutcome(reward=float(reward), success=bool(info["success"]), done=ended)
             columns = dagger_columns(executed, not expert_acts, rules.round_index, outcome)
-            episode.frames.append({**observation, "action": expert_action, **columns})
+            episode.frames.append({**observation, "action": label, **columns})
         return ended
+
+
+def _expert_action(running: _Running) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """What the expert would execute at this step, and its label (both None without an expert).
+
+    A perfect expert executes and labels its own action; an imperfect one (``suite.expert_noise``)
+    executes its action plus this episode's noise, and labels the noisy or its own action
+    (``ExpertNoise.labels``). The noise advances at every step the expert is queried, whoever acts.
+    """
+    if running.expert is None:
+        return None, None
+    action = running.expert.act(running.privileged)
+    if running.noise is None:
+        return action, action
+    return running.noise.perturb(action)
 
 
 def _expert_steps_to_success(env: Any, expert: Any, reset_seed: int) -> int | None:

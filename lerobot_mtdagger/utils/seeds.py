@@ -11,6 +11,8 @@ Streams (number; the keys after it; what it decides):
 - ``EVAL_STREAM`` (1; round, task, episode): the env reset of an evaluation episode (offset by 2**31).
 - ``BETA_STREAM`` (2; round, task, episode): who acts in an episode of a mixed DAgger round.
 - ``TRAINING_STREAM`` (3; round): a phase's initial weights and batch order.
+- ``NOISE_STREAM`` (4; round, task, episode): an imperfect expert's action noise (``experts/noise.py``),
+  seeded by ``--expert.noise_seed`` in place of the run's seed.
 - ``HELDOUT_STREAM`` (7; task): which episodes a run holds out of training.
 
 The frames each phase measures its per-task loss on are drawn from ``np.random.default_rng(seed)``
@@ -25,6 +27,7 @@ COLLECT_STREAM = 0
 EVAL_STREAM = 1
 BETA_STREAM = 2
 TRAINING_STREAM = 3
+NOISE_STREAM = 4
 HELDOUT_STREAM = 7
 
 

@@ -1,0 +1,189 @@
+"""Imperfect experts (``experts/noise.py``, ``--expert.*``): the noise process, and a run's frames."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.experts import ExpertNoise, make_expert, run_expert_episode
+
+LOW, HIGH = -np.ones(4, dtype=np.float32), np.ones(4, dtype=np.float32)
+TOY = ["--suite.name=toy", "--dagger.rounds=1", "--dagger.initial_demos=2", "--dagger.budget_per_task=2"]
+TOY += ["--rollout.eval_episodes=2", "--training.steps_per_round=5", "--policy.batch_size=16"]
+TOY += ["--rollout.workers=0", "--progress=false"]
+
+# sha256 of round 0's frames (observation.state, action, executed_action, learner_acted, in file order)
+# of a run with TOY, made at the commit before expert noise existed, on both LeRobot lines (round 0 is
+# the expert's alone, so torch plays no part): a run with the noise off must still write exactly these.
+ROUND0_FRAMES_BEFORE_NOISE = "ea48d4e6f8db13f78d955d54bb80e2282633647d3f919d6472159af5590de2ac"
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"scale": -0.1}, r"expert.noise must be a finite number >= 0, got -0.1"),
+        ({"scale": float("nan")}, r"expert.noise must be a finite number >= 0"),
+        ({"correlation": 1.0}, r"expert.noise_correlation must be in \[0, 1\), got 1.0"),
+        ({"correlation": -0.5}, r"expert.noise_correlation must be in \[0, 1\)"),
+        ({"seed": -1}, r"expert.noise_seed must be >= 0"),
+        ({"labels": "mean"}, r"expert.labels must be one of \['noisy', 'clean'\], got 'mean'"),
+    ],
+)
+def test_expert_noise_refuses_impossible_values(options, message):
+    with pytest.raises(ValueError, match=message):
+        ExpertNoise(**options)
+
+
+def test_no_noise_draws_nothing():
+    assert ExpertNoise().episode_process((0, 0, 0), LOW, HIGH) is None
+    assert (
+        ExpertNoise(scale=0.0, correlation=0.9, labels="clean").episode_process((0, 0, 0), LOW, HIGH) is None
+    )
+
+
+@pytest.mark.parametrize("correlation", [0.0, 0.5, 0.9])
+def test_the_noise_has_the_given_scale_and_step_correlation(correlation):
+    process = ExpertNoise(scale=0.2, correlation=correlation, seed=3).episode_process((1, 2, 3), LOW, HIGH)
+    noise = np.stack([process.sample(4).copy() for _ in range(20_000)])  # (T, 4)
+    assert noise.std() == pytest.approx(0.2, rel=0.05)  # stationary from the first step
+    lag1 = np.mean([np.corrcoef(noise[:-1, i], noise[1:, i])[0, 1] for i in range(4)])
+    assert lag1 == pytest.approx(correlation, abs=0.03)
+
+
+def test_each_episode_has_its_own_reproducible_noise():
+    noise = ExpertNoise(scale=0.3, correlation=0.5, seed=1)
+
+    def draws(key, seed_noise=noise):
+        process = seed_noise.episode_process(key, LOW, HIGH)
+        return np.stack([process.sample(4).copy() for _ in range(5)])
+
+    np.testing.assert_array_equal(draws((1, 0, 0)), draws((1, 0, 0)))
+    assert not np.allclose(draws((1, 0, 0)), draws((1, 0, 1)))  # another episode
+    assert not np.allclose(draws((1, 0, 0)), draws((2, 0, 0)))  # another round
+    other_seed = ExpertNoise(scale=0.3, correlation=0.5, seed=2)
+    assert not np.allclose(draws((1, 0, 0)), draws((1, 0, 0), other_seed))
+
+
+@pytest.mark.parametrize("labels", ["noisy", "clean"])
+def test_perturb_clips_to_the_bounds_and_labels_as_asked(labels):
+    process = ExpertNoise(scale=5.0, seed=0, labels=labels).episode_process((0, 0, 0), LOW, HIGH)
+    action = np.array([0.9, -0.9, 0.0, 1.5], dtype=np.float32)
+    executed, label = process.perturb(action)
+    assert executed.dtype == np.float32 and np.all(np.abs(executed) <= 1.0)
+    assert not np.allclose(executed, np.clip(action, -1, 1))
+    expected = executed if labels == "noisy" else np.array([0.9, -0.9, 0.0, 1.0], dtype=np.float32)
+    np.testing.assert_array_equal(label, expected)
+
+
+def test_noise_lowers_a_perfect_experts_success():
+    suite = make_suite("toy")
+    env, expert = suite.make_env("toy-up-windy"), make_expert(suite, "toy-up-windy")
+    episodes = range(30)
+    clean = [run_expert_episode(env, expert, seed).success for seed in episodes]
+    noise = ExpertNoise(scale=1.5, correlation=0.9, seed=0)
+    noisy = [
+        run_expert_episode(
+            env, expert, seed, noise=noise.episode_process((0, 0, seed), LOW[:2], HIGH[:2])
+        ).success
+        for seed in episodes
+    ]
+    assert np.mean(clean) == 1.0 and np.mean(noisy) < 0.9
+
+
+def _frames(run_dir, rounds: str = "round-*") -> dict[str, np.ndarray]:
+    """The DAgger columns of the ``rounds`` (a glob), in file order."""
+    tables = [pq.read_table(path) for path in sorted(run_dir.glob(f"rounds/{rounds}/data/*/*.parquet"))]
+    table = pa.concat_tables(tables)
+    names = ["observation.state", "action", "executed_action", "learner_acted"]
+    return {name: np.array(table.column(name).to_pylist(), dtype=np.float64) for name in names}
+
+
+def _digest(frames: dict[str, np.ndarray]) -> str:
+    hasher = hashlib.sha256()
+    for name in sorted(frames):
+        hasher.update(name.encode() + np.ascontiguousarray(frames[name]).tobytes())
+    return hasher.hexdigest()
+
+
+def _run(tmp_path, name: str, *options: str):
+    out = tmp_path / name
+    assert main(["run", *TOY, *options, f"--output_dir={out}"]) == 0
+    return out
+
+
+def test_a_run_with_the_noise_off_is_the_run_without_it(tmp_path):
+    plain = _run(tmp_path, "plain")
+    off = _run(tmp_path, "off", "--expert.noise=0", "--expert.noise_seed=9", "--expert.labels=clean")
+    assert _digest(_frames(plain)) == _digest(_frames(off))
+    assert _digest(_frames(off, "round-000")) == ROUND0_FRAMES_BEFORE_NOISE
+    for round_dir in ("round-000", "round-001"):
+        weights = [(run / "policies" / round_dir / "model.safetensors").read_bytes() for run in (plain, off)]
+        assert weights[0] == weights[1]
+
+
+@pytest.mark.parametrize("labels", ["noisy", "clean"])
+def test_a_noisy_run_records_its_noise_and_labels_as_asked(tmp_path, labels):
+    noisy = ["--expert.noise=0.5", "--expert.noise_correlation=0.8", "--expert.noise_seed=4"]
+    out = _run(tmp_path, labels, *noisy, f"--expert.labels={labels}")
+    config = json.loads((out / "config.json").read_text())
+    expected = {"noise": 0.5, "noise_correlation": 0.8, "noise_seed": 4, "labels": labels}
+    assert config["expert"] == expected
+    record = json.loads((out / "rounds" / "round-001" / "meta" / "mtdagger.json").read_text())
+    assert record["config"]["expert"] == expected
+    frames = _frames(out)
+    expert_acted = frames["learner_acted"].reshape(-1) == 0
+    same = np.all(frames["action"] == frames["executed_action"], axis=1)
+    if labels == "noisy":  # the label is what the expert executed
+        assert np.all(same[expert_acted])
+    else:  # the label is the expert's own action; it executed that plus the noise
+        # (equal only where the noise pushed an action already at its bound past it: clipped back)
+        on_bounds = np.all(np.abs(frames["action"]) == 1.0, axis=1)
+        assert np.all(on_bounds[expert_acted & same]) and np.mean(same[expert_acted]) < 0.25
+    plain = _frames(_run(tmp_path, "plain"))
+    assert not np.array_equal(plain["observation.state"], frames["observation.state"])
+
+
+def test_a_noisy_run_resumes_only_with_its_noise(tmp_path, capsys):
+    out = _run(tmp_path, "run", "--expert.noise=0.3")
+    assert main(["run", *TOY, "--expert.noise=0.4", f"--output_dir={out}", "--resume=true"]) == 2
+    assert "expert.noise: 0.3 -> 0.4" in capsys.readouterr().err
+    assert main(["run", *TOY, f"--output_dir={out}", "--resume=true"]) == 2
+    assert main(["run", *TOY, "--expert.noise=0.3", f"--output_dir={out}", "--resume=true"]) == 0
+
+
+def test_bad_expert_options_are_refused_before_anything_is_written(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["run", *TOY, "--expert.noise_correlation=1.2", f"--output_dir={out}"]) == 2
+    assert "expert.noise_correlation must be in [0, 1)" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_verify_refuses_a_round_whose_recorded_experts_differ_from_the_run(tmp_path, capsys):
+    out = _run(tmp_path, "run", "--expert.noise=0.3")
+    assert main(["verify", f"--experiment_dir={out}"]) == 0
+    capsys.readouterr()
+    path = out / "rounds" / "round-001" / "meta" / "mtdagger.json"
+    record = json.loads(path.read_text())
+    record["config"]["expert"]["noise"] = 0.0  # as if round 1 had been collected with perfect experts
+    path.write_text(json.dumps(record))
+    with pytest.raises(SystemExit) as exited:
+        main(["verify", f"--experiment_dir={out}"])
+    assert exited.value.code == 1
+    assert "round-001: collected with experts {'noise': 0.0" in capsys.readouterr().out
+
+
+def test_compare_gives_every_arm_the_same_experts():
+    from lerobot_mtdagger.studies.compare import CompareConfig, jobs_for
+
+    noisy = ["--expert.noise=0.3", "--expert.noise_correlation=0.9", "--expert.labels=clean"]
+    jobs = jobs_for(
+        CompareConfig(methods=["need", "uniform", "bc"], seeds=[3], bc_budgets=[2, 4]), [*TOY, *noisy], 3
+    )
+    assert len(jobs) == 4 and all(set(noisy) <= set(job.args) for job in jobs)
