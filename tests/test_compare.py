@@ -741,16 +741,6 @@ def test_a_saved_table_without_phase_timings_is_refused_naming_the_column(tmp_pa
     assert "lack the column(s) ['train_s']" in capsys.readouterr().err
 
 
-def test_a_paired_line_gives_each_seed_s_difference_and_skips_seeds_missing_a_side():
-    """The line the study scripts print: differences 0.3, 0.2, 0.1 -> +0.200 [-0.048, +0.448]."""
-    from lerobot_mtdagger.studies.figures import paired_line
-
-    nan = float("nan")
-    pairs = [(0.9, 0.6), (0.8, 0.6), (nan, 0.5), (0.7, 0.6)]
-    assert paired_line("need - bc", pairs) == "need - bc: +0.300 / +0.200 / +0.100; +0.200 [-0.048, +0.448]"
-    assert paired_line("need - bc", [(0.9, 0.6), (0.8, nan)]) == "need - bc: fewer than 2 seeds have both"
-
-
 @pytest.mark.parametrize(
     ("cores", "jobs", "environ", "run_args", "expected"),
     [

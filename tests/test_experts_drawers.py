@@ -3,7 +3,7 @@
 DAgger asks the expert about the learner's states, and a point-cloud learner localises the handle to
 about a centimetre. An expert whose command flips from "descend" to "rise at full speed" on a few
 millimetres of misalignment gives labels the learner cannot tell apart (measured: they made visual
-DAgger rounds worse, ``docs/results/visual-collapse-dev/README.md``). No MuJoCo here: states are built.
+DAgger rounds worse, ``experiments/visual-collapse-dev/README.md``). No MuJoCo here: states are built.
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ open/close decision. DAgger needs that: a point-cloud learner localises the hand
 centimetre, and an earlier version of this controller, which retreated to the safe height whenever
 the open hand was low and more than 8 mm off, gave its learner states labels that flipped from
 "descend" to "rise at full speed" within that centimetre (54% of the states its BC student visited;
-visual DAgger rounds then lowered success, ``docs/results/visual-collapse-dev/README.md``).
+visual DAgger rounds then lowered success, ``experiments/visual-collapse-dev/README.md``).
 
 An earlier version closed only within 8 mm of the grasp pose and held only within 1.5 cm across the
 axis for every handle, and its funnel rose for sideways misalignment too: its round-1 point-cloud

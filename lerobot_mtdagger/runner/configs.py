@@ -6,7 +6,7 @@ a value given on the command line always wins. The ``*-paper`` presets follow th
 and hyperparameter table (n_min is ``scheduler.n_min``; lr and batch are ``policy.lr`` and
 ``policy.batch_size``; points is ``suite.num_points``) and are sized for a GPU; ``metaworld-pixels``
 and ``drawers-pointcloud`` keep the paper's rounds and scale the demonstrations, steps and batch down
-to a 2-core CPU (the visual-collapse study's reduced run, ``docs/results/visual-collapse-dev``):
+to a 2-core CPU (the visual-collapse study's reduced run, ``experiments/visual-collapse-dev``):
 
 =========================  ==========  ======  =======  ==========  =====  =====  ====  =====  ======
 preset                     obs_mode    rounds  initial  per round   steps  n_min  lr    batch  points
@@ -207,9 +207,9 @@ GAIN_SPLITS: tuple[str, ...] = ("train", "heldout")
 
 PIXELS_SAMPLING = "balanced"
 """``metaworld-pixels``' batch sampling, DAgger and BC, chosen on development seeds 100-102. DAgger
-(200 evaluation episodes per phase, ``docs/results/visual-collapse-dev`` 6c): with uniform sampling
+(200 evaluation episodes per phase, ``experiments/visual-collapse-dev`` 6c): with uniform sampling
 the rounds lowered success (0.680 -> 0.678 -> 0.630), with balanced sampling they raised it (0.627 ->
-0.678 -> 0.685). BC (``docs/results/pixels-bc-dev``, a rule fixed before its runs): uniform BC is
+0.678 -> 0.685). BC (``experiments/pixels-bc-dev``, a rule fixed before its runs): uniform BC is
 ahead at 10 demos per task (0.670 against 0.600) but loses success from 10 to 30 (0.645); balanced
 BC rises (0.762 at 30, 0.795 at 60 against uniform's 0.755) and has the higher mean."""
 
