@@ -11,7 +11,7 @@
 # drawers-training-spread-dev, complete, and pixels-dagger-epochs-dev, paused: see their READMEs.)
 set -uo pipefail
 
-CALIBRATION_COMMIT=${CALIBRATION_COMMIT:?set CALIBRATION_COMMIT to the commit that added paper-regime-calibration-dev}
+CALIBRATION_COMMIT=${CALIBRATION_COMMIT:-83268c0}  # the commit that added paper-regime-calibration-dev
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 

@@ -420,7 +420,7 @@ class ReportConfig:
             the tables alone, e.g. after the run folders are gone, with other ``--levels``, or joining
             seeds run on other machines (each point in one table only; the methods' configs must
             agree). Default ``output_dir`` for one table: its folder.
-        records: Runs' saved records (``experiments/save_run_records.sh``: config, round and training
+        records: Runs' saved records (``scripts/save_run_records.sh``: config, round and training
             records, no frames or weights), each a run's records folder or a folder of them, reported
             beside ``experiments`` and ``compare_dir`` as their runs are: a study whose ``outputs/`` was
             lost keeps its finished runs. Their frames per task are known only on average.
@@ -525,7 +525,7 @@ def _saved_records_runs(folder: Path) -> list[Path]:
     if not runs:
         raise UserError(
             f"--records: {folder} holds no run's records (a config.json in it or in its subfolders): "
-            "give the folder `bash experiments/save_run_records.sh RUNS DEST` wrote (DEST), or one run's "
+            "give the folder `bash scripts/save_run_records.sh RUNS DEST` wrote (DEST), or one run's "
             "folder in it."
         )
     return runs

@@ -361,7 +361,7 @@ def test_report_results_goes_alone(compared, tmp_path, capsys):
     assert "give --output_dir for the joined report" in capsys.readouterr().err
 
 
-SAVE_RUN_RECORDS = Path(__file__).resolve().parents[1] / "docs" / "results" / "save_run_records.sh"
+SAVE_RUN_RECORDS = Path(__file__).resolve().parents[1] / "scripts" / "save_run_records.sh"
 
 
 def _save_records(runs: Path, dest: Path) -> Path:

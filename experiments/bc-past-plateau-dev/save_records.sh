@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Copies every run's records from outputs/bc-past-plateau-dev/<training>/runs/ into
-# records/<training>/<run>/ here (../save_run_records.sh), so the numbers outlive outputs/ (not in
+# records/<training>/<run>/ here (scripts/save_run_records.sh), so the numbers outlive outputs/ (not in
 # git), then writes table.txt (the decision rule of run.sh, applied once every run has finished) from
 # all records. Run from the repository root at any time.
 set -euo pipefail
-HERE=docs/results/bc-past-plateau-dev
+HERE=experiments/bc-past-plateau-dev
 for TRAINING in outputs/bc-past-plateau-dev/*/; do
   [ -d "$TRAINING/runs" ] || continue
-  bash docs/results/save_run_records.sh "$TRAINING/runs" "$HERE/records/$(basename "$TRAINING")"
+  bash scripts/save_run_records.sh "$TRAINING/runs" "$HERE/records/$(basename "$TRAINING")"
 done
 mkdir -p "$HERE/records"
 .venv/bin/python "$HERE/table.py" "$HERE/records" > "$HERE/table.txt"

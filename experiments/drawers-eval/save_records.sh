@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Copies every run's records from outputs/drawers-eval/{dagger,bc}/runs into records/<run>/ here
-# (../save_run_records.sh), so a lost outputs/ costs only unfinished runs. Run from the repository
+# (scripts/save_run_records.sh), so a lost outputs/ costs only unfinished runs. Run from the repository
 # root at any time; commit what it writes.
 set -euo pipefail
 for STAGE in dagger bc; do
   if [ -d "outputs/drawers-eval/$STAGE/runs" ]; then
-    bash docs/results/save_run_records.sh "outputs/drawers-eval/$STAGE/runs" docs/results/drawers-eval/records
+    bash scripts/save_run_records.sh "outputs/drawers-eval/$STAGE/runs" experiments/drawers-eval/records
   fi
 done

@@ -8,7 +8,7 @@ at the smallest by more than ``drop_allowed``, take the one with the highest mea
 if none qualifies, the highest mean, and say so. The rule applies only once every (training, budget,
 seed) run has finished.
 
-The records are the ones ``experiments/save_run_records.sh`` saves:
+The records are the ones ``scripts/save_run_records.sh`` saves:
 ``<folder>/<training>/bc-<budget>demos-seed<seed>/policies/round-000/training.json``.
 """
 

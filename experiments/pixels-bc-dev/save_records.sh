@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Copies every run's records from outputs/pixels-bc-dev/<sampling>/runs/ into
-# records/<sampling>/<run>/ here (../save_run_records.sh), so the numbers outlive outputs/ (not in
+# records/<sampling>/<run>/ here (scripts/save_run_records.sh), so the numbers outlive outputs/ (not in
 # git), then writes table.txt from all records (finished runs only). Run from the repository root.
 set -euo pipefail
-HERE=docs/results/pixels-bc-dev
+HERE=experiments/pixels-bc-dev
 for SAMPLING in outputs/pixels-bc-dev/*/; do
   [ -d "$SAMPLING/runs" ] || continue
-  bash docs/results/save_run_records.sh "$SAMPLING/runs" "$HERE/records/$(basename "$SAMPLING")"
+  bash scripts/save_run_records.sh "$SAMPLING/runs" "$HERE/records/$(basename "$SAMPLING")"
 done
 .venv/bin/python "$HERE/table.py" "$HERE/records" > "$HERE/table.txt"

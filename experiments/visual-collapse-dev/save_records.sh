@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Copies the small JSON records of each run (../save_run_records.sh) from outputs/visual-dev/
+# Copies the small JSON records of each run (scripts/save_run_records.sh) from outputs/visual-dev/
 # into records/<run>/ here, with the run's rounds_summary.py table, so the numbers outlive outputs/ (not
 # in git); rounds_summary.txt joins the tables of every run in records/. Run from the repository root.
 set -euo pipefail
-HERE=docs/results/visual-collapse-dev
-bash docs/results/save_run_records.sh outputs/visual-dev "$HERE/records"
+HERE=experiments/visual-collapse-dev
+bash scripts/save_run_records.sh outputs/visual-dev "$HERE/records"
 for RUN in outputs/visual-dev/*-seed*/; do
   NAME=$(basename "$RUN")
   # This run's table, kept beside its records: the joined file below also keeps the runs whose

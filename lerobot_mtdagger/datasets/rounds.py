@@ -606,13 +606,13 @@ class ExperimentDir:
 
 
 SAVED_INFO_FILE = "info.json"
-"""A round's ``meta/info.json`` where ``experiments/save_run_records.sh`` saves it (``rounds/<round>/``)."""
+"""A round's ``meta/info.json`` where ``scripts/save_run_records.sh`` saves it (``rounds/<round>/``)."""
 
 
 class SavedRunRecords(ExperimentDir):
     """A run's small JSON records, saved apart from its datasets and weights, read as a run is read.
 
-    The layout ``experiments/save_run_records.sh`` writes, so that a study's numbers outlive its run
+    The layout ``scripts/save_run_records.sh`` writes, so that a study's numbers outlive its run
     folders::
 
         <run>/config.json                       the run's options

@@ -19,7 +19,7 @@ SEEDS = (100, 101)
 
 
 def write_record(folder: Path, training: str, budget: int, seed: int, success: float) -> None:
-    """One BC run's record as ``experiments/save_run_records.sh`` saves it."""
+    """One BC run's record as ``scripts/save_run_records.sh`` saves it."""
     phase = folder / training / f"bc-{budget}demos-seed{seed}" / "policies" / "round-000"
     phase.mkdir(parents=True)
     (phase / "training.json").write_text(json.dumps({"eval": {"mean": success, "per_task": [success]}}))

@@ -5,7 +5,7 @@
 # git). Unfinished runs give what they have. A run's records are replaced whole (a run restarted from
 # nothing leaves none of its earlier records behind); runs not under RUNS keep theirs. From the
 # repository root:
-#   bash experiments/save_run_records.sh RUNS DEST
+#   bash scripts/save_run_records.sh RUNS DEST
 set -euo pipefail
 RUNS=$1
 DEST=$2
