@@ -133,7 +133,8 @@ def test_a_noisy_run_records_its_noise_and_labels_as_asked(tmp_path, labels):
     noisy = ["--expert.noise=0.5", "--expert.noise_correlation=0.8", "--expert.noise_seed=4"]
     out = _run(tmp_path, labels, *noisy, f"--expert.labels={labels}")
     config = json.loads((out / "config.json").read_text())
-    expected = {"noise": 0.5, "noise_correlation": 0.8, "noise_seed": 4, "labels": labels}
+    expected = {"noise": 0.5, "noise_correlation": 0.8, "noise_seed": 4, "labels": labels, "path": None}
+    expected["type"] = None
     assert config["expert"] == expected
     record = json.loads((out / "rounds" / "round-001" / "meta" / "mtdagger.json").read_text())
     assert record["config"]["expert"] == expected

@@ -42,6 +42,7 @@ from typing import Any
 from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
 from lerobot_mtdagger.envs.config import DEFAULT_NUM_POINTS, SuiteConfig
 from lerobot_mtdagger.envs.drawers.variants import LEGACY_PLACEMENT
+from lerobot_mtdagger.experts.command_line import command_line_experts
 from lerobot_mtdagger.experts.noise import ExpertNoise
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
 from lerobot_mtdagger.utils.parsing import cache_dataclass_sources
@@ -440,16 +441,39 @@ class ExpertConfig:
         noise_seed: Seed of the noise, apart from ``--seed``.
         labels: What a frame stores as the expert's label: ``noisy`` (the executed action: the
             expert is a stochastic policy) or ``clean`` (the expert's own action: DART-style).
+        path: LeRobot policy folders acting on the privileged state (``observation.state``): one
+            multitask policy folder, or a folder with one policy folder per task named after it
+            (``experts/command_line.py``). None: the registered experts.
+        type: An expert factory ``factory(suite, task) -> Expert``: a name registered with
+            ``register_expert_type``, or an importable ``module:attribute``. None: the registered experts.
     """
 
     noise: float = 0.0
     noise_correlation: float = 0.0
     noise_seed: int = 0
     labels: str = "noisy"
+    path: str | None = None
+    type: str | None = None
 
     def check(self) -> None:
         """Refuses impossible values (one line naming the option)."""
         self.settings()
+        if self.path is not None and self.type is not None:
+            raise ValueError("--expert.path and --expert.type both name the experts: give one of them.")
+        if self.path is not None and not Path(self.path).is_dir():
+            raise ValueError(
+                f"--expert.path={self.path} is not a folder: give a policy folder (one multitask expert) "
+                "or a folder with one policy folder per task."
+            )
+
+    def suite_with_experts(self, suite: Any) -> Any:
+        """``suite`` with these experts: the named ones (``path``, ``type``) and their noise.
+
+        Raises:
+            UserError: On a path or type that gives no valid expert for every task (one line).
+        """
+        named = command_line_experts(suite, self.path, self.type)
+        return named.with_expert_noise(self.settings())
 
     def settings(self) -> ExpertNoise:
         """The ``ExpertNoise`` these options describe."""

@@ -386,7 +386,7 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         WorkerDiedError: If an env worker process dies.
     """
     with quiet_third_party():  # importing MetaWorld's renderer logs an OpenGL INFO line
-        suite = suite_from_config(config.suite).with_expert_noise(config.expert.settings())
+        suite = config.expert.suite_with_experts(suite_from_config(config.suite))
     check_budget(config, len(suite.task_names))
     check_heldout(config, len(suite.task_names))
     experiment = ExperimentDir(config.output_dir)

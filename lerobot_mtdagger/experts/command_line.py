@@ -1,0 +1,161 @@
+"""Experts named on the command line: ``--expert.path`` (LeRobot policy folders) and ``--expert.type``.
+
+The paper's experts are RL policies trained on the privileged state. Such a policy, saved as a
+LeRobot pretrained model folder whose ``observation.state`` input is the suite's privileged state,
+labels a run's frames with::
+
+    lerobot-mtdagger run --expert.path=experts/            # experts/<task>/: one policy per task
+    lerobot-mtdagger run --expert.path=experts/multitask   # one policy for every task (task string in)
+
+A folder holding ``config.json`` is one multitask policy (it is handed each episode's task string, as
+LeRobot hands a policy ``observation["task"]``); otherwise every task of the suite needs a policy
+folder named after it inside. ``--expert.type`` names an expert factory ``factory(suite, task) ->
+Expert``: one registered with :func:`register_expert_type`, or an importable ``module:attribute``.
+Both are checked before anything is written: a folder that is not a policy, a policy whose input
+does not match the suite's privileged state, a task without an expert, an unknown type, each get one
+line naming the fix.
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from lerobot_mtdagger.datasets.checkpoints import check_local_policy, load_policy
+from lerobot_mtdagger.experts.base import Expert, LeRobotPolicyExpert
+from lerobot_mtdagger.utils.errors import UserError
+
+STATE_KEY = "observation.state"
+"""The input a policy expert reads the privileged state from."""
+
+_EXPERT_TYPES: dict[str, Callable[[Any, str], Expert]] = {}
+
+
+def register_expert_type(name: str, factory: Callable[[Any, str], Expert]) -> None:
+    """Registers an expert factory under a name ``--expert.type`` can give.
+
+    Raises:
+        TypeError: If ``factory`` is not callable.
+    """
+    if not callable(factory):
+        raise TypeError(f"The expert type {name!r} needs a callable factory(suite, task), got {factory!r}.")
+    _EXPERT_TYPES[name] = factory
+
+
+def expert_type_factory(name: str) -> Callable[[Any, str], Expert]:
+    """The factory of ``--expert.type``: a registered name, or an importable ``module:attribute``.
+
+    Raises:
+        UserError: If the name is neither registered nor importable, naming both ways to fix it.
+    """
+    if name in _EXPERT_TYPES:
+        return _EXPERT_TYPES[name]
+    module_name, _, attribute = name.partition(":")
+    hint = (
+        f"--expert.type={name} is neither a registered expert type ({sorted(_EXPERT_TYPES) or 'none'}) nor "
+        "an importable module:attribute factory(suite, task) -> Expert"
+    )
+    if not attribute:
+        raise UserError(hint + ".")
+    try:
+        factory = getattr(importlib.import_module(module_name), attribute)
+    except (ImportError, AttributeError) as error:
+        raise UserError(f"{hint} ({type(error).__name__}: {error}).") from None
+    if not callable(factory):
+        raise UserError(f"{hint} ({name} is a {type(factory).__name__}, not callable).")
+    return factory
+
+
+def privileged_state_size(suite: Any) -> int:
+    """The size of the suite's privileged state (from one reset of its first task's env)."""
+    env = suite.make_env(suite.task_names[0])
+    try:
+        _, info = env.reset(seed=0)
+        return int(info["privileged_state"].shape[-1])
+    finally:
+        env.close()
+
+
+def _policy_input_size(policy: Any, folder: Path) -> int:
+    """The size of a policy's ``observation.state`` input.
+
+    Raises:
+        UserError: If the policy has no such input.
+    """
+    feature = policy.config.input_features.get(STATE_KEY)
+    if feature is None:
+        inputs = sorted(policy.config.input_features)
+        raise UserError(
+            f"The expert policy {folder} reads {inputs}, not {STATE_KEY!r}: an expert acts on the privileged "
+            f"state, fed as {STATE_KEY!r}; train it on that."
+        )
+    return int(feature.shape[-1])
+
+
+def _load_expert_policy(folder: Path, state_size: int) -> tuple[Any, Any, Any]:
+    """Loads and checks one expert policy folder (its input is the privileged state)."""
+    check_local_policy(folder)
+    policy, pre, post = load_policy(folder)
+    size = _policy_input_size(policy, folder)
+    if size != state_size:
+        raise UserError(
+            f"The expert policy {folder} reads a {STATE_KEY} of size {size}, but this suite's privileged "
+            f"state has size {state_size}: give a policy trained on this suite's privileged state."
+        )
+    return policy, pre, post
+
+
+def policy_experts(path: Path, suite: Any) -> dict[str, LeRobotPolicyExpert]:
+    """The experts of every task of ``suite`` from ``--expert.path`` (see the module docstring).
+
+    Raises:
+        UserError: If the path is missing, a folder is not a policy, a policy's input is not the
+            privileged state, or a task has no expert.
+    """
+    path = Path(path)
+    if not path.is_dir():
+        raise UserError(
+            f"--expert.path={path} is not a folder: give a policy folder (one multitask expert) or a "
+            "folder with one policy folder per task, named after the task."
+        )
+    state_size = privileged_state_size(suite)
+    if (path / "config.json").is_file():
+        policy, pre, post = _load_expert_policy(path, state_size)
+        known = getattr(policy.config, "task_names", None)
+        unknown = [task for task in suite.task_names if known and task not in known]
+        if unknown:
+            raise UserError(
+                f"The multitask expert policy {path} was not trained on the tasks {unknown}: give one "
+                "trained on every task of the suite, or one policy folder per task."
+            )
+        # a copy per task: a policy with an action queue (ACT, Diffusion) keeps one per running episode
+        tasks = suite.task_names
+        return {task: LeRobotPolicyExpert(copy.deepcopy(policy), pre, post, task=task) for task in tasks}
+    missing = [task for task in suite.task_names if not (path / task).is_dir()]
+    if missing:
+        raise UserError(
+            f"--expert.path={path} has no expert for the tasks {missing}: add a policy folder {path}/<task> "
+            "for each (or give one multitask policy folder)."
+        )
+    experts = {}
+    for task in suite.task_names:
+        policy, pre, post = _load_expert_policy(path / task, state_size)
+        experts[task] = LeRobotPolicyExpert(policy, pre, post, task=task)  # a policy may read the task
+    return experts
+
+
+def command_line_experts(suite: Any, path: str | None, type_name: str | None) -> Any:
+    """``suite`` with the experts the command line names (itself when it names none).
+
+    Raises:
+        UserError: On a bad path or type (see :func:`policy_experts`, :func:`expert_type_factory`).
+    """
+    if path is not None:
+        return suite.with_experts(policy_experts(Path(path), suite))
+    if type_name is not None:
+        factory = expert_type_factory(type_name)
+        return suite.with_experts({task: factory(suite, task) for task in suite.task_names})
+    return suite
