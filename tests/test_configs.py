@@ -272,7 +272,7 @@ def test_a_flat_config_migrates_into_the_groups():
     expected = {"suite.episode_length", "rollout.worker_backend", "rollout.ray_address"}
     expected |= {"training.lr_schedule", "training.seed"}
     expected |= {"expert.noise", "expert.noise_correlation", "expert.noise_seed", "expert.labels"}
-    expected |= {"expert.path", "expert.type"}
+    expected |= {"expert.path", "expert.type", "expert.min_success", "expert.success_episodes"}
     assert added == expected, added
     assert all(today[path] == RunConfig.option_defaults()[path] for path in added)
 

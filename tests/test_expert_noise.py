@@ -188,3 +188,52 @@ def test_compare_gives_every_arm_the_same_experts():
         CompareConfig(methods=["need", "uniform", "bc"], seeds=[3], bc_budgets=[2, 4]), [*TOY, *noisy], 3
     )
     assert len(jobs) == 4 and all(set(noisy) <= set(job.args) for job in jobs)
+
+
+NOISY_08 = ["--expert.noise=0.8", "--expert.noise_correlation=0.9", "--expert.success_episodes=10"]
+
+
+def test_min_success_keeps_the_tasks_whose_noisy_expert_passes_and_records_them(
+    tmp_path, capsys, monkeypatch
+):
+    from lerobot_mtdagger.runner import dagger
+    from lerobot_mtdagger.runner.expert_check import expert_success
+
+    suite = make_suite("toy").with_expert_noise(ExpertNoise(scale=0.8, correlation=0.9))
+    rates = {task: expert_success(suite, i, 10, seed=0) for i, task in enumerate(suite.task_names)}
+    assert len(set(rates.values())) > 1, rates  # the threshold below keeps some tasks and drops others
+    threshold = max(rates.values())
+    kept = [task for task, rate in rates.items() if rate >= threshold]
+    out = _run(tmp_path, "kept", *NOISY_08, f"--expert.min_success={threshold}")
+    check = json.loads((out / "expert_check.json").read_text())
+    assert check["success"] == rates and check["kept"] == kept
+    assert check["dropped"] == [task for task in rates if task not in kept]
+    record = json.loads((out / "rounds" / "round-001" / "meta" / "mtdagger.json").read_text())
+    assert record["task_names"] == kept and record["config"]["expert"]["min_success"] == threshold
+    # a resume reads the measurement back and measures nothing
+    monkeypatch.setattr(dagger, "measure_expert_check", lambda *args: pytest.fail("measured again"))
+    args = [*TOY, *NOISY_08, f"--expert.min_success={threshold}", "--dagger.rounds=2"]
+    assert main(["run", *args, f"--output_dir={out}", "--resume=true"]) == 0
+    assert main(["verify", f"--experiment_dir={out}"]) == 0
+    check["kept"] = list(rates)
+    (out / "expert_check.json").write_text(json.dumps(check))
+    capsys.readouterr()
+    with pytest.raises(SystemExit):
+        main(["verify", f"--experiment_dir={out}"])
+    assert "expert_check.json kept" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--expert.min_success=0"], "expert.min_success must be in (0, 1], got 0.0"),
+        (["--expert.min_success=1.5"], "expert.min_success must be in (0, 1]"),
+        (["--expert.success_episodes=0"], "expert.success_episodes must be > 0"),
+        ([*NOISY_08[:2], "--expert.noise=3", "--expert.min_success=1"], "No task's expert reaches"),
+    ],
+)
+def test_bad_or_unmet_task_rules_are_refused_before_anything_is_written(tmp_path, capsys, options, message):
+    out = tmp_path / "out"
+    assert main(["run", *TOY, *options, f"--output_dir={out}"]) == 2
+    error = capsys.readouterr().err
+    assert message in error and len(error.strip().splitlines()) == 1 and not out.exists()

@@ -16,7 +16,7 @@ PACKAGE = Path(lerobot_mtdagger.__file__).parent
 
 def test_streams_are_distinct():
     streams = {name: value for name, value in vars(seeds).items() if name.endswith("_STREAM")}
-    assert len(streams) == 6
+    assert len(streams) == 7
     assert len(set(streams.values())) == len(streams)
 
 

@@ -70,6 +70,8 @@ POLICIES_DIR = "policies"
 STAGING_DIR = ".staging"
 TRAINING_FILE = "training.json"
 CONFIG_FILE = "config.json"
+EXPERT_CHECK_FILE = "expert_check.json"
+"""The measurement that chose an experiment's tasks (``--expert.min_success``, ``runner/expert_check.py``)."""
 LOCK_FILE = ".lock"
 """The writer lock of an experiment folder (an OS lock held while a run writes; it holds the pid)."""
 
@@ -232,11 +234,12 @@ class ExperimentDir:
         """Whether the directory exists and is not empty."""
         return self.root.exists() and any(self.root.iterdir())
 
-    def initialise(self, config: dict[str, Any]) -> None:
+    def initialise(self, config: dict[str, Any], extra: Mapping[str, Any] | None = None) -> None:
         """Creates the experiment atomically: built beside ``root``, then renamed onto it.
 
         A start that fails before the rename leaves nothing at ``root``; after it, ``root`` holds
-        the config and empty ``rounds/`` and ``policies/``, a folder ``--resume=true`` continues.
+        the config, the ``extra`` JSON files (file name -> content; e.g. ``expert_check.json``) and
+        empty ``rounds/`` and ``policies/``, a folder ``--resume=true`` continues.
 
         Raises:
             UserError: If the directory exists and is not empty.
@@ -254,6 +257,8 @@ class ExperimentDir:
             (building / ROUNDS_DIR).mkdir(parents=True)
             (building / POLICIES_DIR).mkdir()
             write_json_atomic(building / CONFIG_FILE, config)
+            for name, content in (extra or {}).items():
+                write_json_atomic(building / name, content)
             os.replace(building, self.root)  # replaces an empty root too
         finally:
             if building.exists():  # the start failed before the rename: leave nothing

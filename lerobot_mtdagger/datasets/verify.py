@@ -21,7 +21,7 @@ import pyarrow.parquet as pq
 
 from lerobot_mtdagger.datasets.checkpoints import load_policy
 from lerobot_mtdagger.datasets.records import RoundRecord
-from lerobot_mtdagger.datasets.rounds import ExperimentDir, round_name
+from lerobot_mtdagger.datasets.rounds import EXPERT_CHECK_FILE, ExperimentDir, round_name
 from lerobot_mtdagger.scheduler import allocation_mismatches
 from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
 
@@ -184,7 +184,23 @@ def verify_experiment(experiment: ExperimentDir) -> tuple[int, int, list[str]]:
         record = experiment.read_round_record(round_index)
         problems += verify_round(experiment, record, previous, readable_phases)
         previous = record
+    if previous is not None:
+        problems += kept_task_mismatches(experiment, previous)
     return len(rounds), len(phases), problems
+
+
+def kept_task_mismatches(experiment: ExperimentDir, record: RoundRecord) -> list[str]:
+    """Whether the rounds hold the tasks ``expert_check.json`` kept (``--expert.min_success``)."""
+    path = experiment.root / EXPERT_CHECK_FILE
+    if not path.is_file():
+        return []
+    try:
+        kept = json.loads(path.read_text())["kept"]
+    except (OSError, json.JSONDecodeError, KeyError, TypeError) as error:
+        return [f"{EXPERT_CHECK_FILE} cannot be read ({type(error).__name__}: {error})"]
+    if kept != record.task_names:
+        return [f"{EXPERT_CHECK_FILE} kept {kept}, but the rounds hold the tasks {record.task_names}"]
+    return []
 
 
 def _readable_phase(experiment: ExperimentDir, round_index: int) -> bool:

@@ -446,6 +446,10 @@ class ExpertConfig:
             (``experts/command_line.py``). None: the registered experts.
         type: An expert factory ``factory(suite, task) -> Expert``: a name registered with
             ``register_expert_type``, or an importable ``module:attribute``. None: the registered experts.
+        min_success: Keep only the tasks whose expert (as the run uses it, noise included) succeeds at
+            least this often over ``success_episodes`` episodes, measured before round 0 (the paper kept
+            the MT50 tasks its SAC experts passed at 80%; ``runner/expert_check.py``). None: every task.
+        success_episodes: Episodes per task that ``min_success`` is measured on.
     """
 
     noise: float = 0.0
@@ -454,10 +458,16 @@ class ExpertConfig:
     labels: str = "noisy"
     path: str | None = None
     type: str | None = None
+    min_success: float | None = None
+    success_episodes: int = 20
 
     def check(self) -> None:
         """Refuses impossible values (one line naming the option)."""
         self.settings()
+        if self.min_success is not None and not (0.0 < self.min_success <= 1.0):
+            raise ValueError(f"expert.min_success must be in (0, 1], got {self.min_success}.")
+        if self.success_episodes <= 0:
+            raise ValueError(f"expert.success_episodes must be > 0, got {self.success_episodes}.")
         if self.path is not None and self.type is not None:
             raise ValueError("--expert.path and --expert.type both name the experts: give one of them.")
         if self.path is not None and not Path(self.path).is_dir():

@@ -60,6 +60,7 @@ from lerobot_mtdagger.runner.collect import (
 )
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.evaluate import EvalResult, PolicyRunner, evaluate, make_runner
+from lerobot_mtdagger.runner.expert_check import EXPERT_CHECK_FILE, ExpertCheck, measure_expert_check
 from lerobot_mtdagger.runner.train import RoundCache, check_heldout, student_config, train_on_rounds
 from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
@@ -385,21 +386,43 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
         FloatingPointError: If training diverges.
         WorkerDiedError: If an env worker process dies.
     """
-    with quiet_third_party():  # importing MetaWorld's renderer logs an OpenGL INFO line
-        suite = config.expert.suite_with_experts(suite_from_config(config.suite))
-    check_budget(config, len(suite.task_names))
-    check_heldout(config, len(suite.task_names))
     experiment = ExperimentDir(config.output_dir)
     if config.resume:
         experiment.check_resumable(config.to_dict(), added_defaults=RunConfig.option_defaults())
-    else:
-        experiment.initialise(config.to_dict())
+    with quiet_third_party():  # importing MetaWorld's renderer logs an OpenGL INFO line
+        suite = config.expert.suite_with_experts(suite_from_config(config.suite))
+        check = kept_tasks_check(config, suite, experiment)
+        if check is not None:
+            suite = config.expert.suite_with_experts(suite_from_config(config.suite, tasks=check.kept))
+    check_budget(config, len(suite.task_names))
+    check_heldout(config, len(suite.task_names))
+    if not config.resume:
+        extra = {EXPERT_CHECK_FILE: check.to_dict()} if check is not None else None
+        experiment.initialise(config.to_dict(), extra)
     with experiment.writer_lock():
         if config.resume:
             experiment.check_committed_files()  # refuses foreign, corrupt or changed rounds and policies
             experiment.clear_staging()
             experiment.extend_rounds(config.dagger.rounds)  # a DAgger run resumed with more rounds
         return _run_locked(config, suite, experiment, on_summary)
+
+
+def kept_tasks_check(config: RunConfig, suite: TaskSuite, experiment: ExperimentDir) -> ExpertCheck | None:
+    """The tasks ``--expert.min_success`` keeps: read back on a resume, else measured (None: no rule).
+
+    Raises:
+        UserError: If no task is kept, or a resumed experiment's ``expert_check.json`` is unreadable.
+    """
+    options = config.expert
+    if options.min_success is None:
+        return None
+    stored = experiment.root / EXPERT_CHECK_FILE
+    if config.resume:
+        return ExpertCheck.read(stored)
+    logger.info(
+        "Measuring each task's expert on %d episodes (--expert.min_success)", options.success_episodes
+    )
+    return measure_expert_check(suite, options.min_success, options.success_episodes, config.seed)
 
 
 def unseen_task_suite(config: RunConfig, suite: TaskSuite) -> TaskSuite | None:

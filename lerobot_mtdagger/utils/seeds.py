@@ -13,6 +13,8 @@ Streams (number; the keys after it; what it decides):
 - ``TRAINING_STREAM`` (3; round): a phase's initial weights and batch order.
 - ``NOISE_STREAM`` (4; round, task, episode): an imperfect expert's action noise (``experts/noise.py``),
   seeded by ``--expert.noise_seed`` in place of the run's seed.
+- ``EXPERT_CHECK_STREAM`` (5; 0, task, episode): the env reset of an episode that measures a task's
+  expert for ``--expert.min_success`` (``runner/expert_check.py``).
 - ``HELDOUT_STREAM`` (7; task): which episodes a run holds out of training.
 
 The frames each phase measures its per-task loss on are drawn from ``np.random.default_rng(seed)``
@@ -28,6 +30,7 @@ EVAL_STREAM = 1
 BETA_STREAM = 2
 TRAINING_STREAM = 3
 NOISE_STREAM = 4
+EXPERT_CHECK_STREAM = 5
 HELDOUT_STREAM = 7
 
 
