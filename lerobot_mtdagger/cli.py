@@ -53,6 +53,7 @@ from lerobot_mtdagger.studies.compare import CompareConfig, follow_parent, split
 from lerobot_mtdagger.studies.simulate import SyntheticTasks, simulate
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
+from lerobot_mtdagger.utils.paths import check_output_dir, check_output_file
 from lerobot_mtdagger.utils.ray_session import import_ray
 
 HELDOUT_TASKS = "heldout"
@@ -189,6 +190,7 @@ class MergeConfig:
     def __post_init__(self) -> None:
         if self.experiment_dir is None or self.output is None:
             raise ValueError("--experiment_dir and --output are required.")
+        check_output_dir(self.output, "--output")
 
 
 def merge_command(config: MergeConfig) -> Path:
@@ -272,6 +274,8 @@ class EvalConfig:
             import_ray()  # refuses a missing Ray before anything runs
         if self.policy_path is None:
             raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
+        if self.output is not None:  # before evaluating, not after: the results would be lost
+            check_output_file(self.output, "--output")
         if self.episodes <= 0:
             raise ValueError(f"episodes must be > 0, got {self.episodes}.")
         if self.unseen_rule not in UNSEEN_RULES:
@@ -452,6 +456,7 @@ class ReportConfig:
             raise ValueError(f"{self.compare_dir} is not a compare folder (no runs/ in it).")
         if self.compare_dir is not None and self.output_dir is None:
             self.output_dir = self.compare_dir / "report"
+        self._check_outputs()
         from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
 
         for name, folder in self.variants.items():
@@ -476,6 +481,14 @@ class ReportConfig:
         if self.output_dir is None:
             table = Path(self.results[0])
             self.output_dir = table if table.is_dir() else table.parent
+        self._check_outputs()
+
+    def _check_outputs(self) -> None:
+        """Refuses an output folder or file that cannot be written, before any table is made."""
+        if self.output_dir is not None:
+            check_output_dir(self.output_dir, "--output_dir")
+        if self.output is not None:
+            check_output_file(self.output, "--output")
 
     @property
     def experiment_dirs(self) -> list[Path]:

@@ -2,14 +2,19 @@
 
 Usage::
 
-    .venv/bin/python scripts/compare_experiments.py OLD_DIR NEW_DIR [--ignore-config KEY ...]
+    .venv/bin/python scripts/compare_experiments.py OLD_DIR NEW_DIR [--ignore-config KEY ...] [--strict]
 
-Reads the stored JSON directly (no class of this package), so it also compares folders written by
-older versions. Per round it compares the ``mtdagger`` record of ``meta/info.json`` (every field except
-``config``, compared separately minus ``output_dir`` and the ``--ignore-config`` keys), the data
-files (sha256 of each parquet file's decoded table), and per training phase ``training.json``
-(everything but ``timings``) and the policy weights. Prints one line per difference and exits 1 if
-there is any.
+Reads the stored JSON directly (no class of this package but the config layout), so it also compares
+folders written by older versions. Per round it compares the round's record (every field except
+``config``, compared separately option by option), the data files (sha256 of each parquet file's
+decoded table), and per training phase ``training.json`` and the policy weights. Prints one line per
+difference and exits 1 if there is any.
+
+By default it leaves out what never changes a result: the options a resume may change
+(``RESULT_NEUTRAL_OPTIONS``: ``resume``, ``progress``, ``output_dir``, worker counts and backend,
+``preset``, ``policy.device``) and, in ``training.json``, ``timings`` and ``environment`` (where it
+ran). ``--strict`` compares those too; ``--ignore-config KEY ...`` leaves out more options (dotted
+paths, e.g. ones renamed on purpose).
 """
 
 from __future__ import annotations
@@ -24,6 +29,10 @@ import pyarrow.parquet as pq
 from safetensors.numpy import load_file
 
 from lerobot_mtdagger.datasets.config_layout import flatten, migrate_run_config
+from lerobot_mtdagger.datasets.rounds import RESULT_NEUTRAL_OPTIONS
+
+PROVENANCE_FIELDS = {"timings", "environment"}
+"""``training.json`` fields that say how and where a phase ran, not what it gave."""
 
 
 def round_record(root: Path) -> dict:
@@ -52,7 +61,7 @@ def compare_round(old: Path, new: Path, ignore_config: set[str]) -> list[str]:
     problems = compare_dicts(records[0], records[1], old.name, {"config"})
     # Configs compared option by option, in today's layout (a flat stored config is migrated).
     configs = [flatten(migrate_run_config(r["config"])) for r in records]
-    problems += compare_dicts(configs[0], configs[1], f"{old.name}.config", {"output_dir", *ignore_config})
+    problems += compare_dicts(configs[0], configs[1], f"{old.name}.config", ignore_config)
     files = [sorted(p.relative_to(root) for p in (root / "data").rglob("*.parquet")) for root in (old, new)]
     if files[0] != files[1]:
         problems.append(f"{old.name}: data files {files[0]} != {files[1]}")
@@ -62,10 +71,10 @@ def compare_round(old: Path, new: Path, ignore_config: set[str]) -> list[str]:
     return problems
 
 
-def compare_phase(old: Path, new: Path) -> list[str]:
-    """Differences of one training phase's record and weights."""
+def compare_phase(old: Path, new: Path, skip: set[str]) -> list[str]:
+    """Differences of one training phase's record (less the ``skip`` fields) and weights."""
     records = [json.loads((p / "training.json").read_text()) for p in (old, new)]
-    problems = compare_dicts(records[0], records[1], f"policy {old.name}", {"timings"})
+    problems = compare_dicts(records[0], records[1], f"policy {old.name}", skip)
     weights = [load_file(str(p / "model.safetensors")) for p in (old, new)]
     for name in sorted(set(weights[0]) | set(weights[1])):
         if name not in weights[0] or name not in weights[1] or (weights[0][name] != weights[1][name]).any():
@@ -78,19 +87,26 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("old", type=Path)
     parser.add_argument("new", type=Path)
-    parser.add_argument("--ignore-config", nargs="*", default=[], help="config keys renamed on purpose")
+    parser.add_argument(
+        "--ignore-config", nargs="*", default=[], help="more config options to leave out (dotted paths)"
+    )
+    parser.add_argument(
+        "--strict",
+        action="store_true",
+        help="also compare what never changes a result (resume, workers, ...)",
+    )
     args = parser.parse_args()
+    ignore = set(args.ignore_config) | (set() if args.strict else {*RESULT_NEUTRAL_OPTIONS})
+    phase_skip = {"timings"} if args.strict else PROVENANCE_FIELDS
     problems = []
     rounds = [sorted(p.name for p in (root / "rounds").glob("round-*")) for root in (args.old, args.new)]
     phases = [sorted(p.name for p in (root / "policies").glob("round-*")) for root in (args.old, args.new)]
     if rounds[0] != rounds[1] or phases[0] != phases[1]:
         problems.append(f"committed rounds/phases differ: {rounds} {phases}")
     for name in rounds[0]:
-        problems += compare_round(
-            args.old / "rounds" / name, args.new / "rounds" / name, set(args.ignore_config)
-        )
+        problems += compare_round(args.old / "rounds" / name, args.new / "rounds" / name, ignore)
     for name in phases[0]:
-        problems += compare_phase(args.old / "policies" / name, args.new / "policies" / name)
+        problems += compare_phase(args.old / "policies" / name, args.new / "policies" / name, phase_skip)
     for problem in problems:
         print(problem)
     counts = f"{len(rounds[0])} rounds, {len(phases[0])} phases"

@@ -14,6 +14,10 @@ from lerobot_mtdagger.utils.errors import UserError
 
 DEFAULT_NUM_POINTS = 1024
 DEFAULT_IMAGE_SIZE = 84
+MAX_IMAGE_SIZE = 480
+"""The largest image side: MuJoCo's default offscreen buffer (MetaWorld's and the drawers') is 640x480."""
+MAX_NUM_POINTS = 65_536
+"""The largest point cloud: a round keeps every frame's cloud in memory (65 536 points: 768 kB a frame)."""
 DRAWERS = "drawers"
 
 
@@ -64,6 +68,13 @@ class SuiteConfig:
             value = getattr(self, name)
             if value is not None and value <= 0:
                 raise UserError(f"suite.{name} must be > 0, got {value}.")
+        for name, limit, why in (
+            ("image_size", MAX_IMAGE_SIZE, "the suites' offscreen render buffer is 640x480"),
+            ("num_points", MAX_NUM_POINTS, "a round keeps every frame's cloud in memory"),
+        ):
+            value = getattr(self, name)
+            if value is not None and value > limit:
+                raise UserError(f"suite.{name} must be <= {limit} ({why}), got {value}.")
         if not 0.0 < self.mesh_detail <= 1.0:
             raise UserError(f"suite.mesh_detail must be in (0, 1], got {self.mesh_detail}.")
 

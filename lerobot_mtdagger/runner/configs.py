@@ -46,6 +46,7 @@ from lerobot_mtdagger.experts.command_line import command_line_experts
 from lerobot_mtdagger.experts.noise import ExpertNoise
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
 from lerobot_mtdagger.utils.parsing import cache_dataclass_sources
+from lerobot_mtdagger.utils.paths import check_output_dir
 from lerobot_mtdagger.utils.ray_session import import_ray
 
 cache_dataclass_sources()  # draccus.parse(RunConfig) in 0.1 s instead of 2-3 s (utils/parsing.py)
@@ -650,6 +651,7 @@ class RunConfig:
                 f"got {self.policy.batch_size}, {lr}."
             )
         check_device(self.policy.device)
+        check_output_dir(self.output_dir, "--output_dir")
         self._check_student()
 
     def _check_student(self) -> None:
@@ -779,6 +781,10 @@ def check_device(device: str) -> None:
             )
     elif parsed.type == "mps" and not torch.backends.mps.is_available():
         raise ValueError(f"policy.device={device!r} is not available here; pass --policy.device=cpu.")
+    elif parsed.type == "cpu" and parsed.index not in (None, 0):
+        raise ValueError(
+            f"policy.device={device!r} names a CPU that does not exist: pass --policy.device=cpu."
+        )
 
 
 def resolve_workers(workers: int | None) -> int:

@@ -95,6 +95,9 @@ class CompareConfig:
             )
         if self.launcher == "ray":
             import_ray()  # refuses a missing Ray before anything runs
+        negative = [seed for seed in self.seeds if seed < 0]
+        if negative or not self.seeds or len(set(self.seeds)) != len(self.seeds):
+            raise ValueError(f"--seeds must be distinct seeds >= 0, got {self.seeds}.")
 
 
 LAUNCHERS: tuple[str, ...] = ("local", "ray")

@@ -17,6 +17,7 @@ import functools
 import inspect
 import io
 from collections.abc import Sequence
+from pathlib import Path
 from typing import TypeVar
 
 import draccus
@@ -87,6 +88,20 @@ def unparsable_option(options: Sequence[str]) -> str | None:
     return None
 
 
+def missing_config_file(options: Sequence[str]) -> None:
+    """Refuses a ``--config_path`` that is not a readable file (draccus would raise FileNotFoundError).
+
+    Raises:
+        UserError: Naming the path and the fix.
+    """
+    for option in options:
+        name, separator, value = option.partition("=")
+        if name == "--config_path" and separator and not Path(value).is_file():
+            raise UserError(
+                f"--config_path={value} is not a file: give a YAML or JSON config file, or drop the option."
+            )
+
+
 def parse_options(config_class: type[T], options: Sequence[str], prog: str) -> T:
     """Parses command-line options into a config, every failure a ``UserError``.
 
@@ -97,6 +112,7 @@ def parse_options(config_class: type[T], options: Sequence[str], prog: str) -> T
     unparsable = unparsable_option(options)
     if unparsable is not None:
         raise UserError(unparsable)
+    missing_config_file(options)
     cache_dataclass_sources()
     argparse_output = io.StringIO()
     try:

@@ -1,0 +1,70 @@
+"""Output paths probed before a command does any work, so a bad one is refused in one line, up front."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+
+def _nearest_existing(path: Path) -> Path:
+    """``path`` itself or its nearest ancestor that exists."""
+    probe = path.absolute()
+    while not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    return probe
+
+
+def _writable(folder: Path) -> bool:
+    """Whether a file can be created in ``folder`` (probed with a temporary file, removed at once).
+
+    A real probe, not ``os.access``: root passes ``os.access`` on read-only mounts (``/proc``, a
+    read-only volume) where creating a file still fails.
+    """
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            return True
+    except OSError:
+        return False
+
+
+def check_output_dir(path: Path | str, option: str) -> None:
+    """Refuses a folder that cannot be created or written: a file, or under a file or a read-only folder.
+
+    Args:
+        path: The folder a command will create or write into.
+        option: The option that gave it (``--output_dir``), for the message.
+
+    Raises:
+        ValueError: Naming the option, the path and the fix.
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{option}={path} is a file: give a folder path.")
+    _check_creatable(path, option)
+
+
+def check_output_file(path: Path | str, option: str) -> None:
+    """Refuses a file path that cannot be written: a folder, or under a file or a read-only folder.
+
+    Raises:
+        ValueError: Naming the option, the path and the fix.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{option}={path} is a folder: give a file path.")
+    if path.exists() and not os.access(path, os.W_OK):
+        raise ValueError(f"{option}={path} cannot be written (read-only file); choose another path.")
+    _check_creatable(path.parent, option, shown=path)
+
+
+def _check_creatable(folder: Path, option: str, shown: Path | None = None) -> None:
+    """Refuses a folder whose nearest existing ancestor is a file or cannot be written into."""
+    shown = folder if shown is None else shown
+    existing = _nearest_existing(folder)
+    if not existing.is_dir():
+        raise ValueError(f"{option}={shown} lies under the file {existing}: give a path in a folder.")
+    if not _writable(existing):
+        raise ValueError(
+            f"{option}={shown} cannot be written: {existing} is not writable here; choose another."
+        )
