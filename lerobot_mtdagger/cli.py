@@ -240,6 +240,8 @@ class EvalConfig:
             what a run's unseen-drawer evaluation does), ``nearest`` with the task input of the
             training task most like it (the drawers: the same handle type, the nearest handle size
             and height; ``docs/drawers.md``).
+        allow_changed_policy: Evaluate a policy folder of an experiment even if its files differ from
+            the checksums committed with it (said in the output); by default such a folder is refused.
     """
 
     policy_path: str | None = None
@@ -252,6 +254,7 @@ class EvalConfig:
     ray_address: str | None = None
     trust_checkpoint: bool = False
     unseen_rule: str = "shared"
+    allow_changed_policy: bool = False
 
     @property
     def worker_count(self) -> int:
@@ -285,11 +288,43 @@ class EvalConfig:
         self.suite.check()
 
 
+def check_committed_policy(folder: Path, allow_changed: bool) -> None:
+    """Refuses a policy folder of an experiment whose files changed after commit (unless allowed).
+
+    A folder ``<experiment>/policies/round-XXX`` is checked against the checksums in its
+    ``training.json`` and the experiment's ledger; any other folder (or a Hub id) is not.
+
+    Raises:
+        UserError: Naming the changed files and ``--allow_changed_policy=true``.
+    """
+    from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, TRAINING_FILE, ExperimentDir
+
+    experiment_root = folder.parent.parent
+    if folder.parent.name != "policies" or not (experiment_root / CONFIG_FILE).is_file():
+        return
+    if not (folder / TRAINING_FILE).is_file() or not folder.name.startswith("round-"):
+        return
+    experiment = ExperimentDir(experiment_root)
+    record = experiment.read_phase_record(int(folder.name.split("-")[1]))
+    record_path = str(folder / TRAINING_FILE)
+    problems = experiment.phase_file_problems(record)
+    problems += [p for p in experiment.ledger_problems(unledgered=False) if record_path in p]
+    if not problems:
+        return
+    if not allow_changed:
+        raise UserError(
+            f"{folder} changed after it was committed ({'; '.join(problems)}): restore it, or pass "
+            "--allow_changed_policy=true to evaluate it as it is."
+        )
+    print(f"warning: evaluating {folder} although it changed after commit: {'; '.join(problems)}")
+
+
 def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
     """The suite the config names and its pretrained policy, checked to take the suite's observations."""
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.runner.evaluate import PolicyRunner
 
+    check_committed_policy(Path(config.policy_path), config.allow_changed_policy)
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
     suite_config = dataclasses.replace(config.suite, **observation_options(runner, config.suite))
     if list(suite_config.tasks) == [HELDOUT_TASKS]:

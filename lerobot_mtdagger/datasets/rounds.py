@@ -51,6 +51,7 @@ from lerobot_mtdagger.datasets.config_layout import (
     migrate_run_config,
 )
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
+from lerobot_mtdagger.datasets.ledger import Ledger
 from lerobot_mtdagger.datasets.records import (
     FORMAT_VERSION,
     RECORD_KEY,
@@ -394,6 +395,7 @@ class ExperimentDir:
             problems += self.round_file_problems(self.read_round_record(round_index))
         for round_index in self.committed_phases():
             problems += self.phase_file_problems(self.read_phase_record(round_index))
+        problems += self.ledger_problems(unledgered=False)  # a cut-off run's last record: added on resume
         if problems:
             raise CorruptExperimentError(
                 f"{self.root} was changed after commit: {'; '.join(problems)}. Restore the files, or "
@@ -562,6 +564,7 @@ class ExperimentDir:
         write_json_atomic(staging / RECORD_FILE, info[RECORD_KEY])
         write_json_atomic(info_path, info)
         os.replace(staging, final)
+        self.update_ledger()
         return final
 
     # ---------------------------------------------------------------------------------------------
@@ -596,7 +599,33 @@ class ExperimentDir:
         if final.exists():
             raise FileExistsError(f"Training phase {round_index} is already committed at {final}.")
         os.replace(staging, final)
+        self.update_ledger()
         return final
+
+    # ---------------------------------------------------------------------------------------------
+    # The ledger (datasets/ledger.py)
+    # ---------------------------------------------------------------------------------------------
+
+    def committed_record_files(self) -> list[Path]:
+        """Every committed record file, in commit order (round k's record, then phase k's)."""
+        rounds, phases = set(self.committed_rounds()), set(self.committed_phases())
+        files = []
+        for k in sorted(rounds | phases):
+            if k in rounds:
+                root = self.round_root(k)
+                files.append(root / RECORD_FILE if (root / RECORD_FILE).is_file() else root / INFO_FILE)
+            if k in phases:
+                files.append(self.policy_root(k) / TRAINING_FILE)
+        return files
+
+    def update_ledger(self) -> None:
+        """Adds the committed records the ledger does not list yet (starting it if there is none)."""
+        Ledger(self.root).append(self.committed_record_files(), write_json_atomic)
+
+    def ledger_problems(self, unledgered: bool = True) -> list[str]:
+        """Records that differ from the ledger (``unledgered``: also those it does not list yet)."""
+        problems = Ledger(self.root).problems(self.committed_record_files())
+        return problems if unledgered else [p for p in problems if "is committed but not in" not in p]
 
     def read_phase_record(self, round_index: int) -> PhaseRecord:
         """The training record of a committed phase.

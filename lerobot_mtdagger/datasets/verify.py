@@ -186,6 +186,7 @@ def verify_experiment(experiment: ExperimentDir) -> tuple[int, int, list[str]]:
         previous = record
     if previous is not None:
         problems += kept_task_mismatches(experiment, previous)
+    problems += experiment.ledger_problems()
     return len(rounds), len(phases), problems
 
 

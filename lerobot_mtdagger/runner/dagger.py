@@ -402,6 +402,7 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
     with experiment.writer_lock():
         if config.resume:
             experiment.check_committed_files()  # refuses foreign, corrupt or changed rounds and policies
+            experiment.update_ledger()  # a record committed just before a cut-off, and older experiments
             experiment.clear_staging()
             experiment.extend_rounds(config.dagger.rounds)  # a DAgger run resumed with more rounds
         return _run_locked(config, suite, experiment, on_summary)

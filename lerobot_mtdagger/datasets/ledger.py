@@ -1,0 +1,117 @@
+"""The experiment's ledger: a hash chain over every committed record, so an edited number is named.
+
+A round's files and a policy's files are hashed into their records at commit
+(``datasets/integrity.py``), but the records themselves (``rounds/<round>/meta/mtdagger.json``,
+mirrored in ``meta/info.json``, and ``policies/<round>/training.json``) hold the numbers ``report``,
+``compare`` and a resume read: success, allocations, losses. ``ledger.json`` at the experiment's root
+lists every record in commit order with its sha256 and the sha256 of the entry before it, like git's
+commits::
+
+    {"entries": [
+      {"record": "rounds/round-000/meta/mtdagger.json", "sha256": "...", "previous": null},
+      {"record": "policies/round-000/training.json", "sha256": "...", "previous": "<entry 0's hash>"},
+      ...]}
+
+An edited record no longer matches its entry; an edited entry breaks the chain after it. ``verify``
+and every resume check it. An experiment made before the ledger existed has none (nothing is
+checked there); the first commit of a resumed one starts it with the records it holds then, as they
+are. A record committed by a run cut off before it reached the ledger is added by the next resume.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from lerobot_mtdagger.datasets.integrity import file_sha256
+
+logger = logging.getLogger(__name__)
+
+LEDGER_FILE = "ledger.json"
+
+
+def entry_hash(entry: dict[str, Any]) -> str:
+    """The sha256 of one entry (its canonical JSON), which the next entry names as ``previous``."""
+    return hashlib.sha256(json.dumps(entry, sort_keys=True).encode()).hexdigest()
+
+
+class Ledger:
+    """The hash chain of an experiment folder's committed records."""
+
+    def __init__(self, root: Path) -> None:
+        """The ledger of the experiment at ``root`` (it may not exist yet)."""
+        self.root = Path(root)
+        self.path = self.root / LEDGER_FILE
+
+    def exists(self) -> bool:
+        """Whether the experiment has a ledger (one made before the ledger existed has none)."""
+        return self.path.is_file()
+
+    def entries(self) -> list[dict[str, Any]]:
+        """The entries, in commit order ([] without a ledger).
+
+        Raises:
+            ValueError: If the file is not a ledger.
+        """
+        if not self.exists():
+            return []
+        try:
+            entries = json.loads(self.path.read_text())["entries"]
+        except (OSError, json.JSONDecodeError, KeyError, TypeError) as error:
+            reason = f"{type(error).__name__}: {error}"
+            raise ValueError(f"{self.path} is not a readable ledger ({reason})") from None
+        return list(entries)
+
+    def append(self, records: Sequence[Path], write: Any) -> None:
+        """Adds the records (files under ``root``) that the ledger does not list yet, in order.
+
+        Args:
+            records: Record files, in commit order; those already listed are skipped.
+            write: ``write(path, payload)``, an atomic JSON writer.
+        """
+        entries = self.entries()
+        listed = {entry["record"] for entry in entries}
+        count = len(entries)
+        for record in records:
+            name = Path(record).relative_to(self.root).as_posix()
+            if name in listed:
+                continue
+            previous = entry_hash(entries[-1]) if entries else None
+            entries.append({"record": name, "sha256": file_sha256(record), "previous": previous})
+            listed.add(name)
+        if len(entries) > count:  # nothing new: the file is left as it is
+            write(self.path, {"entries": entries})
+
+    def problems(self, records: Sequence[Path]) -> list[str]:
+        """What differs between the committed records and the ledger (nothing without a ledger).
+
+        Args:
+            records: Every committed record file, in commit order.
+        """
+        if not self.exists():
+            return []
+        try:
+            entries = self.entries()
+        except ValueError as error:
+            return [str(error)]
+        problems = []
+        previous = None
+        for position, entry in enumerate(entries):
+            if entry.get("previous") != previous:
+                problems.append(f"{LEDGER_FILE}: entry {position} ({entry.get('record')}) breaks the chain")
+            previous = entry_hash(entry)
+            path = self.root / str(entry.get("record"))
+            if not path.is_file():
+                problems.append(f"{path} is in the ledger but missing")
+            elif file_sha256(path) != entry.get("sha256"):
+                problems.append(f"{path} changed after commit (its sha256 differs from {LEDGER_FILE})")
+        listed = {entry.get("record") for entry in entries}
+        for record in records:
+            name = Path(record).relative_to(self.root).as_posix()
+            if name not in listed:
+                problems.append(f"{name} is committed but not in {LEDGER_FILE} (a resume adds it)")
+        return problems
