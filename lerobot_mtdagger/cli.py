@@ -159,7 +159,8 @@ def verify_command(config: VerifyConfig) -> list[str]:
     from lerobot_mtdagger.datasets.rounds import ExperimentDir
     from lerobot_mtdagger.datasets.verify import verify_experiment
 
-    num_rounds, num_policies, problems = verify_experiment(ExperimentDir(config.experiment_dir))
+    experiment = ExperimentDir(config.experiment_dir)
+    num_rounds, num_policies, problems = verify_experiment(experiment, RunConfig.option_defaults())
     for problem in problems:
         print(f"PROBLEM {problem}")
     print(
@@ -308,7 +309,7 @@ def check_committed_policy(folder: Path, allow_changed: bool) -> None:
     record = experiment.read_phase_record(int(folder.name.split("-")[1]))
     record_path = str(folder / TRAINING_FILE)
     problems = experiment.phase_file_problems(record)
-    problems += [p for p in experiment.ledger_problems(unledgered=False) if record_path in p]
+    problems += [p for p in experiment.ledger_problems(resuming=True) if record_path in p]
     if not problems:
         return
     if not allow_changed:

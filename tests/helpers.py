@@ -22,6 +22,13 @@ def edit_round_record(round_root: Path, edit: Callable[[dict[str, Any]], None]) 
     info = json.loads(info_path.read_text())
     info["mtdagger"] = record
     info_path.write_text(json.dumps(info))
+    # the state the test makes is one a run could have committed: its ledger is made anew to match
+    experiment_root = round_root.parent.parent
+    if (experiment_root / "ledger.json").is_file():
+        from lerobot_mtdagger.datasets.rounds import ExperimentDir
+
+        (experiment_root / "ledger.json").unlink()
+        ExperimentDir(experiment_root).update_ledger()
 
 
 def child_pids(pid: int) -> list[int]:

@@ -134,7 +134,7 @@ def test_a_noisy_run_records_its_noise_and_labels_as_asked(tmp_path, labels):
     out = _run(tmp_path, labels, *noisy, f"--expert.labels={labels}")
     config = json.loads((out / "config.json").read_text())
     expected = {"noise": 0.5, "noise_correlation": 0.8, "noise_seed": 4, "labels": labels, "path": None}
-    expected["type"] = None
+    expected |= {"type": None, "min_success": None, "success_episodes": 20}
     assert config["expert"] == expected
     record = json.loads((out / "rounds" / "round-001" / "meta" / "mtdagger.json").read_text())
     assert record["config"]["expert"] == expected
@@ -177,7 +177,9 @@ def test_verify_refuses_a_round_whose_recorded_experts_differ_from_the_run(tmp_p
     with pytest.raises(SystemExit) as exited:
         main(["verify", f"--experiment_dir={out}"])
     assert exited.value.code == 1
-    assert "round-001: collected with experts {'noise': 0.0" in capsys.readouterr().out
+    assert "round-001: collected with other experts: expert.noise: 0.0 (the run's config.json: 0.3)" in (
+        capsys.readouterr().out
+    )
 
 
 def test_compare_gives_every_arm_the_same_experts():

@@ -119,3 +119,20 @@ def test_eval_refuses_a_changed_policy_of_an_experiment_unless_told(run, capsys,
     assert "changed after it was committed" in error and "--allow_changed_policy=true" in error
     assert main([*args, "--allow_changed_policy=true"]) == 0
     assert "warning: evaluating" in capsys.readouterr().out
+
+
+def test_the_last_rounds_deleted_to_be_redone_leave_the_ledger_on_resume(run, capsys):
+    shutil.rmtree(run / "rounds" / "round-001")
+    shutil.rmtree(run / "policies" / "round-001")
+    status, out = _verify(capsys, run)
+    assert status == 1 and "round-001/meta/mtdagger.json is in the ledger but missing" in out
+    assert main(["run", *TOY, f"--output_dir={run}", "--resume=true"]) == 0
+    assert _verify(capsys, run)[0] == 0
+    assert len(json.loads((run / LEDGER_FILE).read_text())["entries"]) == 4
+
+
+def test_a_record_deleted_in_the_middle_is_refused_on_resume(run, capsys):
+    (run / "policies" / "round-000" / "training.json").unlink()
+    (run / "policies" / "round-000").rename(run / "policies" / "round-000-gone")
+    assert main(["run", *TOY, f"--output_dir={run}", "--resume=true"]) == 2
+    assert "policies/round-000/training.json is in the ledger but missing" in capsys.readouterr().err

@@ -178,9 +178,10 @@ def test_the_round_record_survives_lerobot_rewriting_info_json(finished, tmp_pat
 
 
 def remove_record_files(root: Path) -> None:
-    """Makes every round look as rounds did before meta/mtdagger.json existed."""
+    """Makes every round look as rounds did before meta/mtdagger.json existed (and so before the ledger)."""
     for sidecar in (root / "rounds").glob("round-*/meta/mtdagger.json"):
         sidecar.unlink()
+    (root / "ledger.json").unlink()
 
 
 def test_rounds_written_before_the_record_file_existed_still_read_and_verify(finished, tmp_path):

@@ -66,6 +66,15 @@ class Ledger:
             raise ValueError(f"{self.path} is not a readable ledger ({reason})") from None
         return list(entries)
 
+    def missing_tail(self, entries: Sequence[dict[str, Any]]) -> int:
+        """How many of the last entries name records that no longer exist (rounds deleted to be redone)."""
+        count = 0
+        for entry in reversed(entries):
+            if (self.root / str(entry.get("record"))).is_file():
+                break
+            count += 1
+        return count
+
     def append(self, records: Sequence[Path], write: Any) -> None:
         """Adds the records (files under ``root``) that the ledger does not list yet, in order.
 
@@ -74,8 +83,13 @@ class Ledger:
             write: ``write(path, payload)``, an atomic JSON writer.
         """
         entries = self.entries()
-        listed = {entry["record"] for entry in entries}
         count = len(entries)
+        tail = self.missing_tail(entries)
+        if tail:  # the last rounds were deleted to be redone: their entries go, and they are written anew
+            logger.info("Dropping %d ledger entries of deleted records from %s", tail, self.path)
+            entries = entries[: len(entries) - tail]
+            count = -1
+        listed = {entry["record"] for entry in entries}
         for record in records:
             name = Path(record).relative_to(self.root).as_posix()
             if name in listed:
@@ -86,11 +100,13 @@ class Ledger:
         if len(entries) > count:  # nothing new: the file is left as it is
             write(self.path, {"entries": entries})
 
-    def problems(self, records: Sequence[Path]) -> list[str]:
+    def problems(self, records: Sequence[Path], deleted_tail_ok: bool = False) -> list[str]:
         """What differs between the committed records and the ledger (nothing without a ledger).
 
         Args:
             records: Every committed record file, in commit order.
+            deleted_tail_ok: Accept entries at the end whose records were deleted (the last rounds,
+                deleted so that a resume redoes them; the resume then drops those entries).
         """
         if not self.exists():
             return []
@@ -100,13 +116,15 @@ class Ledger:
             return [str(error)]
         problems = []
         previous = None
+        if deleted_tail_ok:
+            entries = entries[: len(entries) - self.missing_tail(entries)]
         for position, entry in enumerate(entries):
             if entry.get("previous") != previous:
                 problems.append(f"{LEDGER_FILE}: entry {position} ({entry.get('record')}) breaks the chain")
             previous = entry_hash(entry)
             path = self.root / str(entry.get("record"))
             if not path.is_file():
-                problems.append(f"{path} is in the ledger but missing")
+                problems.append(f"{path} is in the ledger but missing (deleted after commit)")
             elif file_sha256(path) != entry.get("sha256"):
                 problems.append(f"{path} changed after commit (its sha256 differs from {LEDGER_FILE})")
         listed = {entry.get("record") for entry in entries}

@@ -395,7 +395,7 @@ class ExperimentDir:
             problems += self.round_file_problems(self.read_round_record(round_index))
         for round_index in self.committed_phases():
             problems += self.phase_file_problems(self.read_phase_record(round_index))
-        problems += self.ledger_problems(unledgered=False)  # a cut-off run's last record: added on resume
+        problems += self.ledger_problems(resuming=True)
         if problems:
             raise CorruptExperimentError(
                 f"{self.root} was changed after commit: {'; '.join(problems)}. Restore the files, or "
@@ -622,10 +622,15 @@ class ExperimentDir:
         """Adds the committed records the ledger does not list yet (starting it if there is none)."""
         Ledger(self.root).append(self.committed_record_files(), write_json_atomic)
 
-    def ledger_problems(self, unledgered: bool = True) -> list[str]:
-        """Records that differ from the ledger (``unledgered``: also those it does not list yet)."""
-        problems = Ledger(self.root).problems(self.committed_record_files())
-        return problems if unledgered else [p for p in problems if "is committed but not in" not in p]
+    def ledger_problems(self, resuming: bool = False) -> list[str]:
+        """Records that differ from the ledger.
+
+        Args:
+            resuming: Accept what a resume mends: the last records deleted to be redone, and records
+                committed by a run cut off before it reached the ledger.
+        """
+        problems = Ledger(self.root).problems(self.committed_record_files(), deleted_tail_ok=resuming)
+        return [p for p in problems if "is committed but not in" not in p] if resuming else problems
 
     def read_phase_record(self, round_index: int) -> PhaseRecord:
         """The training record of a committed phase.

@@ -13,7 +13,9 @@ phase's gain, the Kalman prior = the previous round's posterior. For each commit
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pyarrow as pa
@@ -60,20 +62,37 @@ def read_parquet(path: Path, columns: list[str] | None = None) -> pa.Table:
         raise CorruptExperimentError(f"{path} cannot be read ({error}).") from None
 
 
-def expert_mismatches(run_config: dict, record: RoundRecord) -> list[str]:
+def expert_mismatches(
+    run_config: dict, record: RoundRecord, added_defaults: Mapping[str, Any] | None = None
+) -> list[str]:
     """Whether a round was collected with the run's experts (``--expert.*``, the same in every round).
 
-    A run started before the expert options existed stores none in ``config.json``; rounds it commits
-    since record them at their default, which is noise off (perfect experts, as the run began).
+    An option that one side does not store (the run began before it existed) is taken at its default
+    from ``added_defaults`` (``RunConfig.option_defaults``, by dotted path); without a default for it,
+    it is not compared.
     """
-    stored, recorded = run_config.get("expert"), record.config.get("expert")
-    if stored == recorded or (stored is None and recorded is not None and recorded.get("noise", 0) == 0):
-        return []
-    return [f"collected with experts {recorded}, but the run's config.json says {stored}"]
+    stored, recorded = run_config.get("expert") or {}, record.config.get("expert") or {}
+    defaults = {
+        path.split(".", 1)[1]: v for path, v in (added_defaults or {}).items() if path.startswith("expert.")
+    }
+    differing = []
+    for name in sorted(set(stored) | set(recorded)):
+        ours = stored.get(name, defaults.get(name, _UNKNOWN))
+        theirs = recorded.get(name, defaults.get(name, _UNKNOWN))
+        if _UNKNOWN not in (ours, theirs) and ours != theirs:
+            differing.append(f"expert.{name}: {theirs!r} (the run's config.json: {ours!r})")
+    return [f"collected with other experts: {', '.join(differing)}"] if differing else []
+
+
+_UNKNOWN = object()
 
 
 def verify_round(
-    experiment: ExperimentDir, record: RoundRecord, previous: RoundRecord | None, committed_phases: set[int]
+    experiment: ExperimentDir,
+    record: RoundRecord,
+    previous: RoundRecord | None,
+    committed_phases: set[int],
+    added_defaults: Mapping[str, Any] | None = None,
 ) -> list[str]:
     """Checks one committed round against its data and its own record.
 
@@ -82,13 +101,14 @@ def verify_round(
         record: The round's record.
         previous: The previous round's record (None for round 0).
         committed_phases: Indices of the committed training phases.
+        added_defaults: Options' defaults by dotted path, for options the run's config predates.
 
     Returns:
         One message per problem, prefixed by the round's name; empty when the round checks out.
     """
     name = round_name(record.round)
     problems = experiment.round_file_problems(record)
-    problems += expert_mismatches(experiment.read_config(), record)
+    problems += expert_mismatches(experiment.read_config(), record, added_defaults)
     if record.files is None:
         problems.append("no checksums recorded (committed by an older version): files not checked")
     try:
@@ -162,8 +182,13 @@ def verify_policy(experiment: ExperimentDir, round_index: int) -> list[str]:
     return [f"{prefix}: {problem}" for problem in problems]
 
 
-def verify_experiment(experiment: ExperimentDir) -> tuple[int, int, list[str]]:
+def verify_experiment(
+    experiment: ExperimentDir, added_defaults: Mapping[str, Any] | None = None
+) -> tuple[int, int, list[str]]:
     """Verifies every committed round and policy of an experiment.
+
+    ``added_defaults`` (``RunConfig.option_defaults``) gives options the run's config predates their
+    default, so that its rounds' records are compared with it as a resume compares a config.
 
     Returns:
         The numbers of rounds and of policies verified, and every problem found.
@@ -182,7 +207,7 @@ def verify_experiment(experiment: ExperimentDir) -> tuple[int, int, list[str]]:
     previous = None
     for round_index in rounds:
         record = experiment.read_round_record(round_index)
-        problems += verify_round(experiment, record, previous, readable_phases)
+        problems += verify_round(experiment, record, previous, readable_phases, added_defaults)
         previous = record
     if previous is not None:
         problems += kept_task_mismatches(experiment, previous)
