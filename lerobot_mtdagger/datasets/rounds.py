@@ -607,8 +607,14 @@ class ExperimentDir:
     # ---------------------------------------------------------------------------------------------
 
     def committed_record_files(self) -> list[Path]:
-        """Every committed record file, in commit order (round k's record, then phase k's)."""
-        rounds, phases = set(self.committed_rounds()), set(self.committed_phases())
+        """Every committed record file, in commit order (round k's record, then phase k's).
+
+        Found by folder name alone (``round-XXX`` with a record file), without reading any record:
+        the other checks of a round's record are ``committed_rounds``' and ``verify``'s.
+        """
+        rounds = {int(p.name.split("-")[1]) for p in self.rounds.glob("round-*") if p.is_dir()}
+        rounds = {k for k in rounds if any((self.round_root(k) / f).is_file() for f in RECORD_FILES)}
+        phases = set(self.committed_phases())
         files = []
         for k in sorted(rounds | phases):
             if k in rounds:
