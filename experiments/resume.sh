@@ -6,9 +6,11 @@
 #   mkdir -p outputs && cp experiments/resume.sh outputs/resume-running.sh
 #   nohup bash outputs/resume-running.sh >> outputs/resume.log 2>&1 &
 #
-# Both cores: paper-regime-calibration-dev (../study-code-calibration at the commit that added it; its
-# steps use --jobs 2). (Until 2026-11-28 this script ran drawers-preset-dev, now stopped,
-# drawers-training-spread-dev, complete, and pixels-dagger-epochs-dev, paused: see their READMEs.)
+# Nothing is running (2026-11-28 05:19 UTC): paper-regime-calibration-dev is complete, and run again
+# it only re-reports (every step is skipped or resumed as finished). The script is kept as the way to
+# start the next study from its frozen worktree. (Until 2026-11-28 this script ran drawers-preset-dev,
+# now stopped, drawers-training-spread-dev, complete, and pixels-dagger-epochs-dev, paused: see their
+# READMEs.)
 set -uo pipefail
 
 CALIBRATION_COMMIT=${CALIBRATION_COMMIT:-83268c0}  # the commit that added paper-regime-calibration-dev
