@@ -135,8 +135,10 @@ def run_experiment(config: RunConfig) -> list[str]:
     from lerobot_mtdagger.runner.dagger import run
 
     follow_parent()
-    print(f"experiment {config.output_dir} ({config.method}, seed {config.seed}):", flush=True)
-    return run(config, on_summary=lambda line: print(line, flush=True))
+    header = f"experiment {config.output_dir} ({config.method}, seed {config.seed}):"
+    return run(
+        config, on_summary=lambda line: print(line, flush=True), on_start=lambda: print(header, flush=True)
+    )
 
 
 @dataclass

@@ -114,3 +114,12 @@ def test_compare_experiments_ignores_what_never_changes_a_result(tmp_path):
     record["config"]["dagger"]["beta"] = 0.7
     path.write_text(json.dumps(record))
     assert "config.dagger.beta" in compare().stdout
+
+
+def test_a_refused_run_prints_no_experiment_header(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["run", *TOY, f"--output_dir={out}"]) == 0
+    assert capsys.readouterr().out.startswith(f"experiment {out} (need, seed 0):")
+    assert main(["run", *TOY, f"--output_dir={out}"]) == 2  # exists: refused
+    captured = capsys.readouterr()
+    assert captured.out == "" and "already exists" in captured.err

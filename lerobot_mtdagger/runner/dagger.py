@@ -372,12 +372,18 @@ def check_budget(config: RunConfig, num_tasks: int) -> None:
         )
 
 
-def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> list[str]:
+def run(
+    config: RunConfig,
+    on_summary: Callable[[str], None] | None = None,
+    on_start: Callable[[], None] | None = None,
+) -> list[str]:
     """Runs (or resumes) one experiment; returns the per-round summary lines.
 
     Args:
         config: The run's options.
         on_summary: Called with each round's summary line as soon as the round is done.
+        on_start: Called once every check has passed and the experiment is locked, before any round
+            (a refused run never calls it).
 
     Raises:
         UserError: If the output directory exists and ``resume`` is false, on a bad config, on a
@@ -405,6 +411,8 @@ def run(config: RunConfig, on_summary: Callable[[str], None] | None = None) -> l
             experiment.update_ledger()  # a record committed just before a cut-off, and older experiments
             experiment.clear_staging()
             experiment.extend_rounds(config.dagger.rounds)  # a DAgger run resumed with more rounds
+        if on_start is not None:
+            on_start()
         return _run_locked(config, suite, experiment, on_summary)
 
 
