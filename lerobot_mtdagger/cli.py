@@ -54,7 +54,7 @@ from lerobot_mtdagger.studies.simulate import SyntheticTasks, simulate
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
 from lerobot_mtdagger.utils.paths import check_output_dir, check_output_file
-from lerobot_mtdagger.utils.ray_session import import_ray
+from lerobot_mtdagger.utils.ray_session import check_ray_address, import_ray
 
 HELDOUT_TASKS = "heldout"
 """``--suite.tasks='[heldout]'``: the suite's unseen tasks (``eval``, ``shift``)."""
@@ -278,6 +278,7 @@ class EvalConfig:
             )
         if self.worker_backend == "ray":
             import_ray()  # refuses a missing Ray before anything runs
+            check_ray_address(self.ray_address, "--ray_address")
         if self.policy_path is None:
             raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
         if self.output is not None:  # before evaluating, not after: the results would be lost

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import shutil
@@ -123,3 +124,12 @@ def test_a_refused_run_prints_no_experiment_header(tmp_path, capsys):
     assert main(["run", *TOY, f"--output_dir={out}"]) == 2  # exists: refused
     captured = capsys.readouterr()
     assert captured.out == "" and "already exists" in captured.err
+
+
+@pytest.mark.skipif(importlib.util.find_spec("grpc") is not None, reason="ray[client] is installed here")
+def test_a_ray_client_address_without_ray_client_is_refused_before_anything_is_written(tmp_path, capsys):
+    pytest.importorskip("ray")
+    out = tmp_path / "out"
+    ray = ["--rollout.worker_backend=ray", "--rollout.ray_address=ray://127.0.0.1:1"]
+    _refused(capsys, ["run", *TOY, *ray, f"--output_dir={out}"], 'needs pip install "ray[client]"')
+    assert not out.exists()

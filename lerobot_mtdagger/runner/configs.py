@@ -47,7 +47,7 @@ from lerobot_mtdagger.experts.noise import ExpertNoise
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
 from lerobot_mtdagger.utils.parsing import cache_dataclass_sources
 from lerobot_mtdagger.utils.paths import check_output_dir
-from lerobot_mtdagger.utils.ray_session import import_ray
+from lerobot_mtdagger.utils.ray_session import check_ray_address, import_ray
 
 cache_dataclass_sources()  # draccus.parse(RunConfig) in 0.1 s instead of 2-3 s (utils/parsing.py)
 
@@ -410,6 +410,7 @@ class RolloutConfig:
         _require_choice(self.worker_backend, "rollout.worker_backend", WORKER_BACKENDS)
         if self.worker_backend == "ray":
             import_ray()  # refuses a missing Ray before anything runs
+            check_ray_address(self.ray_address, "--rollout.ray_address")
 
     @property
     def worker_count(self) -> int:

@@ -8,6 +8,7 @@ reuse the connection.
 
 from __future__ import annotations
 
+import importlib.util
 import logging
 import os
 from types import ModuleType
@@ -30,6 +31,23 @@ def import_ray() -> ModuleType:
     except ImportError:
         raise UserError(RAY_MISSING) from None
     return ray
+
+
+def check_ray_address(address: str | None, option: str) -> None:
+    """Refuses a ``ray://`` address when the Ray Client's dependency (grpcio) is not installed.
+
+    Ray raises this only when it connects, after a run has started; checked here with the options.
+
+    Raises:
+        UserError: Naming the option and both fixes.
+    """
+    if address is None or not address.startswith("ray://"):
+        return
+    if importlib.util.find_spec("grpc") is None:
+        raise UserError(
+            f'{option}={address} connects through the Ray Client, which needs pip install "ray[client]" '
+            f"(not installed here); or run on a node of the cluster with {option}=auto."
+        )
 
 
 def connect(address: str | None) -> ModuleType:
