@@ -341,6 +341,12 @@ def _suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
     else:
         suite = suite_from_config(suite_config)
         trained = [name for name in suite.task_names if name in runner.task_names]
+        if not suite_config.tasks and runner.task_names and not trained and not runner.acts_on_unseen_tasks:
+            shown = ", ".join(runner.task_names[:4]) + (", ..." if len(runner.task_names) > 4 else "")
+            raise UserError(
+                f"The policy was trained on {shown}, none of which --suite.name={suite_config.name} has "
+                "(eval's default suite is metaworld-mt10): pass the --suite.name it was trained on."
+            )
         if not suite_config.tasks and trained and len(trained) < len(suite.task_names):
             logger.info("Evaluating the %d tasks of %s the policy knows", len(trained), suite_config.name)
             suite = suite_from_config(suite_config, tasks=trained)

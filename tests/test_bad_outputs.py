@@ -133,3 +133,12 @@ def test_a_ray_client_address_without_ray_client_is_refused_before_anything_is_w
     ray = ["--rollout.worker_backend=ray", "--rollout.ray_address=ray://127.0.0.1:1"]
     _refused(capsys, ["run", *TOY, *ray, f"--output_dir={out}"], 'needs pip install "ray[client]"')
     assert not out.exists()
+
+
+def test_eval_of_a_policy_from_another_suite_names_the_suite_option(tmp_path, capsys):
+    experiment = tmp_path / "toy"
+    assert main(["run", *TOY, f"--output_dir={experiment}"]) == 0
+    capsys.readouterr()
+    policy = experiment / "policies" / "round-000"
+    args = ["eval", f"--policy_path={policy}", "--episodes=1", "--workers=0"]  # MT10 by default
+    _refused(capsys, args, "none of which --suite.name=metaworld-mt10 has")
