@@ -83,12 +83,11 @@ class Ledger:
             write: ``write(path, payload)``, an atomic JSON writer.
         """
         entries = self.entries()
-        count = len(entries)
         tail = self.missing_tail(entries)
         if tail:  # the last rounds were deleted to be redone: their entries go, and they are written anew
             logger.info("Dropping %d ledger entries of deleted records from %s", tail, self.path)
             entries = entries[: len(entries) - tail]
-            count = -1
+        kept = len(entries)
         listed = {entry["record"] for entry in entries}
         for record in records:
             name = Path(record).relative_to(self.root).as_posix()
@@ -97,7 +96,7 @@ class Ledger:
             previous = entry_hash(entries[-1]) if entries else None
             entries.append({"record": name, "sha256": file_sha256(record), "previous": previous})
             listed.add(name)
-        if len(entries) > count:  # nothing new: the file is left as it is
+        if tail or len(entries) > kept:  # nothing dropped or added: the file is left as it is
             write(self.path, {"entries": entries})
 
     def problems(self, records: Sequence[Path], deleted_tail_ok: bool = False) -> list[str]:
