@@ -5,8 +5,10 @@ markdown table, one row per task and one column pair per noise level: success ov
 ``--first-seed``.., and mean steps to the first success. ``--noise 0 0.1 0.3`` measures the expert
 with ``--expert.noise`` at each level (``--correlation``: ``--expert.noise_correlation``; the noise of
 episode ``e`` of task ``i`` is the one a run draws for round 0, task ``i``, episode ``e`` with
-``--noise-seed``). ``--jobs N`` measures N tasks at once (one process each); ``--json PATH`` also writes
-every number. ``--suite drawers`` also measures the held-out drawers (rows marked "held out").
+``--noise-seed``). ``--noise-by-task MAP.json`` (``{task: scale}``, as ``--expert.noise_by_task``) gives
+the named tasks their own scale at every level (a task's row then measures its own scale; the level
+is the scale of the others). ``--jobs N`` measures N tasks at once (one process each); ``--json PATH``
+also writes every number. ``--suite drawers`` also measures the held-out drawers (rows marked "held out").
 
 Example (the paper-regime calibration, ``experiments/``): ``--suite metaworld-mt50 --noise 0 0.2 0.4
 0.6 --correlation 0.9 --episodes 20 --jobs 2 --json outputs/expert-success-mt50.json``.
@@ -33,10 +35,16 @@ def measure_task(args: tuple[argparse.Namespace, str, int]) -> dict:
     low, high = env.action_space.low, env.action_space.high
     seeds = range(options.first_seed, options.first_seed + options.episodes)
     result: dict = {"task": task_name, "heldout": task_name in suite.heldout_task_names, "levels": {}}
+    result["own_scale"] = options.task_scales.get(task_name)
+    own = tuple(sorted(options.task_scales.items()))
     for scale in options.noise:
-        noise = ExpertNoise(scale=scale, correlation=options.correlation, seed=options.noise_seed)
+        noise = ExpertNoise(
+            scale=scale, correlation=options.correlation, seed=options.noise_seed, task_scales=own
+        )
         episodes = [
-            run_expert_episode(env, expert, seed, noise=noise.episode_process((0, task_index, e), low, high))
+            run_expert_episode(
+                env, expert, seed, noise=noise.episode_process((0, task_index, e), low, high, task=task_name)
+            )
             for e, seed in enumerate(seeds)
         ]
         lengths = [episode.steps for episode in episodes if episode.success]
@@ -61,9 +69,16 @@ def main() -> None:
     parser.add_argument("--noise-seed", type=int, default=0)
     parser.add_argument("--jobs", type=int, default=1, help="tasks measured at once (processes)")
     parser.add_argument("--json", type=Path, default=None, help="also write every number here")
+    parser.add_argument(
+        "--noise-by-task", type=Path, default=None, help="JSON {task: scale}: these tasks' own noise scale"
+    )
     options = parser.parse_args()
     suite = make_suite(options.suite, placement=options.placement)
     tasks = suite.task_names + suite.heldout_task_names
+    options.task_scales = json.loads(options.noise_by_task.read_text()) if options.noise_by_task else {}
+    unknown = sorted(set(options.task_scales) - set(tasks))
+    if unknown:
+        parser.error(f"--noise-by-task names {', '.join(unknown)}, not a task of {options.suite}")
     work = [(options, task, index) for index, task in enumerate(tasks)]
     if options.jobs > 1:
         with multiprocessing.get_context("fork").Pool(options.jobs) as pool:
@@ -75,6 +90,7 @@ def main() -> None:
     print("|---|" + "---:|---:|" * len(levels))
     for row in results:
         label = f"{row['task']} (held out)" if row["heldout"] else row["task"]
+        label += f" (own noise {row['own_scale']})" if row["own_scale"] is not None else ""
         cells = []
         for level in levels:
             measured = row["levels"][level]

@@ -71,6 +71,24 @@ def test_each_episode_has_its_own_reproducible_noise():
     assert not np.allclose(draws((1, 0, 0)), draws((1, 0, 0), other_seed))
 
 
+def test_a_task_of_its_own_gets_its_own_scale_and_a_zero_scale_draws_nothing():
+    noise = ExpertNoise(scale=0.2, correlation=0.5, seed=1, task_scales=(("hard", 0.0), ("easy", 0.6)))
+    assert noise.active and noise.scale_for("easy") == 0.6 and noise.scale_for("other") == 0.2
+    assert noise.episode_process((0, 0, 0), LOW, HIGH, task="hard") is None
+    easy = noise.episode_process((0, 0, 0), LOW, HIGH, task="easy")
+    assert np.stack([easy.sample(4).copy() for _ in range(20_000)]).std() == pytest.approx(0.6, rel=0.05)
+    # the same episode's draws, scaled: a task's scale changes no other random draw
+    other = noise.episode_process((0, 0, 0), LOW, HIGH, task="other")
+    np.testing.assert_allclose(
+        other.sample(4) * 3.0, noise.episode_process((0, 0, 0), LOW, HIGH, "easy").sample(4)
+    )
+    assert (
+        ExpertNoise(task_scales=(("easy", 0.1),)).active and not ExpertNoise(task_scales=(("a", 0.0),)).active
+    )
+    with pytest.raises(ValueError, match="expert.noise_by_task: easy's noise must be finite, >= 0, got -1"):
+        ExpertNoise(task_scales=(("easy", -1.0),))
+
+
 @pytest.mark.parametrize("labels", ["noisy", "clean"])
 def test_perturb_clips_to_the_bounds_and_labels_as_asked(labels):
     process = ExpertNoise(scale=5.0, seed=0, labels=labels).episode_process((0, 0, 0), LOW, HIGH)
@@ -134,7 +152,7 @@ def test_a_noisy_run_records_its_noise_and_labels_as_asked(tmp_path, labels):
     out = _run(tmp_path, labels, *noisy, f"--expert.labels={labels}")
     config = json.loads((out / "config.json").read_text())
     expected = {"noise": 0.5, "noise_correlation": 0.8, "noise_seed": 4, "labels": labels, "path": None}
-    expected |= {"type": None, "min_success": None, "success_episodes": 20}
+    expected |= {"type": None, "min_success": None, "success_episodes": 20, "noise_by_task": None}
     assert config["expert"] == expected
     record = json.loads((out / "rounds" / "round-001" / "meta" / "mtdagger.json").read_text())
     assert record["config"]["expert"] == expected
@@ -239,3 +257,56 @@ def test_bad_or_unmet_task_rules_are_refused_before_anything_is_written(tmp_path
     assert main(["run", *TOY, *options, f"--output_dir={out}"]) == 2
     error = capsys.readouterr().err
     assert message in error and len(error.strip().splitlines()) == 1 and not out.exists()
+
+
+def test_noise_by_task_perturbs_only_the_named_tasks_and_is_recorded(tmp_path):
+    by_task = ["--expert.noise_by_task={toy-right: 0.5}", "--expert.noise_correlation=0.9"]
+    out = _run(tmp_path, "by-task", *by_task)
+    config = json.loads((out / "config.json").read_text())
+    assert config["expert"]["noise_by_task"] == {"toy-right": 0.5} and config["expert"]["noise"] == 0.0
+    record = json.loads((out / "rounds" / "round-001" / "meta" / "mtdagger.json").read_text())
+    assert record["config"]["expert"]["noise_by_task"] == {"toy-right": 0.5}
+    plain = _run(tmp_path, "plain")
+    frames = {name: _frames(run, "round-000") for name, run in (("by-task", out), ("plain", plain))}
+    right = {name: _task_index(run) == 1 for name, run in (("by-task", out), ("plain", plain))}  # toy-right
+    assert make_suite("toy").task_names[1] == "toy-right"
+    for name in ("observation.state", "executed_action"):  # round 0: the experts' episodes alone
+        others = [frames[run][name][~right[run]] for run in frames]
+        np.testing.assert_array_equal(*others)
+        named = [frames[run][name][right[run]] for run in frames]
+        assert named[0].shape != named[1].shape or not np.allclose(*named)
+    # the other tasks' experts are the plain ones, so the named task's noise is the whole difference
+    assert main(["verify", f"--experiment_dir={out}"]) == 0
+
+
+def test_noise_by_task_resumes_only_with_the_same_tasks_and_scales(tmp_path, capsys):
+    out = _run(tmp_path, "run", "--expert.noise_by_task={toy-right: 0.5}")
+    args = [*TOY, f"--output_dir={out}", "--resume=true"]
+    assert main(["run", *args, "--expert.noise_by_task={toy-right: 0.4}"]) == 2
+    assert "expert.noise_by_task" in capsys.readouterr().err
+    assert main(["run", *args]) == 2
+    assert main(["run", *args, "--expert.noise_by_task={toy-right: 0.5}"]) == 0
+
+
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        (
+            "{toy-middle: 0.3}",
+            "--expert.noise_by_task names toy-middle, not a task of suite toy (its tasks: ",
+        ),
+        ("{toy-right: -0.3}", "expert.noise_by_task: toy-right's noise must be finite, >= 0, got -0.3"),
+    ],
+)
+def test_bad_noise_by_task_is_refused_in_one_line_before_anything_is_written(
+    tmp_path, capsys, option, message
+):
+    out = tmp_path / "out"
+    assert main(["run", *TOY, f"--expert.noise_by_task={option}", f"--output_dir={out}"]) == 2
+    error = capsys.readouterr().err
+    assert message in error and len(error.strip().splitlines()) == 1 and not out.exists()
+
+
+def _task_index(run_dir) -> np.ndarray:
+    tables = [pq.read_table(path) for path in sorted(run_dir.glob("rounds/round-000/data/*/*.parquet"))]
+    return np.array(pa.concat_tables(tables).column("task_index").to_pylist())

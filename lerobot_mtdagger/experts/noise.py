@@ -9,8 +9,9 @@ expert act the way a stochastic RL policy acts: at step ``t`` of an episode the 
     e_0 = sigma * z_0,   e_t = rho * e_(t-1) + sqrt(1 - rho^2) * sigma * z_t,   z_t ~ N(0, I)
 
 where ``mu`` is the wrapped expert, ``low``/``high`` the env's action bounds, ``sigma`` the noise
-scale and ``rho`` its step-to-step correlation: every ``e_t`` has standard deviation ``sigma`` (an
-AR(1) process, the discretised Ornstein-Uhlenbeck noise of DDPG; ``rho = 0`` is white noise).
+scale (one for every task, or a task's own: ``task_scales``) and ``rho`` its step-to-step
+correlation: every ``e_t`` has standard deviation ``sigma`` (an AR(1) process, the discretised
+Ornstein-Uhlenbeck noise of DDPG; ``rho = 0`` is white noise).
 
 The stored label is, by ``labels``:
 
@@ -50,12 +51,16 @@ class ExpertNoise:
         seed: Seed of the noise, apart from the run's seed (the same demonstrations' noise can be
             redrawn, or kept while the run's seed changes).
         labels: ``noisy`` (the label is the executed action) or ``clean`` (the expert's own action).
+        task_scales: ``(task, scale)`` pairs: these tasks' own noise scale instead of ``scale`` (one
+            scale cannot put every expert at the same success: easy tasks' experts shrug off a noise
+            that breaks a grasping task's).
     """
 
     scale: float = 0.0
     correlation: float = 0.0
     seed: int = 0
     labels: str = "noisy"
+    task_scales: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.scale) and self.scale >= 0):
@@ -66,36 +71,59 @@ class ExpertNoise:
             raise ValueError(f"expert.noise_seed must be >= 0, got {self.seed}.")
         if self.labels not in LABEL_CHOICES:
             raise ValueError(f"expert.labels must be one of {list(LABEL_CHOICES)}, got {self.labels!r}.")
+        for task, scale in self.task_scales:
+            if not (math.isfinite(scale) and scale >= 0):
+                raise ValueError(f"expert.noise_by_task: {task}'s noise must be finite, >= 0, got {scale}.")
 
     @property
     def active(self) -> bool:
-        """Whether any noise is added."""
-        return self.scale > 0.0
+        """Whether any task's expert gets noise."""
+        return self.scale > 0.0 or any(scale > 0.0 for _, scale in self.task_scales)
+
+    def scale_for(self, task: str | None) -> float:
+        """The noise scale of ``task``'s expert: its own (``task_scales``), else ``scale``."""
+        return dict(self.task_scales).get(task, self.scale) if task is not None else self.scale
 
     def episode_process(
-        self, episode_key: Sequence[int], low: np.ndarray, high: np.ndarray
+        self, episode_key: Sequence[int], low: np.ndarray, high: np.ndarray, task: str | None = None
     ) -> ActionNoise | None:
-        """The noise of one episode (None when off).
+        """The noise of one episode (None when this task's expert gets none).
 
         Args:
             episode_key: ``(round, task, episode)``: which episode, for its own generator.
             low: The env's lower action bounds.
             high: The env's upper action bounds.
+            task: The task's name, for its own scale (``task_scales``); None: ``scale``.
         """
-        if not self.active:
+        scale = self.scale_for(task)
+        if scale <= 0.0:
             return None
         entropy = [self.seed, NOISE_STREAM, *(int(part) for part in episode_key)]
-        return ActionNoise(self, np.random.default_rng(np.random.SeedSequence(entropy)), low, high)
+        return ActionNoise(self, np.random.default_rng(np.random.SeedSequence(entropy)), low, high, scale)
 
 
 class ActionNoise:
     """One episode's correlated noise process (``ExpertNoise`` gives the formula)."""
 
     def __init__(
-        self, noise: ExpertNoise, rng: np.random.Generator, low: np.ndarray, high: np.ndarray
+        self,
+        noise: ExpertNoise,
+        rng: np.random.Generator,
+        low: np.ndarray,
+        high: np.ndarray,
+        scale: float | None = None,
     ) -> None:
-        """Starts the process; the first ``perturb`` draws ``e_0``."""
+        """Starts the process; the first ``perturb`` draws ``e_0``.
+
+        Args:
+            noise: The noise's settings.
+            rng: The episode's own generator.
+            low: The env's lower action bounds.
+            high: The env's upper action bounds.
+            scale: This task's ``sigma`` (``ExpertNoise.scale_for``); None: ``noise.scale``.
+        """
         self.noise = noise
+        self.scale = noise.scale if scale is None else scale
         self.rng = rng
         self.low = np.asarray(low, dtype=np.float32)
         self.high = np.asarray(high, dtype=np.float32)
@@ -103,7 +131,7 @@ class ActionNoise:
 
     def sample(self, size: int) -> np.ndarray:
         """The next noise vector ``e_t`` (float64, standard deviation ``scale`` per component)."""
-        sigma, rho = self.noise.scale, self.noise.correlation
+        sigma, rho = self.scale, self.noise.correlation
         draw = self.rng.standard_normal(size)
         if self._state is None:
             self._state = sigma * draw

@@ -45,6 +45,7 @@ from lerobot_mtdagger.envs.drawers.variants import LEGACY_PLACEMENT
 from lerobot_mtdagger.experts.command_line import command_line_experts
 from lerobot_mtdagger.experts.noise import ExpertNoise
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
+from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import cache_dataclass_sources
 from lerobot_mtdagger.utils.paths import check_output_dir
 from lerobot_mtdagger.utils.ray_session import check_ray_address, import_ray
@@ -439,6 +440,9 @@ class ExpertConfig:
     Attributes:
         noise: Standard deviation of the noise on each action component, in action units (actions
             lie in [-1, 1]); 0: no noise.
+        noise_by_task: Some tasks' own noise instead of ``noise``, by task name (``--expert.noise_by_task=
+            '{assembly-v3: 0.05, reach-v3: 0.6}'``): one level cannot put every expert at the same success.
+            None: ``noise`` for every task.
         noise_correlation: Step-to-step correlation of the noise, in [0, 1) (0: white noise).
         noise_seed: Seed of the noise, apart from ``--seed``.
         labels: What a frame stores as the expert's label: ``noisy`` (the executed action: the
@@ -458,6 +462,7 @@ class ExpertConfig:
     noise_correlation: float = 0.0
     noise_seed: int = 0
     labels: str = "noisy"
+    noise_by_task: dict[str, float] | None = None
     path: str | None = None
     type: str | None = None
     min_success: float | None = None
@@ -484,13 +489,23 @@ class ExpertConfig:
         Raises:
             UserError: On a path or type that gives no valid expert for every task (one line).
         """
+        unknown = sorted(set(self.noise_by_task or {}) - set(suite.task_names))
+        if unknown:
+            raise UserError(
+                f"--expert.noise_by_task names {', '.join(unknown)}, not a task of suite {suite.name} "
+                f"(its tasks: {', '.join(suite.task_names)}): fix the names or --suite.tasks."
+            )
         named = command_line_experts(suite, self.path, self.type)
         return named.with_expert_noise(self.settings())
 
     def settings(self) -> ExpertNoise:
         """The ``ExpertNoise`` these options describe."""
         return ExpertNoise(
-            scale=self.noise, correlation=self.noise_correlation, seed=self.noise_seed, labels=self.labels
+            scale=self.noise,
+            correlation=self.noise_correlation,
+            seed=self.noise_seed,
+            labels=self.labels,
+            task_scales=tuple(sorted((self.noise_by_task or {}).items())),
         )
 
 

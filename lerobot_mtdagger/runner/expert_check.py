@@ -89,7 +89,7 @@ def expert_success(suite: Any, task_index: int, episodes: int, seed: int) -> flo
             process = None
             if noise is not None:  # a key of its own length: none of the run's episodes' noise
                 key = (EXPERT_CHECK_STREAM, 0, task_index, episode)
-                process = noise.episode_process(key, env.action_space.low, env.action_space.high)
+                process = noise.episode_process(key, env.action_space.low, env.action_space.high, task=task)
             successes += run_expert_episode(env, expert, reset_seed, noise=process).success
     finally:
         env.close()

@@ -238,7 +238,8 @@ class RolloutWorker:
         noise = None
         if expert is not None and self.suite.expert_noise is not None:
             key = (self.rules.round_index, spec.task_index, spec.episode)
-            noise = self.suite.expert_noise.episode_process(key, env.action_space.low, env.action_space.high)
+            bounds = (env.action_space.low, env.action_space.high)
+            noise = self.suite.expert_noise.episode_process(key, *bounds, task=task_name)
         return _Running(
             spec=spec,
             env=env,
