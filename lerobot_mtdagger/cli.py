@@ -21,6 +21,9 @@ Commands:
         and a summary with paired differences.
     push: round datasets (tag ``round-{k:03d}`` each) and round policies to the Hub
         (``--experiment_dir``, ``--repo_id``, ``--policy_repo_id``).
+    plan: the next collection session's episodes per task from LeRobot datasets of the policy's
+        episodes (``--datasets``, ``--budget`` or ``--budget_minutes``, ``--output``, ``--previous``);
+        ``--verify=PLAN`` recomputes a plan from its recorded inputs (``planning/plan.py``).
     demo: run the performance-aware scheduler on synthetic tasks and print each round's allocation
         (no simulator, no policy; shows how the methods split a budget).
 """
@@ -40,6 +43,7 @@ import numpy as np
 
 from lerobot_mtdagger.datasets.hub import PushConfig, push_command
 from lerobot_mtdagger.envs.config import DEFAULT_IMAGE_SIZE, DEFAULT_NUM_POINTS, SuiteConfig
+from lerobot_mtdagger.planning.plan import PlanConfig
 from lerobot_mtdagger.runner.configs import (
     RUN_OPTION_RENAMES,
     SUITE_OPTION_RENAMES,
@@ -676,6 +680,25 @@ def compare_command(config: CompareConfig, run_args: list[str]) -> list[dict]:
     return rows
 
 
+def plan_command(config: PlanConfig) -> dict | list[str]:
+    """Prints and writes the next session's plan, or (``--verify``) checks a plan; exits 1 on a problem."""
+    from lerobot_mtdagger.planning.plan import make_plan, plan_table, verify_plan, write_plan
+
+    if config.verify is not None:
+        problems = verify_plan(config.verify)
+        for problem in problems:
+            print(f"PROBLEM {problem}")
+        print(f"verified plan {config.verify}: {len(problems)} problem(s)")
+        if problems:
+            raise SystemExit(1)
+        return problems
+    plan = make_plan(config)
+    write_plan(plan, config.output)
+    print(plan_table(plan))
+    print(f"plan file: {config.output}")
+    return plan
+
+
 COMMANDS: dict[str, tuple[type, Callable]] = {
     "run": (RunConfig, run_experiment),
     "compare": (CompareConfig, compare_command),
@@ -685,6 +708,7 @@ COMMANDS: dict[str, tuple[type, Callable]] = {
     "merge": (MergeConfig, merge_command),
     "push": (PushConfig, push_command),
     "report": (ReportConfig, report_command),
+    "plan": (PlanConfig, plan_command),
     "demo": (DemoConfig, run_demo),
 }
 

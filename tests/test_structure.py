@@ -210,6 +210,7 @@ def test_verify_loads_policies_without_the_rollout_stack():
 WING_RANKS = {
     "lerobot_mtdagger.cli": 6,
     "lerobot_mtdagger.studies": 5,
+    "lerobot_mtdagger.planning": 5,
     "lerobot_mtdagger.runner": 4,
     "lerobot_mtdagger.envs": 3,
     "lerobot_mtdagger.experts": 3,
