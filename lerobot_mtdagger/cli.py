@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lerobot_mtdagger.datasets.hub import PushConfig, push_command
+from lerobot_mtdagger.datasets.push_config import PushConfig
 from lerobot_mtdagger.envs.config import DEFAULT_IMAGE_SIZE, DEFAULT_NUM_POINTS, SuiteConfig
 from lerobot_mtdagger.planning.plan import PlanConfig
 from lerobot_mtdagger.runner.configs import (
@@ -680,6 +680,13 @@ def compare_command(config: CompareConfig, run_args: list[str]) -> list[dict]:
     return rows
 
 
+def push_command(config: PushConfig) -> dict[str, dict[str, str]]:
+    """Pushes an experiment's rounds (and policies) to the Hub (``datasets/hub.py``)."""
+    from lerobot_mtdagger.datasets.hub import push_command as push
+
+    return push(config)
+
+
 def plan_command(config: PlanConfig) -> dict | list[str]:
     """Prints and writes the next session's plan, or (``--verify``) checks a plan; exits 1 on a problem."""
     from lerobot_mtdagger.planning.plan import make_plan, plan_table, verify_plan, write_plan
@@ -800,7 +807,9 @@ def run_command(command: str, options: list[str]) -> None:
     """
     config_class, function = COMMANDS[command]
     passed: list[str] = []
-    if command == "compare":  # compare's own options; every other option goes to each run
+    if command == "compare" and ("--help" in options or "-h" in options):
+        options = ["--help"]  # compare's own options; `run --help` lists those passed to each run
+    elif command == "compare":  # compare's own options; every other option goes to each run
         options, passed = split_arguments(options)
     renamed = renamed_option_error(passed if command == "compare" else options, OPTION_RENAMES.get(command))
     if renamed is not None:

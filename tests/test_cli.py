@@ -121,3 +121,67 @@ def test_eval_takes_the_observation_options_the_policy_was_trained_with(inputs, 
     runner = SimpleNamespace(policy=SimpleNamespace(config=SimpleNamespace(input_features=features)))
     options = observation_options(runner, EvalConfig(policy_path="p", suite=SuiteConfig(**given)).suite)
     assert (options["obs_mode"], options["num_points"], options["image_size"]) == expected
+
+
+COMMAND_OPTIONS = {
+    "run": [
+        "--preset",
+        "--suite.name",
+        "--dagger.rounds",
+        "--scheduler.R0",
+        "--policy.type",
+        "--expert.noise",
+    ],
+    "compare": ["--methods", "--seeds", "--bc_budgets", "--jobs", "--cores", "--launcher"],
+    "eval": ["--policy_path", "--suite.name", "--episodes", "--output"],
+    "shift": ["--policy_path", "--episodes"],
+    "verify": ["--experiment_dir"],
+    "merge": ["--experiment_dir", "--output", "--up_to_round"],
+    "push": ["--experiment_dir", "--repo_id", "--policy_repo_id"],
+    "report": ["--experiments", "--compare_dir", "--results", "--records"],
+    "plan": ["--datasets", "--budget", "--budget_minutes", "--previous", "--verify", "--scheduler.type"],
+    "demo": ["--num_tasks", "--rounds", "--scheduler.temperature"],
+}
+
+
+@pytest.mark.parametrize("command", sorted(COMMAND_OPTIONS))
+def test_each_commands_help_lists_its_own_options_one_line_each(capsys, command):
+    with pytest.raises(SystemExit) as exited:
+        main([command, "--help"])
+    assert exited.value.code == 0
+    page = capsys.readouterr().out
+    assert page.startswith(f"usage: lerobot-mtdagger {command} ")
+    lines = {line.split()[0].split("=")[0]: line for line in page.splitlines() if line.startswith("  --")}
+    for option in COMMAND_OPTIONS[command]:
+        assert option in lines, (option, sorted(lines))
+        help_text = lines[option].split(None, 1)[1] if len(lines[option].split(None, 1)) > 1 else ""
+        assert help_text and not help_text.startswith("(default"), lines[option]  # a line of help, not bare
+    assert "Attributes:" not in page and "def " not in page and "lambda" not in page  # no source text
+    if command == "compare":  # its own options, and where the run options are listed
+        assert "--dagger.rounds" not in page and "lerobot-mtdagger run --help" in page
+
+
+def test_run_help_names_lerobot_students_and_describes_one_when_asked(capsys):
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    page = capsys.readouterr().out
+    assert "--policy.type={mtdagger,act,diffusion}" in page and "--policy.chunk_size" not in page
+    with pytest.raises(SystemExit):
+        main(["run", "--policy.type=act", "--help"])
+    assert "--policy.chunk_size=INT" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "args", [["run", "--help"], ["compare", "--help"], ["run", "--preset=nope"], ["plan", "--help"]]
+)
+def test_help_and_a_refused_option_import_neither_torch_nor_lerobot(args):
+    """What makes them answer in under a second instead of 9-18 s (``benchmarks/bench_cli_startup.sh``)."""
+    code = (
+        "import sys\nfrom lerobot_mtdagger.cli import main\n"
+        f"try:\n    main({args!r})\nexcept SystemExit:\n    pass\n"
+        "print(sorted(m for m in ('torch', 'lerobot') if m in sys.modules))"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
+    )
+    assert result.stdout.strip().splitlines()[-1] == "[]", result.stdout[-2000:]

@@ -28,13 +28,13 @@ import os
 import shutil
 import tempfile
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from huggingface_hub import DatasetCardData, HfApi
 
 from lerobot_mtdagger.datasets.config_layout import option
+from lerobot_mtdagger.datasets.push_config import PushConfig
 from lerobot_mtdagger.datasets.records import PhaseRecord, RoundRecord
 from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, ExperimentDir, round_name
 from lerobot_mtdagger.datasets_cards import card_template
@@ -391,35 +391,6 @@ def push_experiment(
 # -------------------------------------------------------------------------------------------------
 # Command
 # -------------------------------------------------------------------------------------------------
-
-
-@dataclass
-class PushConfig:
-    """Options of ``lerobot-mtdagger push``: an experiment to the Hub, round k as revision ``round-{k:03d}``.
-
-    Attributes:
-        experiment_dir: The experiment's output directory.
-        repo_id: Hub dataset repo for the rounds, ``owner/name``.
-        policy_repo_id: Hub model repo for the trained policies (None: policies are not pushed).
-        private: Whether repos created by the push are private.
-    """
-
-    experiment_dir: Path | None = None
-    repo_id: str | None = None
-    policy_repo_id: str | None = None
-    private: bool = False
-
-    def __post_init__(self) -> None:
-        if self.experiment_dir is None:
-            raise ValueError(
-                "--experiment_dir is required: pass the --output_dir of a `lerobot-mtdagger run`, "
-                "e.g. --experiment_dir=outputs/mt10."
-            )
-        if self.repo_id is None:
-            raise ValueError(
-                "--repo_id is required: the Hub dataset repo to push the rounds to, "
-                "e.g. --repo_id=<user>/mtdagger-mt10."
-            )
 
 
 def push_command(config: PushConfig) -> dict[str, dict[str, str]]:

@@ -53,7 +53,7 @@ PLAN_VERSION = 1
 
 @dataclass
 class PlanConfig:
-    """Options of ``lerobot-mtdagger plan``.
+    """Options of ``lerobot-mtdagger plan``: the next session's episodes per task, from LeRobot datasets.
 
     Attributes:
         datasets: LeRobot datasets of this session's policy episodes: local folders or Hub repo ids

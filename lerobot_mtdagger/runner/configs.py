@@ -30,11 +30,13 @@ a step (classic DAgger; the paper's text is ambiguous): 0.5 in the first DAgger 
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import functools
 import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -42,7 +44,6 @@ from typing import Any
 from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
 from lerobot_mtdagger.envs.config import DEFAULT_NUM_POINTS, SuiteConfig
 from lerobot_mtdagger.envs.drawers.variants import LEGACY_PLACEMENT
-from lerobot_mtdagger.experts.command_line import command_line_experts
 from lerobot_mtdagger.experts.noise import ExpertNoise
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
 from lerobot_mtdagger.utils.errors import UserError
@@ -139,6 +140,42 @@ def lerobot_students() -> dict[str, type]:
     return {"act": _lerobot_student(ACTConfig), "diffusion": _lerobot_student(DiffusionConfig)}
 
 
+_LEROBOT_STUDENTS_PARSED: contextvars.ContextVar[bool] = contextvars.ContextVar(
+    "lerobot_students_parsed", default=True
+)
+"""Whether the option parser offers LeRobot's students (building it for them imports LeRobot and torch)."""
+
+
+def names_lerobot_student(options: Sequence[str]) -> bool:
+    """Whether command-line options may choose a LeRobot student.
+
+    They may with a ``--policy.type`` other than ``mtdagger``, or a ``--config_path`` file.
+    """
+    for position, option in enumerate(options):
+        name, separator, value = option.partition("=")
+        if name == "--config_path":
+            return True
+        if name == "--policy.type":
+            if not separator:
+                value = options[position + 1] if position + 1 < len(options) else ""
+            return value != "mtdagger"
+    return False
+
+
+@contextlib.contextmanager
+def students_for(options: Sequence[str]) -> Iterator[None]:
+    """Offers LeRobot's students to the parser only if ``options`` may name one.
+
+    ``--help`` and a refused option then answer without importing LeRobot and torch (seconds on a
+    small machine).
+    """
+    token = _LEROBOT_STUDENTS_PARSED.set(names_lerobot_student(options))
+    try:
+        yield
+    finally:
+        _LEROBOT_STUDENTS_PARSED.reset(token)
+
+
 class StudentOptions:
     """The student policy and its options: ``--policy.type`` (draccus choice type; default ``mtdagger``).
 
@@ -153,7 +190,12 @@ class StudentOptions:
 
     @classmethod
     def get_known_choices(cls) -> dict[str, type]:
-        """Every ``--policy.type`` and its options class."""
+        """Every ``--policy.type`` and its options class.
+
+        ``mtdagger`` alone while options that name no LeRobot student are parsed (``students_for``).
+        """
+        if not _LEROBOT_STUDENTS_PARSED.get():
+            return {"mtdagger": PolicyOptions}
         return {"mtdagger": PolicyOptions, **lerobot_students()}
 
     @classmethod
@@ -440,9 +482,9 @@ class ExpertConfig:
     Attributes:
         noise: Standard deviation of the noise on each action component, in action units (actions
             lie in [-1, 1]); 0: no noise.
-        noise_by_task: Some tasks' own noise instead of ``noise``, by task name (``--expert.noise_by_task=
-            '{assembly-v3: 0.05, reach-v3: 0.6}'``): one level cannot put every expert at the same success.
-            None: ``noise`` for every task.
+        noise_by_task: Some tasks' own noise instead of ``noise``, by task name, e.g.
+            ``'{assembly-v3: 0.05, reach-v3: 0.6}'`` (one level cannot put every expert at the same
+            success). None: ``noise`` for every task.
         noise_correlation: Step-to-step correlation of the noise, in [0, 1) (0: white noise).
         noise_seed: Seed of the noise, apart from ``--seed``.
         labels: What a frame stores as the expert's label: ``noisy`` (the executed action: the
@@ -495,6 +537,8 @@ class ExpertConfig:
                 f"--expert.noise_by_task names {', '.join(unknown)}, not a task of suite {suite.name} "
                 f"(its tasks: {', '.join(suite.task_names)}): fix the names or --suite.tasks."
             )
+        from lerobot_mtdagger.experts.command_line import command_line_experts  # LeRobot and torch
+
         named = command_line_experts(suite, self.path, self.type)
         return named.with_expert_noise(self.settings())
 
@@ -626,6 +670,25 @@ class RunConfig:
     seed: int = 0
     resume: bool = False
     progress: bool = True
+
+    @staticmethod
+    def help_choices(options: Sequence[str]) -> Any:
+        """``--help``'s view of the student choices: LeRobot's named, described only when asked for."""
+        asked = names_lerobot_student(options)
+
+        def choices(group_class: type) -> dict[str, type | None] | None:
+            if group_class is not StudentOptions:
+                return None
+            if asked:
+                return dict(StudentOptions.get_known_choices())
+            return {"mtdagger": PolicyOptions, **dict.fromkeys(LEROBOT_STUDENT_TYPES)}
+
+        return choices
+
+    @staticmethod
+    def parsing_context(options: Sequence[str]) -> contextlib.AbstractContextManager[None]:
+        """What ``parse_options`` parses these options under (``students_for``)."""
+        return students_for(options)
 
     def __post_init__(self) -> None:
         if self.preset not in PRESETS:

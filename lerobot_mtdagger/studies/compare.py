@@ -36,6 +36,7 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import ClassVar
 
 from lerobot_mtdagger.runner.configs import RunConfig, default_worker_count
 from lerobot_mtdagger.scheduler import scheduling_methods
@@ -73,6 +74,11 @@ class CompareConfig:
         ray_gpus_per_run: GPUs each run holds with ``launcher=ray`` (0: none; pass
             ``--policy.device=cuda`` for the runs to use them).
     """
+
+    HELP_FOOTER: ClassVar[str] = (
+        "Every other option goes to each run (`lerobot-mtdagger run --help` lists them), except --seed, "
+        "--mode, --scheduler.type, --output_dir and --resume, which compare sets per run."
+    )
 
     methods: list[str] = field(default_factory=lambda: ["bc", "uniform", "need", "gain"])
     seeds: list[int] = field(default_factory=lambda: [0, 1, 2])

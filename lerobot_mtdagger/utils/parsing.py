@@ -102,6 +102,20 @@ def missing_config_file(options: Sequence[str]) -> None:
             )
 
 
+def command_help(config_class: type, options: Sequence[str], prog: str) -> str:
+    """The ``--help`` page of a command: one line per option (``utils/help.py``).
+
+    A config may name costly choices without importing them (``help_choices(options)``) and add a
+    footer (``HELP_FOOTER``).
+    """
+    from lerobot_mtdagger.utils.help import option_lines, render_help, summary_of
+
+    chooser = getattr(config_class, "help_choices", None)
+    choices = chooser(options) if chooser is not None else None
+    lines = list(option_lines(config_class, options, choices=choices))
+    return render_help(prog, summary_of(config_class), lines, getattr(config_class, "HELP_FOOTER", ""))
+
+
 def parse_options(config_class: type[T], options: Sequence[str], prog: str) -> T:
     """Parses command-line options into a config, every failure a ``UserError``.
 
@@ -109,14 +123,23 @@ def parse_options(config_class: type[T], options: Sequence[str], prog: str) -> T
         UserError: Naming the option at fault (draccus' own message, or the config's check).
         SystemExit: With status 0 after ``--help``.
     """
+    if "--help" in options or "-h" in options:
+        print(command_help(config_class, options, prog))
+        raise SystemExit(0)
     unparsable = unparsable_option(options)
     if unparsable is not None:
         raise UserError(unparsable)
     missing_config_file(options)
     cache_dataclass_sources()
     argparse_output = io.StringIO()
+    # a config may narrow what its parser offers for these options (RunConfig: no LeRobot student
+    # unless one may be named), so that --help and refusals import no heavy library
+    narrowing = getattr(config_class, "parsing_context", None)
     try:
-        with contextlib.redirect_stderr(argparse_output):
+        with (
+            contextlib.redirect_stderr(argparse_output),
+            narrowing(options) if narrowing is not None else contextlib.nullcontext(),
+        ):
             return draccus.parse(config_class=config_class, args=list(options), prog=prog)
     except draccus.utils.ParsingError as error:
         # draccus hides the config's own ValueError (which names the field and the fix) as the cause.
