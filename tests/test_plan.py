@@ -197,9 +197,6 @@ def test_bad_input_is_refused_in_one_line_and_writes_nothing(tmp_path, capsys):
         tmp_path, capsys, f"--datasets=[{tmp_path}]", "--budget=5"
     )
     assert "Give one budget" in _refused(tmp_path, capsys, f"--datasets=[{data}]")
-    assert "which plan does not measure" in _refused(
-        tmp_path, capsys, f"--datasets=[{data}]", "--budget=5", "--scheduler.type=gain"
-    )
     assert "does not cover n_min=1 episode(s) per task" in _refused(
         tmp_path, capsys, f"--datasets=[{data}]", "--budget_minutes=0.01"
     )
@@ -258,4 +255,47 @@ def test_operator_labels_give_success_to_a_rollout_that_records_none(tmp_path, c
     labels.write_text(json.dumps({str(rollouts): {"0": "yes"}}))
     assert "is not {dataset: {episode: true|false}} JSON" in _refused(
         tmp_path, capsys, f"--datasets=[{rollouts}]", "--budget=8", f"--success_labels={labels}"
+    )
+
+
+@pytest.mark.parametrize("line", ["0.4.4", "0.6.1"])
+def test_the_gain_is_the_loss_drop_the_runner_measured_for_the_same_policies_and_data(tmp_path, capsys, line):
+    """A run's two phases, read by plan as a user's policies and datasets, give the run's own losses."""
+    experiment = Path(__file__).parent / "data" / f"experiment-lerobot-{line}"
+    rounds = [experiment / "rounds" / name for name in ("round-000", "round-001")]
+    options = [
+        f"--datasets=[{rounds[1]}]",
+        f"--loss_datasets=[{rounds[0]},{rounds[1]}]",
+        f"--policy_path={experiment / 'policies' / 'round-001'}",
+        f"--previous_policy_path={experiment / 'policies' / 'round-000'}",
+        "--scheduler.type=gain",
+        "--budget=9",
+    ]
+    status, made = plan(tmp_path, "gain", *options)
+    assert status == 0
+    phase = json.loads((experiment / "policies" / "round-001" / "training.json").read_text())
+    np.testing.assert_allclose(made["gain"]["loss"], phase["loss_end"], rtol=1e-5)
+    np.testing.assert_allclose(made["gain"]["loss_previous"], phase["loss_previous"], rtol=1e-5)
+    assert made["gain"]["frames"] == phase["loss_samples"]
+    drops = np.maximum(np.array(phase["loss_previous"]) - np.array(phase["loss_end"]), 0)
+    np.testing.assert_allclose(made["allocation"]["gain"], drops, rtol=1e-4)
+    counts = made["allocation"]["episodes_per_task"]
+    assert counts[int(np.argmax(drops))] == max(counts)  # the task that improved most gets the most
+    assert main(["plan", f"--verify={tmp_path / 'gain.json'}"]) == 0
+    edited = json.loads((tmp_path / "gain.json").read_text())
+    edited["gain"]["loss"][0] = 0.0  # as if the new policy had fitted the first task perfectly
+    (tmp_path / "gain.json").write_text(json.dumps(edited))
+    capsys.readouterr()
+    with pytest.raises(SystemExit):
+        main(["plan", f"--verify={tmp_path / 'gain.json'}"])
+    assert "gain: recorded" in capsys.readouterr().out
+
+
+def test_the_gain_needs_both_policies(tmp_path, capsys):
+    data = record(tmp_path / "session-1", SESSION_1)
+    assert "needs each task's loss drop" in _refused(
+        tmp_path, capsys, f"--datasets=[{data}]", "--budget=5", "--scheduler.type=gain"
+    )
+    assert "give --policy_path (trained since the last session) and --previous_policy_path" in _refused(
+        tmp_path, capsys, f"--datasets=[{data}]", "--budget=5", f"--policy_path={tmp_path}"
     )

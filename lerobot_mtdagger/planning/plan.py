@@ -73,7 +73,12 @@ class PlanConfig:
             no success. Datasets it does not name are read from their columns.
         intervention_key: The column marking frames a person controlled (episodes with any are not
             counted as the policy's); a dataset without it has only policy episodes.
-        scheduler: ``--scheduler.type=need|need_raw|uniform`` and its hyperparameters (as ``run``).
+        scheduler: ``--scheduler.type=need|need_raw|gain|uniform`` and its hyperparameters (as ``run``).
+        policy_path: The policy trained since the last session (a LeRobot pretrained folder): with
+            ``previous_policy_path``, each task's performance gain, ``max(0, L_previous - L_policy)``
+            over ``loss_datasets`` (``planning/loss.py``); needed by ``--scheduler.type=gain``.
+        previous_policy_path: The policy before that training (the one that collected the session).
+        loss_datasets: The training datasets the losses are measured on (empty: ``datasets``).
         verify: A plan file to check instead: recomputed from its recorded inputs.
     """
 
@@ -88,6 +93,9 @@ class PlanConfig:
     success_labels: Path | None = None
     intervention_key: str = INTERVENTION_KEY
     scheduler: SchedulerConfig = field(default_factory=NeedSchedulerConfig)
+    policy_path: Path | None = None
+    previous_policy_path: Path | None = None
+    loss_datasets: list[str] = field(default_factory=list)
     verify: Path | None = None
 
     def __post_init__(self) -> None:
@@ -118,10 +126,15 @@ class PlanConfig:
             raise ValueError(
                 "--tasks is for a first plan; a later plan keeps --previous's tasks: drop --tasks."
             )
-        if GAIN in self.scheduler.measurements:
+        if (self.policy_path is None) != (self.previous_policy_path is None):
             raise ValueError(
-                f"--scheduler.type={self.scheduler.type} needs the policy's per-task loss drop, which plan "
-                "does not measure: use need, need_raw or uniform."
+                "The performance gain compares two policies: give --policy_path (trained since the last "
+                "session) and --previous_policy_path (the one before), or neither."
+            )
+        if GAIN in self.scheduler.measurements and self.policy_path is None:
+            raise ValueError(
+                f"--scheduler.type={self.scheduler.type} needs each task's loss drop: give --policy_path, "
+                "--previous_policy_path and --loss_datasets (the data the policy was trained on)."
             )
 
 
@@ -222,6 +235,33 @@ def plan_tasks(config: PlanConfig, read: Sequence[DatasetEpisodes], previous: di
     return tasks
 
 
+def measure_gain(config: PlanConfig, tasks: Sequence[str]) -> dict | None:
+    """Each task's loss before and after training and their drop (None without the two policies)."""
+    if config.policy_path is None or config.previous_policy_path is None:
+        return None
+    from lerobot_mtdagger.planning.loss import loss_inputs, per_task_loss
+
+    sources = list(config.loss_datasets) or list(config.datasets)
+    before, frames = per_task_loss(config.previous_policy_path, sources, tasks)
+    after, _ = per_task_loss(config.policy_path, sources, tasks)
+    return {
+        "previous_policy": loss_inputs(config.previous_policy_path, sources),
+        "policy": loss_inputs(config.policy_path, sources),
+        "loss_previous": before,
+        "loss": after,
+        "frames": frames,
+        "gain": loss_drop(before, after),
+    }
+
+
+def loss_drop(before: Sequence[float | None], after: Sequence[float | None]) -> list[float]:
+    """``max(0, before - after)`` per task (0 where a task has no frame)."""
+    return [
+        max(0.0, b - a) if b is not None and a is not None else 0.0
+        for b, a in zip(before, after, strict=True)
+    ]
+
+
 def episode_budget(config: PlanConfig, scheduler: Scheduler, seconds: Sequence[float]) -> int:
     """``--budget``, or the most episodes whose allocation fits in ``--budget_minutes``."""
     if config.budget is not None:
@@ -298,7 +338,12 @@ def make_plan(config: PlanConfig) -> dict:
     scheduler = continued_scheduler(config, tasks, previous)
     state_before = scheduler.state_dict()
     measured = measure(read, tasks)
-    scheduler.update(success_rate=measured.success_rate, episodes=measured.policy_episodes)
+    gain_record = measure_gain(config, tasks)
+    scheduler.update(
+        success_rate=measured.success_rate,
+        episodes=measured.policy_episodes,
+        gain=None if gain_record is None else gain_record["gain"],
+    )
     seconds = task_seconds(config, measured)
     budget = episode_budget(config, scheduler, seconds)
     allocation = scheduler.allocate(budget)
@@ -328,6 +373,7 @@ def make_plan(config: PlanConfig) -> dict:
             "successes": measured.successes,
             "episode_seconds": seconds,
         },
+        "gain": gain_record,
         "state_before": state_before,
         "state": scheduler.state_dict(),
         "budget": {"episodes": budget, "minutes": float(sum(minutes)), "minutes_per_task": minutes},
@@ -352,6 +398,11 @@ def plan_table(plan: dict) -> str:
             f"{allocation['kalman_posterior']['p'][i]:.3f} | {allocation['metric'][i]:.3f} | "
             f"{allocation['episodes_per_task'][i]} | {plan['budget']['minutes_per_task'][i]:.1f} |"
         )
+    if plan.get("gain") is not None:
+        drops = ", ".join(
+            f"{task} {drop:.4f}" for task, drop in zip(plan["tasks"], plan["gain"]["gain"], strict=True)
+        )
+        lines.append(f"loss drop per task (previous policy - policy, on the training datasets): {drops}")
     lines += [f"note: {note}" for note in allocation.get("notes", [])]
     return "\n".join(lines)
 
@@ -390,7 +441,29 @@ def verify_plan(path: Path) -> list[str]:
             for name in ("episodes", "tasks", "success", "policy_only"):
                 if list(getattr(again, name)) != list(dataset[name]):
                     problems.append(f"dataset {dataset['source']}: recorded {name} differ from its files")
+    problems += _gain_input_problems(plan)
     problems += _allocation_problems(plan)
+    return problems
+
+
+def _gain_input_problems(plan: dict) -> list[str]:
+    """Whether the policies and datasets the losses were measured with are still those files."""
+    if plan.get("gain") is None:
+        return []
+    from lerobot_mtdagger.planning.loss import policy_checksum
+
+    problems = []
+    for role in ("previous_policy", "policy"):
+        inputs = plan["gain"][role]
+        path = Path(inputs["policy"])
+        if not path.is_dir():
+            problems.append(f"{role} {path} is gone: its losses cannot be checked")
+        elif policy_checksum(path) != inputs["policy_sha256"]:
+            problems.append(f"{role} {path} changed since the plan (checksum differs)")
+    for dataset in plan["gain"]["policy"]["datasets"]:
+        root = Path(dataset["source"])
+        if root.is_dir() and dataset_checksum(root) != dataset["checksum"]:
+            problems.append(f"loss dataset {dataset['source']} changed since the plan (checksum differs)")
     return problems
 
 
@@ -441,7 +514,14 @@ def _allocation_problems(plan: dict) -> list[str]:
     state = plan["state_before"]
     scheduler = Scheduler(_config_of(state), len(tasks))
     scheduler.load_state_dict(state)
-    scheduler.update(success_rate=measured.success_rate, episodes=measured.policy_episodes)
+    gain = None
+    if plan.get("gain") is not None:
+        gain = loss_drop(plan["gain"]["loss_previous"], plan["gain"]["loss"])
+        if gain != plan["gain"]["gain"]:
+            problems.append(
+                f"gain: recorded {plan['gain']['gain']} != the drop of the recorded losses {gain}"
+            )
+    scheduler.update(success_rate=measured.success_rate, episodes=measured.policy_episodes, gain=gain)
     again = scheduler.allocate(int(plan["budget"]["episodes"])).to_dict()
     if again["episodes_per_task"] != plan["allocation"]["episodes_per_task"]:
         problems.append(

@@ -296,6 +296,8 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     timing = {
         "load_s": loaded - start + trained.prepare_s,
         "train_s": trained.train_s,
+        "steps_s": trained.result.steps_s,  # the bare optimiser steps within train_s
+        "task_loss_s": trained.result.task_loss_s,  # the per-task loss before and after them
         "eval_s": time.perf_counter() - trained_at,
     }
     ctx.timings.setdefault(round_index, {}).update(timing)
@@ -349,7 +351,7 @@ def summary_line(ctx: RunContext, round_index: int) -> str:
     if phase.heldout_eval is not None:
         success += f" | unseen {phase.heldout_eval['mean']:.3f}"
     demos = np.mean(record.demos_so_far)
-    timing = " ".join(f"{k}={v:.1f}" for k, v in phase.timings.items())
+    timing = " ".join(f"{k}={v:.1f}" for k, v in phase.timings.items() if k not in PHASE_DETAIL_TIMINGS)
     return (
         f"round {round_index}: demos/task {demos:.1f} | eval success {success} | "
         f"allocation {record.episodes_per_task} | beta {record.beta:.2f} | {timing}"
@@ -370,6 +372,10 @@ def check_budget(config: RunConfig, num_tasks: int) -> None:
             f"{n_min * num_tasks}: raise --dagger.budget to at least {n_min * num_tasks} or lower "
             "--scheduler.n_min."
         )
+
+
+PHASE_DETAIL_TIMINGS = ("steps_s", "task_loss_s")
+"""Parts of ``train_s`` kept in the phase's record (``training.json``) but not in the summary line."""
 
 
 def run(

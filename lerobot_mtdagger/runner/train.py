@@ -377,6 +377,8 @@ class PhaseResult:
         steps: Optimiser steps taken (fewer than asked where a plateau stopped the phase).
         best_step: With a plateau stop, the step whose weights are returned (0: the initial ones).
         heldout_loss: With a plateau stop, ``[step, mean held-out loss]`` at every measurement.
+        steps_s: Seconds spent in the optimiser steps (the bare training).
+        task_loss_s: Seconds spent measuring the per-task loss before and after them.
     """
 
     loss_start: list[float | None]
@@ -387,6 +389,8 @@ class PhaseResult:
     steps: int = 0
     best_step: int | None = None
     heldout_loss: list[list[float]] | None = None
+    steps_s: float = 0.0
+    task_loss_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -732,7 +736,9 @@ def train_phase(
     _check_phase_inputs(policy, data, log_interval, plateau)
     num_tasks = len(data.task_names)
     ops = phase_ops(policy, data, options)
+    started = time.perf_counter()
     loss_start, _ = ops.task_losses(loss_index, num_tasks)
+    measured = time.perf_counter()
     generator = torch.Generator().manual_seed(options.seed)
     draw = batch_sampler(train_index, data.data.task_index, options.sampling, generator)
     optimizer, scheduler, clip_norm = ops.optimizer(steps)
@@ -767,6 +773,7 @@ def train_phase(
             stopped = tracker.measure(done)
     if tracker is not None:
         tracker.restore_best()
+    trained = time.perf_counter()
     loss_end, counts = ops.task_losses(loss_index, num_tasks)
     return PhaseResult(
         loss_start=loss_start,
@@ -777,6 +784,8 @@ def train_phase(
         steps=done,
         best_step=None if tracker is None else tracker.best_step,
         heldout_loss=None if tracker is None else tracker.curve,
+        steps_s=trained - measured,
+        task_loss_s=(measured - started) + (time.perf_counter() - trained),
     )
 
 
