@@ -266,6 +266,27 @@ def test_training_is_deterministic_for_a_seed_and_does_not_depend_on_log_interva
     assert not all(torch.equal(t, other_weights[n]) for n, t in reference_weights.items())
 
 
+@pytest.mark.parametrize("sampling", ["uniform", "balanced"])
+def test_a_phase_records_the_passes_it_made_over_each_tasks_frames(sampling):
+    data = synthetic_data()
+    # an unequal split: task 0 has 3x the training frames of the others
+    keep = torch.cat(
+        [torch.nonzero(data.task_index == 0).flatten()] * 1
+        + [torch.nonzero(data.task_index == t).flatten()[:50] for t in range(1, len(TASKS))]
+    )
+    policy = small_policy()
+    options = StepOptions(steps=300, batch_size=64, lr=1e-3, seed=0, sampling=sampling, log_interval=7)
+    result = train_phase(policy, normalised(data, policy), keep, torch.arange(9), options)
+    frames = torch.bincount(data.task_index[keep], minlength=len(TASKS)).tolist()
+    draws = [p * f for p, f in zip(result.passes_per_task, frames, strict=True)]
+    assert sum(draws) == pytest.approx(300 * 64)  # every drawn frame of the steps taken, no more
+    if sampling == "uniform":  # every frame equally likely: the same passes for every task
+        assert np.allclose(result.passes_per_task, 300 * 64 / len(keep), rtol=0.1)
+    else:  # every task the same share of the draws: fewer passes over the larger task's frames
+        assert np.allclose(draws, 300 * 64 / len(TASKS), rtol=0.1)
+        assert result.passes_per_task[0] < 0.5 * min(result.passes_per_task[1:])
+
+
 def test_a_cosine_schedule_takes_each_phase_from_the_full_rate_to_zero(monkeypatch):
     rates: dict[str, list[float]] = {}
     build = MTDAggerOps.optimizer

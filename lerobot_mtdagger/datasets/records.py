@@ -274,6 +274,8 @@ class PhaseRecord:
             and its kernel level, torch threads, device); None in phases written before it was
             recorded. The same data and seeds give the same weights bit for bit only in the same
             environment: elsewhere the arithmetic differs in the last bits and grows over the steps.
+        passes_per_task: Per task, the frames the phase's steps drew over its training frames (how
+            many passes over each task's data it made); None in phases written before it was recorded.
     """
 
     round: int
@@ -295,6 +297,7 @@ class PhaseRecord:
     heldout_loss: list[list[float]] | None = None
     heldout_eval: dict[str, Any] | None = None
     environment: dict[str, Any] | None = None
+    passes_per_task: list[float | None] | None = None
 
     @property
     def eval_mean(self) -> float | None:

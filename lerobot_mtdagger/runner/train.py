@@ -25,7 +25,7 @@ import math
 import platform
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -379,6 +379,8 @@ class PhaseResult:
         heldout_loss: With a plateau stop, ``[step, mean held-out loss]`` at every measurement.
         steps_s: Seconds spent in the optimiser steps (the bare training).
         task_loss_s: Seconds spent measuring the per-task loss before and after them.
+        passes_per_task: Per task, the frames its steps drew divided by its training frames: how
+            many times over its data the phase went (None where a task had no training frame).
     """
 
     loss_start: list[float | None]
@@ -389,8 +391,9 @@ class PhaseResult:
     steps: int = 0
     best_step: int | None = None
     heldout_loss: list[list[float]] | None = None
-    steps_s: float = 0.0
-    task_loss_s: float = 0.0
+    steps_s: float = field(default=0.0, compare=False)  # timings: equal phases differ in them
+    task_loss_s: float = field(default=0.0, compare=False)
+    passes_per_task: list[float | None] | None = None
 
 
 @dataclass(frozen=True)
@@ -749,12 +752,16 @@ def train_phase(
     policy.train()
     losses = _LossWindow(on_step)
     picks = torch.empty(0, dtype=torch.long)
+    draws = DrawCounter(data.data.task_index, train_index, num_tasks)
     done = 0
     while done < steps and not stopped:
         offset = done % log_interval
         if offset == 0:
             # One interval's batch indices at once, drawn on the CPU (device independent).
-            picks = draw((min(log_interval, steps - done), size)).to(data.device)
+            drawn = draw((min(log_interval, steps - done), size))
+            draws.start_interval(drawn)
+            picks = drawn.to(data.device)
+        draws.count(offset)
         loss = ops.step_loss(picks[offset], first_of_interval=offset == 0)
         if offset == 0:
             _check_finite(loss.detach().reshape(1), done)
@@ -786,6 +793,7 @@ def train_phase(
         heldout_loss=None if tracker is None else tracker.curve,
         steps_s=trained - measured,
         task_loss_s=(measured - started) + (time.perf_counter() - trained),
+        passes_per_task=draws.passes(),
     )
 
 
@@ -809,6 +817,29 @@ def _check_phase_inputs(
             f"A plateau stop needs held-out frames, every >= 1 and patience >= 1; got "
             f"{len(plateau.index)} frames, every={plateau.every}, patience={plateau.patience}."
         )
+
+
+class DrawCounter:
+    """Counts the frames each task's steps drew, for ``PhaseResult.passes_per_task``."""
+
+    def __init__(self, task_index: torch.Tensor, train_index: torch.Tensor, num_tasks: int) -> None:
+        """Starts at zero draws; ``train_index``'s frames per task are the denominators."""
+        self.task_index = task_index.cpu()
+        self.frames = torch.bincount(self.task_index[train_index.cpu()], minlength=num_tasks)
+        self.drawn = torch.zeros(num_tasks, dtype=torch.long)
+        self.tasks = torch.empty(0, dtype=torch.long)
+
+    def start_interval(self, picks: torch.Tensor) -> None:
+        """An interval's drawn frames ``(steps, batch)``, on the CPU."""
+        self.tasks = self.task_index[picks]
+
+    def count(self, offset: int) -> None:
+        """Counts the draws of the interval's step ``offset`` (the steps taken, not those drawn ahead)."""
+        self.drawn += torch.bincount(self.tasks[offset], minlength=len(self.drawn))
+
+    def passes(self) -> list[float | None]:
+        """Draws over training frames, per task."""
+        return [float(d) / float(f) if f > 0 else None for d, f in zip(self.drawn, self.frames, strict=True)]
 
 
 def batch_sampler(
@@ -992,6 +1023,7 @@ class TrainedPhase:
             best_step=result.best_step,
             heldout_loss=result.heldout_loss,
             environment=training_environment(next(self.policy.parameters()).device),
+            passes_per_task=result.passes_per_task,
         )
 
 
