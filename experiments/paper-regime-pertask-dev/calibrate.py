@@ -1,5 +1,6 @@
-"""The rules of ``run.sh``, applied: each task's noise scale (step 1), the kept tasks (step 2), the BC check
-(step 3). Written with ``run.sh`` on 2026-11-28, before any of its runs.
+"""The rules of ``run.sh``, applied: each task's noise scale, the kept tasks, the BC check.
+
+Steps 1, 2 and 3 of ``run.sh``; written with it on 2026-11-28, before any of its runs.
 
 - ``calibrate.py noise OUT SWEEP.json``: per MT50 task, the scale from the committed sweep (and at most two
   bisections, measured here) whose expert success is nearest 0.875 inside [0.80, 0.95]; writes

@@ -69,7 +69,9 @@ def main() -> None:
             results["plain"] = {}
         print(f"\n## {method}\n")
         decision = f"the best training of {method} is {{}}"
-        lines = choice_report(results, TRAININGS, BUDGETS, SEEDS, label="training", decision=decision, none_word="none")
+        lines = choice_report(
+            results, TRAININGS, BUDGETS, SEEDS, label="training", decision=decision, none_word="none"
+        )
         print("\n".join(lines))
 
 
