@@ -7,12 +7,14 @@
 #   mkdir -p outputs && cp experiments/resume.sh outputs/resume-running.sh
 #   nohup bash outputs/resume-running.sh >> outputs/resume.log 2>&1 &
 #
-# Running (2026-11-28): paper-regime-pertask-dev on core 0, plateau-dagger-training-dev on core 1. (paper-regime-calibration-dev is
+# Running (2026-11-28): on core 0 paper-regime-pertask-dev, then paper-regime-training-dev (which
+# starts only if the former's BC check accepted the regime); on core 1 plateau-dagger-training-dev. (paper-regime-calibration-dev is
 # complete; pixels-dagger-epochs-dev is paused and drawers-preset-dev stopped: see their READMEs.)
 set -uo pipefail
 
 PLATEAU_COMMIT=${PLATEAU_COMMIT:-fe972b0}  # the commit that added plateau-dagger-training-dev
 PERTASK_COMMIT=${PERTASK_COMMIT:-b76672e}  # the commit that added paper-regime-pertask-dev
+TRAINING_COMMIT=${TRAINING_COMMIT:-b05f863}  # the commit that added paper-regime-training-dev
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
@@ -39,6 +41,7 @@ study() {  # study NAME WORKTREE COMMIT CORE: runs experiments/NAME/run.sh there
 }
 
 mkdir -p outputs
-study paper-regime-pertask-dev study-code-pertask "$PERTASK_COMMIT" 0 &
+(study paper-regime-pertask-dev study-code-pertask "$PERTASK_COMMIT" 0 &&
+  study paper-regime-training-dev study-code-training "$TRAINING_COMMIT" 0) &
 study plateau-dagger-training-dev study-code-plateau-dagger "$PLATEAU_COMMIT" 1 &
 wait
