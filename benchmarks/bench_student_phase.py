@@ -96,14 +96,19 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=5)
     parser.add_argument("--timeout", type=int, default=600, help="seconds a configuration may take")
     parser.add_argument("--only", default=None, help="one configuration's name")
+    parser.add_argument(
+        "--extra", nargs="*", default=[], help="options added to every run, e.g. --policy.batch_size=8"
+    )
     options = parser.parse_args()
-    print(f"{options.suite}, one BC phase of {options.steps} steps at the preset's batch size:\n")
+    batch = " ".join(options.extra) or "the preset's batch size"
+    print(f"{options.suite}, one BC phase of {options.steps} steps, {batch}:\n")
     print("| student | steps_s | task_loss_s | phase train_s | phase / steps | eval_s | max RSS (GB) |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for name, extra in CONFIGS.items():
         if options.only is not None and name != options.only:
             continue
-        print(row(name, run_phase(options.suite, options.steps, extra, options.timeout)), flush=True)
+        measured = run_phase(options.suite, options.steps, [*extra, *options.extra], options.timeout)
+        print(row(name, measured), flush=True)
 
 
 if __name__ == "__main__":
