@@ -299,3 +299,28 @@ def test_the_gain_needs_both_policies(tmp_path, capsys):
     assert "give --policy_path (trained since the last session) and --previous_policy_path" in _refused(
         tmp_path, capsys, f"--datasets=[{data}]", "--budget=5", f"--policy_path={tmp_path}"
     )
+
+
+def test_a_hub_repo_id_is_read_from_lerobots_cache_with_its_revision(tmp_path, monkeypatch, capsys):
+    """A local stand-in for the Hub (no network here): the repo id resolves under LeRobot's home."""
+    import importlib
+
+    home = tmp_path / "lerobot-home"
+    record(home / "me" / "rollouts", SESSION_1)
+    for module in ("lerobot.datasets.dataset_metadata", "lerobot.datasets.lerobot_dataset"):
+        try:
+            loaded = importlib.import_module(module)
+        except ImportError:  # LeRobot 0.4 has no dataset_metadata module
+            continue
+        if hasattr(loaded, "HF_LEROBOT_HOME"):
+            monkeypatch.setattr(loaded, "HF_LEROBOT_HOME", home)
+    status, made = plan(tmp_path, "hub", "--datasets=[me/rollouts]", "--budget=10")
+    assert status == 0 and made["inputs"][0]["source"] == "me/rollouts"
+    assert (
+        made["inputs"][0]["root"] == str(home / "me" / "rollouts") and made["inputs"][0]["revision"] == "v3.0"
+    )
+    assert made["measurements"]["successes"] == [3, 1]
+    assert main(["plan", f"--verify={tmp_path / 'hub.json'}"]) == 0
+    assert "neither a folder nor a Hub repo id" in _refused(
+        tmp_path, capsys, "--datasets=[not-a-repo]", "--budget=5"
+    )
