@@ -14,15 +14,12 @@ weights on the same data always measure the same.
 from __future__ import annotations
 
 import hashlib
-import logging
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from lerobot_mtdagger.planning.episodes import dataset_checksum, open_metadata
 from lerobot_mtdagger.utils.errors import UserError
-
-logger = logging.getLogger(__name__)
 
 LOSS_BATCH = 64
 """Frames per forward pass (one task's frames at a time)."""
@@ -110,12 +107,11 @@ def _collate(dataset: Any, frames: Sequence[int]) -> dict[str, Any]:
     return default_collate([dataset[i] for i in frames])
 
 
-def loss_inputs(policy_path: Path, sources: Sequence[str]) -> dict[str, Any]:
-    """What a loss measurement read, for the plan file: the policy's and the datasets' checksums."""
-    return {
-        "policy": str(policy_path),
-        "policy_sha256": policy_checksum(policy_path),
-        "datasets": [
-            {"source": s, "checksum": dataset_checksum(Path(open_metadata(s).root))} for s in sources
-        ],
-    }
+def policy_inputs(policy_path: Path) -> dict[str, str]:
+    """A policy folder as a plan records it: its path and checksum."""
+    return {"policy": str(policy_path), "policy_sha256": policy_checksum(policy_path)}
+
+
+def dataset_inputs(sources: Sequence[str]) -> list[dict[str, str]]:
+    """The loss datasets as a plan records them: each source and its files' checksum."""
+    return [{"source": s, "checksum": dataset_checksum(Path(open_metadata(s).root))} for s in sources]

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import logging
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -44,8 +43,6 @@ from lerobot_mtdagger.scheduler import (
 )
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.paths import check_output_file
-
-logger = logging.getLogger(__name__)
 
 PLAN_FORMAT = "lerobot-mtdagger-plan"
 PLAN_VERSION = 1
@@ -239,14 +236,15 @@ def measure_gain(config: PlanConfig, tasks: Sequence[str]) -> dict | None:
     """Each task's loss before and after training and their drop (None without the two policies)."""
     if config.policy_path is None or config.previous_policy_path is None:
         return None
-    from lerobot_mtdagger.planning.loss import loss_inputs, per_task_loss
+    from lerobot_mtdagger.planning.loss import dataset_inputs, per_task_loss, policy_inputs
 
     sources = list(config.loss_datasets) or list(config.datasets)
     before, frames = per_task_loss(config.previous_policy_path, sources, tasks)
     after, _ = per_task_loss(config.policy_path, sources, tasks)
     return {
-        "previous_policy": loss_inputs(config.previous_policy_path, sources),
-        "policy": loss_inputs(config.policy_path, sources),
+        "previous_policy": policy_inputs(config.previous_policy_path),
+        "policy": policy_inputs(config.policy_path),
+        "loss_datasets": dataset_inputs(sources),
         "loss_previous": before,
         "loss": after,
         "frames": frames,
@@ -460,7 +458,7 @@ def _gain_input_problems(plan: dict) -> list[str]:
             problems.append(f"{role} {path} is gone: its losses cannot be checked")
         elif policy_checksum(path) != inputs["policy_sha256"]:
             problems.append(f"{role} {path} changed since the plan (checksum differs)")
-    for dataset in plan["gain"]["policy"]["datasets"]:
+    for dataset in plan["gain"]["loss_datasets"]:
         root = Path(dataset["source"])
         if root.is_dir() and dataset_checksum(root) != dataset["checksum"]:
             problems.append(f"loss dataset {dataset['source']} changed since the plan (checksum differs)")

@@ -114,7 +114,7 @@ def _group_lines(
         yield from option_lines(type(default), options, f"{path}.", choices)
         return
     asked = _asked_choice(options, path)
-    current = _choice_name(group_class, type(default), known)
+    current = _choice_name(type(default), known)
     yield f"--{path}.type={{{','.join(known)}}}", f"{help_text} (default: {current})".strip()
     chosen = known[asked] if asked in known else type(default)
     if chosen is None:  # a choice whose class needs heavy imports: named, not described
@@ -146,7 +146,7 @@ def _choices(
     return None
 
 
-def _choice_name(group_class: type, chosen: type, known: dict[str, Any]) -> str:
+def _choice_name(chosen: type, known: dict[str, Any]) -> str:
     """The name the default choice is registered under."""
     return next((name for name, klass in known.items() if klass is chosen), "?")
 
