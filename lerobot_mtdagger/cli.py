@@ -474,7 +474,8 @@ class ReportConfig:
             seeds run on other machines (each point in one table only; the methods' configs must
             agree). Default ``output_dir`` for one table: its folder.
         records: Runs' saved records (``scripts/save_run_records.sh``: config, round and training
-            records, no frames or weights), each a run's records folder or a folder of them, reported
+            records, no frames or weights), each a run's records folder, a folder of them, or a
+            study's ``runs-records.tar.gz`` (or a folder holding them: ``studies.saved_records``), reported
             beside ``experiments`` and ``compare_dir`` as their runs are: a study whose ``outputs/`` was
             lost keeps its finished runs. Their frames per task are known only on average.
     """
@@ -574,23 +575,10 @@ def _compare_runs(compare_dir: Path) -> list[Path]:
 
 
 def _saved_records_runs(folder: Path) -> list[Path]:
-    """The runs' records in ``folder``: itself if it holds one run's records, else its subfolders that do.
+    """The runs' records at ``folder`` (``studies.saved_records``: folders or archives)."""
+    from lerobot_mtdagger.studies.saved_records import saved_records_runs
 
-    Raises:
-        UserError: If it holds no run's records, naming the command that saves them.
-    """
-    from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
-
-    if (folder / CONFIG_FILE).is_file():
-        return [folder]
-    runs = sorted(p for p in folder.iterdir() if (p / CONFIG_FILE).is_file()) if folder.is_dir() else []
-    if not runs:
-        raise UserError(
-            f"--records: {folder} holds no run's records (a config.json in it or in its subfolders): "
-            "give the folder `bash scripts/save_run_records.sh RUNS DEST` wrote (DEST), or one run's "
-            "folder in it."
-        )
-    return runs
+    return saved_records_runs(folder)
 
 
 def report_command(config: ReportConfig) -> str:
@@ -626,8 +614,11 @@ def report_command(config: ReportConfig) -> str:
     if config.output_dir is not None:
         from lerobot_mtdagger.datasets.rounds import open_run
         from lerobot_mtdagger.studies.results import results_rows, write_results
+        from lerobot_mtdagger.studies.saved_records import shown_name
 
         rows = results_rows(roots, labels)
+        for row in rows:
+            row["experiment"] = shown_name(Path(row["experiment"]))
         task_names = open_run(roots[0]).read_round_record(0).task_names
         write_results(rows, config.output_dir, task_names, configs, unfinished)
         _write_figures(rows, task_names, config, unfinished)

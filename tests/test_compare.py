@@ -11,6 +11,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tarfile
 import time
 from pathlib import Path
 
@@ -393,6 +394,54 @@ def test_runs_saved_as_records_report_as_their_folders_do(compared, tmp_path, ca
     assert all(row["expert_frames_per_task"] is None for row in rows)  # saved in total, not per task
     summary = (tmp_path / "of-records" / "report.md").read_text()
     assert summary == (tmp_path / "of-runs" / "report.md").read_text()
+
+
+def _compact(records: Path) -> Path:
+    """``scripts/compact_records.sh`` on a records folder; its archive."""
+    script = Path(__file__).resolve().parents[1] / "scripts" / "compact_records.sh"
+    result = subprocess.run(["bash", str(script), str(records)], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    return records / "runs-records.tar.gz"
+
+
+def test_records_compacted_into_an_archive_report_as_their_folders_do(compared, tmp_path, capsys):
+    """A study keeps its runs' records as one archive; report reads it and names the runs as before."""
+    folder, _ = compared
+    records = _save_records(folder / "runs", tmp_path / "records")
+    assert main(["report", f"--records=[{records}]", f"--output_dir={tmp_path / 'of-folders'}"]) == 0
+    table_of_folders = capsys.readouterr().out.split("figures and summary")[0]
+    files = sorted(p.relative_to(records) for p in records.rglob("*") if p.is_file())
+
+    archive = _compact(records)
+
+    assert [p.name for p in records.iterdir()] == ["runs-records.tar.gz"]
+    with tarfile.open(archive) as tar:
+        assert sorted(Path(m.name) for m in tar.getmembers() if m.isfile()) == files
+    for given in (records, archive):  # the records folder, or the archive itself
+        out = tmp_path / f"of-{given.name}"
+        assert main(["report", f"--records=[{given}]", f"--output_dir={out}"]) == 0
+        assert capsys.readouterr().out.split("figures and summary")[0] == table_of_folders
+        for name in ("results.json", "results.csv", "report.md"):
+            assert (out / name).read_text() == (tmp_path / "of-folders" / name).read_text()
+
+
+def test_compacting_is_byte_stable_and_never_overwrites(compared, tmp_path):
+    folder, _ = compared
+    first = _compact(_save_records(folder / "runs", tmp_path / "one"))
+    second = _compact(_save_records(folder / "runs", tmp_path / "two"))
+    assert first.read_bytes() == second.read_bytes()
+    (tmp_path / "one" / "late-run").mkdir()
+    script = Path(__file__).resolve().parents[1] / "scripts" / "compact_records.sh"
+    result = subprocess.run(["bash", str(script), str(tmp_path / "one")], capture_output=True, text=True)
+    assert "nothing to compact" in result.stdout  # its subfolder holds no run: left as it is
+    assert (tmp_path / "one" / "late-run").is_dir() and first.read_bytes() == second.read_bytes()
+
+
+def test_a_records_archive_that_is_not_one_is_named(tmp_path, capsys):
+    bad = tmp_path / "runs-records.tar.gz"
+    bad.write_bytes(b"not a tar archive")
+    assert main(["report", f"--records=[{bad}]"]) == 2
+    assert f"--records: cannot read {bad} as a tar archive" in capsys.readouterr().err
 
 
 def test_saved_records_of_some_runs_join_the_folders_of_the_others(compared, tmp_path, capsys):

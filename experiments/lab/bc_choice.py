@@ -9,7 +9,8 @@ if none qualifies, the highest mean, and say so. The rule applies only once ever
 seed) run has finished.
 
 The records are the ones ``scripts/save_run_records.sh`` saves:
-``<folder>/<training>/bc-<budget>demos-seed<seed>/policies/round-000/training.json``.
+``<folder>/<training>/bc-<budget>demos-seed<seed>/policies/round-000/training.json``, or the same
+runs' folders compacted into ``<folder>/<training>/runs-records.tar.gz`` (``scripts/compact_records.sh``).
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lerobot_mtdagger.studies.saved_records import ARCHIVE_NAME, unpack
+
 BC_RUN_NAME = re.compile(r"bc-(\d+)demos-seed(\d+)")
 DROP_ALLOWED = 0.01
 
@@ -32,20 +35,25 @@ def read_bc_records(folder: Path) -> dict[str, dict[tuple[int, int], float]]:
     """Mean evaluation success of every saved BC run, by training, then (budget, seed).
 
     Args:
-        folder: Holds one folder per training, each with the records of its BC runs.
+        folder: Holds one folder per training, each with the records of its BC runs (folders, or
+            compacted into its ``runs-records.tar.gz``).
 
     Returns:
         ``{training: {(budget, seed): success}}``; runs whose only phase has no record yet are absent.
     """
     results: dict[str, dict[tuple[int, int], float]] = {}
-    for path in sorted(folder.glob("*/*/policies/round-000/training.json")):
-        run = path.parents[2]
-        match = BC_RUN_NAME.fullmatch(run.name)
+    found = [(path, path.parents[3].name) for path in folder.glob("*/*/policies/round-000/training.json")]
+    for archive in folder.glob(f"*/{ARCHIVE_NAME}"):  # a training's runs compacted into one archive
+        found += [
+            (path, archive.parent.name) for path in unpack(archive).glob("*/policies/round-000/training.json")
+        ]
+    for path, training in sorted(found, key=lambda item: (item[1], item[0].parents[2].name)):
+        match = BC_RUN_NAME.fullmatch(path.parents[2].name)
         if match is None:
             continue
         budget, seed = int(match.group(1)), int(match.group(2))
         success = json.loads(path.read_text())["eval"]["mean"]
-        results.setdefault(run.parent.name, {})[(budget, seed)] = float(success)
+        results.setdefault(training, {})[(budget, seed)] = float(success)
     return results
 
 

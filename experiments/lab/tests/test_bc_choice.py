@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -43,6 +44,23 @@ def test_records_are_read_by_training_budget_and_seed(tmp_path):
         "plain": {(33, 100): 0.9, (63, 101): 0.8},
         "cosine": {(45, 100): 0.7},
     }
+
+
+def test_records_compacted_per_training_read_as_their_folders(tmp_path):
+    write_record(tmp_path, "plain", 33, 100, 0.9)
+    write_record(tmp_path, "cosine", 45, 100, 0.7)
+    write_record(tmp_path, "cosine", 63, 101, 0.6)
+    for run in tmp_path.glob("*/bc-*"):
+        (run / "config.json").write_text("{}")  # what marks a run's records folder
+    folders = read_bc_records(tmp_path)
+    script = Path(__file__).resolve().parents[3] / "scripts" / "compact_records.sh"
+    subprocess.run(["bash", str(script), str(tmp_path)], check=True, capture_output=True)
+    assert sorted(p.name for p in (tmp_path / "cosine").iterdir()) == ["runs-records.tar.gz"]
+    assert (
+        read_bc_records(tmp_path)
+        == folders
+        == {"plain": {(33, 100): 0.9}, "cosine": {(45, 100): 0.7, (63, 101): 0.6}}
+    )
 
 
 def test_a_training_that_drops_with_more_data_is_passed_over_for_a_lower_mean():
