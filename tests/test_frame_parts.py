@@ -12,19 +12,13 @@ import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
-from lerobot_mtdagger.runner import train
+from lerobot_mtdagger.runner import normalise
 from lerobot_mtdagger.runner.frame_parts import FrameParts, join_frames, materialise
-from lerobot_mtdagger.runner.train import (
-    EPISODE_ID_STRIDE,
-    NormalisedData,
-    StepOptions,
-    TrainingData,
-    build_processors,
-    compute_stats,
-    per_task_loss,
-    per_task_loss_of,
-    train_phase,
-)
+from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
+from lerobot_mtdagger.runner.round_data import EPISODE_ID_STRIDE, TrainingData
+from lerobot_mtdagger.runner.steps import StepOptions, train_phase
+from lerobot_mtdagger.runner.task_loss import per_task_loss, per_task_loss_of
+from lerobot_mtdagger.runner.train import build_processors
 
 TASKS = ["task-a", "task-b", "task-c"]
 IMAGE_SHAPE = (8, 8, 3)
@@ -85,11 +79,11 @@ def test_join_frames_keeps_a_single_tensor_and_drops_empty_parts():
 
 
 def test_statistics_read_in_chunks_equal_those_of_all_the_frames_at_once(monkeypatch):
-    monkeypatch.setattr(train, "STATS_CHUNK", 7)  # 40 frames: six chunks, the last one short
+    monkeypatch.setattr(normalise, "STATS_CHUNK", 7)  # 40 frames: six chunks, the last one short
     generator = torch.Generator().manual_seed(0)
     parts = [torch.randn(n, 5, 3, generator=generator) * (1 + n) + n for n in (12, 20, 18)]
     frames = torch.randperm(50, generator=generator)[:40]
-    stats = train.channel_stats(FrameParts(parts), frames)
+    stats = normalise.channel_stats(FrameParts(parts), frames)
     flat = torch.cat(parts)[frames].reshape(-1, 3).double()
     assert stats["mean"] == pytest.approx(flat.mean(0).float().numpy(), rel=1e-6)
     assert stats["std"] == pytest.approx(flat.std(0, unbiased=False).float().numpy(), rel=1e-6)

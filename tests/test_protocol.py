@@ -28,19 +28,12 @@ from lerobot_mtdagger.runner.configs import RolloutConfig, RunConfig, TrainingCo
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.mixing import expert_episode_coin
-from lerobot_mtdagger.runner.train import (
-    EPISODE_ID_STRIDE,
-    NormalisedData,
-    TrainingData,
-    batch_sampler,
-    build_processors,
-    compute_stats,
-    heldout_episodes,
-    per_task_loss,
-    per_task_loss_of,
-    performance_gain,
-    split_frames,
-)
+from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
+from lerobot_mtdagger.runner.round_data import EPISODE_ID_STRIDE, TrainingData
+from lerobot_mtdagger.runner.splits import heldout_episodes, split_frames
+from lerobot_mtdagger.runner.steps import batch_sampler
+from lerobot_mtdagger.runner.task_loss import per_task_loss, per_task_loss_of, performance_gain
+from lerobot_mtdagger.runner.train import build_processors
 from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.seeds import BETA_STREAM, COLLECT_STREAM

@@ -320,7 +320,8 @@ class _Forward:
 
 
 def test_the_per_task_loss_of_a_lerobot_student_is_reproducible(act_run):
-    from lerobot_mtdagger.runner.train import NormalisedData, RoundCache
+    from lerobot_mtdagger.runner.normalise import NormalisedData
+    from lerobot_mtdagger.runner.train import RoundCache
 
     runner = PolicyRunner.from_pretrained(ExperimentDir(act_run).policy_root(2))
     experiment = ExperimentDir(act_run)

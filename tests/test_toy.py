@@ -25,7 +25,8 @@ from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.runner.collect import episode_seed, run_episodes, success_by_task
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
-from lerobot_mtdagger.runner.train import LOSS_SAMPLES_PER_TASK, TrainingData, split_frames
+from lerobot_mtdagger.runner.round_data import TrainingData
+from lerobot_mtdagger.runner.splits import LOSS_SAMPLES_PER_TASK, split_frames
 from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.scheduler import scheduling_methods
 from lerobot_mtdagger.utils.errors import UserError

@@ -235,8 +235,8 @@ class TaskSuite(abc.ABC):
     def with_expert_noise(self, noise: Any) -> TaskSuite:
         """A copy of the suite whose experts act with ``noise`` (``experts.noise.ExpertNoise``).
 
-        The rollout workers add it to every expert action they execute (``runner/workers.py``); None,
-        or a noise of scale 0, leaves the experts as they are.
+        The rollout workers add it to every expert action they execute
+        (``runner/rollout_worker.py``); None, or a noise of scale 0, leaves the experts as they are.
         """
         clone = self.with_observation()
         clone.expert_noise = noise if noise is not None and noise.active else None

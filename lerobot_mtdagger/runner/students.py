@@ -1,8 +1,8 @@
 """LeRobot's own policies (ACT, Diffusion Policy) as the DAgger student: config, batches, losses.
 
-The runner trains its student through one seam (``train.PhaseOps``): a training batch at given
+The runner trains its student through one seam (``steps.phase_ops``): a training batch at given
 frames, the loss of one step, the per-task imitation loss and the optimiser. ``mtdagger`` has its
-fast implementation in ``train.py``; ``LeRobotOps`` here implements it for any LeRobot
+fast implementation in ``steps.py``; ``LeRobotOps`` here implements it for any LeRobot
 ``PreTrainedPolicy`` of ``configs.lerobot_students()`` from what LeRobot's policies declare:
 
 - **Windows of frames**, as LeRobot's ``delta_timestamps`` give them: a frame's observation history
@@ -156,7 +156,7 @@ class LeRobotOps:
 
     Args:
         policy: The LeRobot policy.
-        data: The phase's normalised frames (``train.NormalisedData``).
+        data: The phase's normalised frames (``normalise.NormalisedData``).
         task_dropout: Probability of zeroing a training frame's task vector.
         seed: Seed of the task dropout and of the loss measurements.
     """

@@ -18,7 +18,7 @@ Streams (number; the keys after it; what it decides):
 - ``HELDOUT_STREAM`` (7; task): which episodes a run holds out of training.
 
 The frames each phase measures its per-task loss on are drawn from ``np.random.default_rng(seed)``
-itself (``train.split_frames``), as every run since the first did.
+itself (``splits.split_frames``), as every run since the first did.
 """
 
 from __future__ import annotations

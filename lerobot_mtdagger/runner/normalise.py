@@ -1,0 +1,147 @@
+"""Normalisation statistics of the training frames and the frames normalised for a phase.
+
+The frames are normalised with LeRobot's own pre-processor built from their statistics, the same
+processor that is saved with the checkpoint; so what is trained, what is rolled out and what
+``lerobot-eval`` loads agree. Statistics and per-task losses read the frames a chunk at a time, so
+their memory is bounded whatever the data's size.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import torch
+
+from lerobot_mtdagger.runner.frame_parts import FrameParts, FrameTensor, materialise
+from lerobot_mtdagger.runner.round_data import TrainingData
+
+STATS_CHUNK = 8192
+"""Frames read at a time for the normalisation statistics."""
+
+
+MEASURE_CHUNK = 4096
+"""Frames per forward pass when measuring per-task losses on vector inputs."""
+
+
+MEASURE_CHUNK_VISUAL = 256
+"""The same with an image or point-cloud input: 4 096 frames of 84 px RGB made about 3 GB of float
+images and convolution activations at once (the pixel run's peak memory)."""
+
+
+def compute_stats(
+    data: TrainingData, image_keys: Sequence[str], index: torch.Tensor | None = None
+) -> dict[str, dict[str, np.ndarray]]:
+    """Mean/std/min/max of the vector inputs and the action (point clouds per channel).
+
+    Args:
+        data: The frames.
+        image_keys: Inputs without statistics (never read, so never copied).
+        index: The frames the statistics come from (None: all).
+    """
+    frames = torch.arange(len(data)) if index is None else index
+    tensors = {k: v for k, v in data.inputs.items() if k not in image_keys} | {"action": data.action}
+    return {key: channel_stats(tensor, frames) for key, tensor in tensors.items()}
+
+
+def channel_stats(tensor: FrameTensor, frames: torch.Tensor) -> dict[str, np.ndarray]:
+    """Mean/std/min/max over the last axis' channels of ``tensor[frames]``, in float64 then float32.
+
+    Read STATS_CHUNK frames at a time in one pass, each chunk's mean and squared deviations merged
+    into the running ones (Chan et al.'s pairwise update), so a phase's point clouds are never
+    copied whole.
+    """
+    channels = tensor.shape[-1]
+    count = 0
+    mean = torch.zeros(channels, dtype=torch.float64)
+    squares = torch.zeros(channels, dtype=torch.float64)
+    low = torch.full((channels,), math.inf, dtype=torch.float64)
+    high = torch.full((channels,), -math.inf, dtype=torch.float64)
+    for chunk in torch.split(frames, STATS_CHUNK):
+        block = materialise(tensor[chunk]).reshape(-1, channels).double()
+        block_mean = block.mean(0)
+        delta, total = block_mean - mean, count + len(block)
+        squares += ((block - block_mean) ** 2).sum(0) + delta**2 * count * len(block) / total
+        mean += delta * len(block) / total
+        count = total
+        low, high = torch.minimum(low, block.min(0).values), torch.maximum(high, block.max(0).values)
+    return {
+        "mean": mean.float().numpy(),
+        "std": (squares / count).sqrt().float().numpy(),
+        "min": low.float().numpy(),
+        "max": high.float().numpy(),
+    }
+
+
+class NormalisedData:
+    """Training frames normalised once with the policy's pre-processor; batches built on demand.
+
+    Tasks are carried as indices into ``task_names`` (checked once here), never as strings per batch.
+    """
+
+    def __init__(
+        self, data: TrainingData, preprocessor: Any, image_keys: Sequence[str], task_names: Sequence[str]
+    ):
+        """Normalises the vector inputs and the action of ``data``.
+
+        Raises:
+            ValueError: If a frame's task index is outside ``task_names``.
+        """
+        self.data = data
+        self.image_keys = list(image_keys)
+        self.task_names = list(task_names)
+        if len(data) and (int(data.task_index.min()) < 0 or int(data.task_index.max()) >= len(task_names)):
+            raise ValueError(
+                f"Task indices {torch.unique(data.task_index).tolist()} fall outside the "
+                f"{len(task_names)} tasks {self.task_names}."
+            )
+        vector = {k: v for k, v in data.inputs.items() if k not in self.image_keys} | {"action": data.action}
+        self.preprocessor = preprocessor
+        self.vector = normalise_inputs(preprocessor, vector)
+        self.device = self.vector["action"].device
+        self.task_index = data.task_index.to(self.device, dtype=torch.long)
+
+    @property
+    def measure_chunk(self) -> int:
+        """Frames per forward pass of a loss measurement (fewer with images or point clouds)."""
+        visual = any(len(tensor.shape) > 2 for tensor in self.data.inputs.values())
+        return MEASURE_CHUNK_VISUAL if visual else MEASURE_CHUNK
+
+    def normalise_actions(self, actions: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
+        """Unnormalised actions for the frames at ``index``, normalised like the labels."""
+        vector = {k: v[index] for k, v in self.data.inputs.items() if k not in self.image_keys}
+        return self.preprocessor({**vector, "action": actions.float()})["action"]
+
+    def batch(self, index: torch.Tensor) -> dict[str, torch.Tensor]:
+        """The normalised batch at ``index``.
+
+        Returns:
+            The vectors, the images as float CHW in [0, 1] and ``task_index`` (indices into
+            ``task_names``), all on the data's device.
+        """
+        index = index.to(self.device)
+        batch = {k: v[index] for k, v in self.vector.items()}
+        for key in self.image_keys:
+            images = self.data.inputs[key][index.cpu()].to(self.device)
+            batch[key] = images.permute(0, 3, 1, 2).float() / 255.0
+        batch["task_index"] = self.task_index[index]
+        return batch
+
+
+def normalise_inputs(preprocessor: Any, vector: dict[str, FrameTensor]) -> dict[str, FrameTensor]:
+    """``vector`` through the pre-processor: tensors at once, ``FrameParts`` part by part (never joined).
+
+    Args:
+        preprocessor: The policy's pre-processor (normalisation of each key is per feature, so parts
+            normalise as the whole would).
+        vector: The action and the non-image inputs by key.
+    """
+    whole = {k: v for k, v in vector.items() if not isinstance(v, FrameParts)}
+    normalised = preprocessor(dict(whole))
+    result: dict[str, FrameTensor] = {k: normalised[k] for k in whole}
+    for key, parts in vector.items():
+        if isinstance(parts, FrameParts):
+            result[key] = parts.map(lambda part, key=key: preprocessor({key: part})[key])
+    return result
