@@ -111,7 +111,7 @@ def test_eval_takes_the_observation_options_the_policy_was_trained_with(inputs, 
 
     from lerobot.configs.types import FeatureType, PolicyFeature
 
-    from lerobot_mtdagger.cli import EvalConfig, observation_options
+    from lerobot_mtdagger.commands.eval import EvalConfig, observation_options
     from lerobot_mtdagger.envs import SuiteConfig
 
     features = {

@@ -209,6 +209,7 @@ def test_verify_loads_policies_without_the_rollout_stack():
 
 WING_RANKS = {
     "lerobot_mtdagger.cli": 6,
+    "lerobot_mtdagger.commands": 6,
     "lerobot_mtdagger.studies": 5,
     "lerobot_mtdagger.planning": 5,
     "lerobot_mtdagger.runner": 4,
@@ -219,10 +220,12 @@ WING_RANKS = {
     "lerobot_mtdagger.scheduler": 1,
     "lerobot_mtdagger.utils": 0,
 }
-"""Imports run one way: studies -> runner -> envs and experts -> datasets and policies -> scheduler ->
-utils. Within a rank, experts may use envs and datasets may use policies (not the reverse)."""
+"""Imports run one way: cli and commands -> studies -> runner -> envs and experts -> datasets and
+policies -> scheduler -> utils. Within a rank, cli may use commands, experts may use envs and datasets
+may use policies (not the reverse)."""
 
 SAME_RANK_ALLOWED = {
+    ("lerobot_mtdagger.cli", "lerobot_mtdagger.commands"),
     ("lerobot_mtdagger.experts", "lerobot_mtdagger.envs"),
     ("lerobot_mtdagger.datasets", "lerobot_mtdagger.policies"),
 }
@@ -256,3 +259,27 @@ def test_imports_run_one_way_between_wings():
             if higher or sideways:
                 wrong.append(f"{name} -> {target}")
     assert wrong == [], wrong
+
+
+MAX_CLI_LINES = 150
+"""``cli.py`` parses the command line and dispatches; the commands live in ``commands/``."""
+
+SHARED_CONFIGS = {
+    "run": "lerobot_mtdagger.runner.configs",
+    "compare": "lerobot_mtdagger.studies.compare",
+    "push": "lerobot_mtdagger.datasets.push_config",
+    "plan": "lerobot_mtdagger.planning.plan",
+}
+"""Commands whose config a lower wing reads too: it is defined there, and the command's module imports it."""
+
+
+def test_cli_only_dispatches_to_one_module_per_command():
+    """Each command's function, and its config, sit in ``commands/<command>.py``; ``cli.py`` stays short."""
+    from lerobot_mtdagger.cli import COMMANDS
+
+    assert len(module_path("lerobot_mtdagger.cli").read_text().splitlines()) <= MAX_CLI_LINES
+    for name, (config_class, function) in COMMANDS.items():
+        home = f"lerobot_mtdagger.commands.{name}"
+        assert function.__module__ == home, (name, function.__module__)
+        assert config_class.__module__ == SHARED_CONFIGS.get(name, home), (name, config_class.__module__)
+        assert vars(sys.modules[home]).get(config_class.__name__) is config_class, (name, "config not named")

@@ -10,7 +10,8 @@ import pytest
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 
-from lerobot_mtdagger.cli import EvalConfig, eval_command, main
+from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.commands.eval import EvalConfig, eval_command
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.drawers import HELDOUT_DRAWERS, TRAINING_DRAWERS, VARIANTS
 from lerobot_mtdagger.envs.drawers.variants import nearest_variant

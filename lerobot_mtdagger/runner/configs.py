@@ -415,17 +415,14 @@ class DAggerConfig:
 
 
 @dataclass
-class RolloutConfig:
-    """Episodes: where a DAgger rollout is cut, evaluation, env workers (``--rollout.*``).
+class WorkerOptions:
+    """Env workers: how many, and where they run (``run``'s ``--rollout.*``, ``eval``'s and ``shift``'s own).
+
+    One definition of the options, their checks and the workers they start, for every command that
+    steps envs; each command keeps its spelling (``--rollout.workers`` for ``run``, ``--workers``
+    for ``eval``).
 
     Attributes:
-        eval_episodes: Evaluation episodes per task after each training phase (None: the preset's).
-        max_steps: Steps after which a DAgger rollout is cut (None: the env's own horizon, the one
-            evaluation runs to).
-        expert_multiple: Cut a DAgger rollout at this multiple of the steps the expert alone takes
-            to succeed from the same reset seed (the expert runs that episode first, unrecorded; no
-            cut where it fails). None: no such cut. ``max_steps`` still applies.
-        steps_after_success: Steps recorded after the first success before an episode ends.
         workers: Env worker processes for collection and evaluation (None: one per core; 0: step
             the envs in the main process; with ``worker_backend=ray``, at least one actor). Never
             changes a result.
@@ -435,25 +432,22 @@ class RolloutConfig:
             on this machine; ``ray://host:10001``; None: start a local Ray).
     """
 
-    eval_episodes: int | None = None
-    max_steps: int | None = None
-    expert_multiple: float | None = None
-    steps_after_success: int = 10
     workers: int | None = None
     worker_backend: str = "local"
     ray_address: str | None = None
 
-    def check(self) -> None:
-        """Refuses impossible values (one line naming the option)."""
-        for name in ("eval_episodes", "steps_after_success"):
-            if getattr(self, name) < 0:
-                raise ValueError(f"rollout.{name} must be >= 0, got {getattr(self, name)}.")
-        _require_positive(self, "rollout", ("max_steps", "expert_multiple"))
-        resolve_workers(self.workers)  # refuses a negative count before anything runs
-        _require_choice(self.worker_backend, "rollout.worker_backend", WORKER_BACKENDS)
+    def check_workers(self, prefix: str = "") -> None:
+        """Refuses a negative count, an unknown backend or a missing Ray, before anything runs.
+
+        Args:
+            prefix: The options' group on the command line (``rollout.`` for ``run``), as the
+                messages name them.
+        """
+        resolve_workers(self.workers)
+        _require_choice(self.worker_backend, f"{prefix}worker_backend", WORKER_BACKENDS)
         if self.worker_backend == "ray":
-            import_ray()  # refuses a missing Ray before anything runs
-            check_ray_address(self.ray_address, "--rollout.ray_address")
+            import_ray()
+            check_ray_address(self.ray_address, f"--{prefix}ray_address")
 
     @property
     def worker_count(self) -> int:
@@ -469,6 +463,43 @@ class RolloutConfig:
         from lerobot_mtdagger.runner.ray_workers import make_env_workers
 
         return make_env_workers(suite, self.worker_count, self.worker_backend, self.ray_address, reserve_cpus)
+
+
+@dataclass
+class RolloutEpisodes:
+    """Where a DAgger rollout is cut, and the evaluation episodes (``RolloutConfig`` without its workers).
+
+    Attributes:
+        eval_episodes: Evaluation episodes per task after each training phase (None: the preset's).
+        max_steps: Steps after which a DAgger rollout is cut (None: the env's own horizon, the one
+            evaluation runs to).
+        expert_multiple: Cut a DAgger rollout at this multiple of the steps the expert alone takes
+            to succeed from the same reset seed (the expert runs that episode first, unrecorded; no
+            cut where it fails). None: no such cut. ``max_steps`` still applies.
+        steps_after_success: Steps recorded after the first success before an episode ends.
+    """
+
+    eval_episodes: int | None = None
+    max_steps: int | None = None
+    expert_multiple: float | None = None
+    steps_after_success: int = 10
+
+
+@dataclass
+class RolloutConfig(WorkerOptions, RolloutEpisodes):
+    """Episodes: where a DAgger rollout is cut, evaluation, env workers (``--rollout.*``).
+
+    The options of ``RolloutEpisodes``, then the env workers (``WorkerOptions``): a dataclass takes
+    the fields of its last base first, which keeps their order in ``config.json`` and ``--help``.
+    """
+
+    def check(self) -> None:
+        """Refuses impossible values (one line naming the option)."""
+        for name in ("eval_episodes", "steps_after_success"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"rollout.{name} must be >= 0, got {getattr(self, name)}.")
+        _require_positive(self, "rollout", ("max_steps", "expert_multiple"))
+        self.check_workers("rollout.")
 
 
 @dataclass

@@ -1,0 +1,208 @@
+"""``lerobot-mtdagger eval``: success per task of a pretrained policy (mtdagger, ACT, Diffusion).
+
+The suite's observations default to those the policy was trained on; ``shift`` (``commands/shift.py``)
+loads its suite and policy the same way (``suite_and_policy``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from lerobot_mtdagger.envs.config import DEFAULT_IMAGE_SIZE, DEFAULT_NUM_POINTS, SuiteConfig
+from lerobot_mtdagger.runner.configs import WorkerOptions
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.paths import check_output_file
+
+if TYPE_CHECKING:
+    from lerobot_mtdagger.envs.base import TaskSuite
+    from lerobot_mtdagger.runner.evaluate import PolicyRunner
+
+HELDOUT_TASKS = "heldout"
+"""``--suite.tasks='[heldout]'``: the suite's unseen tasks (``eval``, ``shift``)."""
+UNSEEN_RULES: tuple[str, ...] = ("shared", "nearest")
+"""``eval --unseen_rule``: how a policy acts on a task it was not trained on (``EvalConfig``)."""
+
+logger = logging.getLogger(__name__)
+
+
+def _eval_suite() -> SuiteConfig:
+    """``eval``'s default suite: MT10, its observations those the policy was trained on."""
+    return SuiteConfig(name="metaworld-mt10")
+
+
+@dataclass
+class EvalTarget:
+    """The policy evaluated, on which suite, over which episodes (``EvalConfig``'s first options).
+
+    Attributes:
+        policy_path: Pretrained model folder or Hub id (with its processors).
+        suite: The suite (``SuiteConfig``, spelt as for ``run``: ``--suite.name=drawers``).
+            ``--suite.tasks='[heldout]'`` evaluates the suite's unseen tasks, which a policy trained
+            with ``task_dropout > 0`` acts on with its shared embedding. ``suite.tasks``,
+            ``suite.obs_mode``, ``suite.num_points`` and ``suite.image_size`` default to what the
+            policy was trained on (its tasks that the suite has, else all the suite's).
+        episodes: Episodes per task.
+        seed: Seed of the evaluation episodes.
+        output: Optional JSON file for the results.
+    """
+
+    policy_path: str | None = None
+    suite: SuiteConfig = field(default_factory=_eval_suite)
+    episodes: int = 10
+    seed: int = 0
+    output: Path | None = None
+
+
+@dataclass
+class EvalConfig(WorkerOptions, EvalTarget):
+    """Options of ``lerobot-mtdagger eval``: success per task of a policy (mtdagger, ACT, Diffusion).
+
+    The options of ``EvalTarget``, then the env workers (``WorkerOptions``, as ``run``'s
+    ``--rollout.*``; the same episodes on any backend), then these: a dataclass takes the fields of
+    its last base first, which keeps this order in ``--help``.
+
+    Attributes:
+        trust_checkpoint: Let the policy's processor configs name Python classes, which LeRobot's
+            loader imports and calls (default: only LeRobot registry names are accepted).
+        unseen_rule: How the policy acts on a task it was not trained on (an unseen drawer):
+            ``shared`` with its shared "any task" embedding (a policy trained with task dropout;
+            what a run's unseen-drawer evaluation does), ``nearest`` with the task input of the
+            training task most like it (the drawers: the same handle type, the nearest handle size
+            and height; ``docs/drawers.md``).
+        allow_changed_policy: Evaluate a policy folder of an experiment even if its files differ from
+            the checksums committed with it (said in the output); by default such a folder is refused.
+    """
+
+    trust_checkpoint: bool = False
+    unseen_rule: str = "shared"
+    allow_changed_policy: bool = False
+
+    def __post_init__(self) -> None:
+        self.check_workers()  # before anything runs
+        if self.policy_path is None:
+            raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
+        if self.output is not None:  # before evaluating, not after: the results would be lost
+            check_output_file(self.output, "--output")
+        if self.episodes <= 0:
+            raise ValueError(f"episodes must be > 0, got {self.episodes}.")
+        if self.unseen_rule not in UNSEEN_RULES:
+            raise ValueError(f"unseen_rule must be one of {list(UNSEEN_RULES)}, got {self.unseen_rule!r}.")
+        if self.suite.name is None:  # draccus builds a SuiteConfig of class defaults when one field is given
+            self.suite.name = _eval_suite().name
+        self.suite.check()
+
+
+def check_committed_policy(folder: Path, allow_changed: bool) -> None:
+    """Refuses a policy folder of an experiment whose files changed after commit (unless allowed).
+
+    A folder ``<experiment>/policies/round-XXX`` is checked against the checksums in its
+    ``training.json`` and the experiment's ledger; any other folder (or a Hub id) is not.
+
+    Raises:
+        UserError: Naming the changed files and ``--allow_changed_policy=true``.
+    """
+    from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, TRAINING_FILE, ExperimentDir
+
+    experiment_root = folder.parent.parent
+    if folder.parent.name != "policies" or not (experiment_root / CONFIG_FILE).is_file():
+        return
+    if not (folder / TRAINING_FILE).is_file() or not folder.name.startswith("round-"):
+        return
+    experiment = ExperimentDir(experiment_root)
+    record = experiment.read_phase_record(int(folder.name.split("-")[1]))
+    record_path = str(folder / TRAINING_FILE)
+    problems = experiment.phase_file_problems(record)
+    problems += [p for p in experiment.ledger_problems(resuming=True) if record_path in p]
+    if not problems:
+        return
+    if not allow_changed:
+        raise UserError(
+            f"{folder} changed after it was committed ({'; '.join(problems)}): restore it, or pass "
+            "--allow_changed_policy=true to evaluate it as it is."
+        )
+    print(f"warning: evaluating {folder} although it changed after commit: {'; '.join(problems)}")
+
+
+def suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
+    """The suite the config names and its pretrained policy, checked to take the suite's observations."""
+    from lerobot_mtdagger.envs import suite_from_config
+    from lerobot_mtdagger.runner.evaluate import PolicyRunner
+
+    check_committed_policy(Path(config.policy_path), config.allow_changed_policy)
+    runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
+    suite_config = dataclasses.replace(config.suite, **observation_options(runner, config.suite))
+    if list(suite_config.tasks) == [HELDOUT_TASKS]:
+        suite = suite_from_config(suite_config, tasks=None).heldout_suite()
+        if suite is None:
+            raise UserError(
+                f"Suite {suite_config.name!r} has no held-out tasks: --suite.tasks='[heldout]' is for the "
+                "drawers."
+            )
+    else:
+        suite = suite_from_config(suite_config)
+        trained = [name for name in suite.task_names if name in runner.task_names]
+        if not suite_config.tasks and runner.task_names and not trained and not runner.acts_on_unseen_tasks:
+            shown = ", ".join(runner.task_names[:4]) + (", ..." if len(runner.task_names) > 4 else "")
+            raise UserError(
+                f"The policy was trained on {shown}, none of which --suite.name={suite_config.name} has "
+                "(eval's default suite is metaworld-mt10): pass the --suite.name it was trained on."
+            )
+        if not suite_config.tasks and trained and len(trained) < len(suite.task_names):
+            logger.info("Evaluating the %d tasks of %s the policy knows", len(trained), suite_config.name)
+            suite = suite_from_config(suite_config, tasks=trained)
+    runner.check_inputs(suite.features, suite_config.obs_mode)
+    if config.unseen_rule == "nearest":
+        unseen = [name for name in suite.task_names if name not in runner.task_names]
+        runner.act_as({name: suite.nearest_training_task(name, runner.task_names) for name in unseen})
+        for name, proxy in runner.task_aliases.items():
+            logger.info("Unseen task %r: the policy acts with the task input of %r.", name, proxy)
+    runner.check_tasks(suite.task_names)
+    return suite, runner
+
+
+def observation_options(runner: PolicyRunner, suite: SuiteConfig) -> dict[str, Any]:
+    """``obs_mode``, ``num_points`` and ``image_size``: the suite config's, else the policy's.
+
+    A policy with a point-cloud input was trained on clouds of its input's point count, one with an
+    image input on images of its side, any other on state.
+    """
+    from lerobot_mtdagger.policies.mtdagger.configuration_mtdagger import is_pointcloud_feature
+
+    features = runner.policy.config.input_features
+    clouds = [f for key, f in features.items() if is_pointcloud_feature(key, f)]
+    images = [f for key, f in features.items() if key.startswith("observation.image")]
+    trained = "pointcloud" if clouds else "rgb" if images else "state"
+    return {
+        "obs_mode": suite.obs_mode or trained,
+        "num_points": suite.num_points or (clouds[0].shape[0] if clouds else DEFAULT_NUM_POINTS),
+        "image_size": suite.image_size or (images[0].shape[-1] if images else DEFAULT_IMAGE_SIZE),
+    }
+
+
+def eval_command(config: EvalConfig) -> dict:
+    """Evaluates a pretrained policy per task with the pure policy acting."""
+    from lerobot_mtdagger.runner.evaluate import evaluate
+
+    suite, runner = suite_and_policy(config)
+    with config.env_workers(suite) as workers:
+        result, _ = evaluate(workers, runner, config.episodes, config.seed)
+    progress = result.progress or [None] * len(result.task_names)
+    for task, success, score in zip(result.task_names, result.success, progress, strict=True):
+        line = f"{task:<32} {success:.3f}" + ("" if score is None else f"  progress {score:.2f}/3")
+        proxy = runner.task_aliases.get(task)
+        print(line + ("" if proxy is None else f"  (acting as {proxy})"))
+    mean_progress = "" if result.progress is None else f"  progress {np.mean(result.progress):.2f}/3"
+    print(f"{'mean':<32} {result.mean:.3f}{mean_progress}")
+    values = result.to_dict() | {"unseen_rule": config.unseen_rule}
+    if runner.task_aliases:
+        values["acted_as"] = dict(runner.task_aliases)
+    if config.output is not None:
+        config.output.write_text(json.dumps(values, indent=2))
+    return values

@@ -1,0 +1,66 @@
+"""``lerobot-mtdagger shift``: a pretrained policy's covariate shift, per task.
+
+Its action error on the states of its own rollouts against on the expert's: whether DAgger's relabelled
+rollouts have much to add over more demonstrations. The options are ``eval``'s (``commands/eval.py``).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from lerobot_mtdagger.commands.eval import EvalConfig, suite_and_policy
+
+if TYPE_CHECKING:
+    from lerobot_mtdagger.studies.shift import ShiftResult
+
+
+@dataclass
+class ShiftConfig(EvalConfig):
+    """Options of ``lerobot-mtdagger shift``: a policy's action error on its own states vs the expert's.
+
+    The attributes are ``EvalConfig``'s; ``episodes`` episodes per task are run by the policy and
+    again by the expert from the same reset seeds (``shift.measure_shift``).
+    """
+
+    episodes: int = 5
+
+
+def shift_command(config: ShiftConfig) -> dict:
+    """Measures a pretrained policy's covariate shift per task and prints it."""
+    from lerobot_mtdagger.studies.shift import measure_shift
+
+    suite, runner = suite_and_policy(config)
+    with config.env_workers(suite) as workers:
+        result = measure_shift(workers, runner, config.episodes, config.seed)
+    print(shift_table(result))
+    if config.output is not None:
+        config.output.write_text(json.dumps(result.to_dict(), indent=2))
+    return result.to_dict()
+
+
+def shift_table(result: ShiftResult) -> str:
+    """One line per task: success, mean squared action error on own and expert states, their ratio."""
+    lines = [f"{'task':<32} {'success':>7} {'own states':>10} {'expert states':>13} {'own/expert':>10}"]
+    rows = zip(
+        result.task_names, result.success, result.own_error, result.expert_error, result.ratio, strict=True
+    )
+    for task, success, own, expert, ratio in rows:
+        lines.append(f"{task:<32} {success:7.3f} {own:10.4f} {expert:13.4f} {ratio:10.2f}")
+    own, expert = float(np.mean(result.own_error)), float(np.mean(result.expert_error))
+    lines.append(
+        f"{'mean':<32} {np.mean(result.success):7.3f} {own:10.4f} {expert:13.4f} {result.mean_ratio:10.2f}"
+    )
+    lines.append(f"median task's own/expert ratio: {result.median_ratio:.2f}")
+    own_by_dimension = np.mean(result.own_error_by_dimension, axis=0)
+    expert_by_dimension = np.mean(result.expert_error_by_dimension, axis=0)
+    lines.append(
+        f"mean error per action dimension, own states:    {np.array2string(own_by_dimension, precision=4)}"
+    )
+    lines.append(
+        f"mean error per action dimension, expert states: {np.array2string(expert_by_dimension, precision=4)}"
+    )
+    return "\n".join(lines)
