@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs import ObservationConfig, make_suite
 
 TARGET = 0.5
 
@@ -72,7 +72,7 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=300)
     parser.add_argument("--rounds", type=int, default=3)
     args = parser.parse_args()
-    suite = make_suite(args.suite, obs_mode="pointcloud", num_points=1024)
+    suite = make_suite(args.suite, observation=ObservationConfig(obs_mode="pointcloud", num_points=1024))
     env = suite.make_env(suite.task_names[0], seed=0)
     env.reset(seed=0)
     camera, data = env.unwrapped._cloud, env.unwrapped._env.data

@@ -34,9 +34,9 @@ from lerobot_mtdagger.datasets.records import EXECUTED_ACTION
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.metaworld import _make_raw_env
 from lerobot_mtdagger.policies import MTDAggerPolicy
-from lerobot_mtdagger.runner.collect import run_episodes
-from lerobot_mtdagger.runner.configs import PolicyOptions
+from lerobot_mtdagger.runner.collect import EpisodeOptions, run_episodes
 from lerobot_mtdagger.runner.evaluate import PolicyRunner, evaluate
+from lerobot_mtdagger.runner.student_options import PolicyOptions
 from lerobot_mtdagger.runner.train import build_processors, policy_config
 from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
@@ -127,10 +127,7 @@ def untrained_runner(suite) -> PolicyRunner:
 def collect_rate(workers: EnvWorkers, runner: PolicyRunner, episodes: int, seed: int) -> tuple[float, list]:
     """Recorded steps per second of a DAgger round with the learner acting, and its episodes."""
     start = time.perf_counter()
-    result = run_episodes(
-        workers,
-        [episodes] * len(workers.suite.task_names),
-        policy=runner,
+    options = EpisodeOptions(
         beta=0.0,
         seed=seed,
         round_index=1,
@@ -139,6 +136,7 @@ def collect_rate(workers: EnvWorkers, runner: PolicyRunner, episodes: int, seed:
         max_steps=None,  # the runner's default: the env's own 500-step horizon
         steps_after_success=10,
     )
+    result = run_episodes(workers, [episodes] * len(workers.suite.task_names), options, policy=runner)
     return sum(e.steps for e in result) / (time.perf_counter() - start), result
 
 

@@ -36,7 +36,7 @@ from collections import defaultdict
 
 import numpy as np
 
-from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.envs.drawers.catalogue import VARIANTS
 from lerobot_mtdagger.envs.drawers.scene import DrawerSceneEnv
 from lerobot_mtdagger.envs.metaworld import _make_raw_env
@@ -87,11 +87,13 @@ def make_env(suite_name: str, task: str, mode: str, num_points: int, image_size:
     detail = MESH_DETAIL if mode.endswith("-simple") else 1.0
     suite = make_suite(
         suite_name,
-        obs_mode=obs_mode.removesuffix("-simple"),
-        num_points=num_points,
-        image_size=image_size,
-        pointcloud_cameras=cameras,
-        mesh_detail=detail,
+        observation=ObservationConfig(
+            obs_mode=obs_mode.removesuffix("-simple"),
+            num_points=num_points,
+            image_size=image_size,
+            pointcloud_cameras=cameras,
+            mesh_detail=detail,
+        ),
     )
     return suite.make_env(task, seed=0)
 

@@ -23,11 +23,11 @@ import statistics
 import numpy as np
 from bench_collect import collect_rate, eval_rate  # the same round and evaluation, timed
 
-from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.policies import MTDAggerPolicy
-from lerobot_mtdagger.runner.configs import PolicyOptions
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.ray_workers import RayEnvWorkers
+from lerobot_mtdagger.runner.student_options import PolicyOptions
 from lerobot_mtdagger.runner.train import build_processors, policy_config
 from lerobot_mtdagger.runner.workers import EnvWorkers
 
@@ -82,7 +82,9 @@ def main() -> None:
     parser.add_argument("--obs_mode", default="pointcloud")
     parser.add_argument("--nodes", type=int, default=1, help="Ray nodes started on this machine")
     args = parser.parse_args()
-    suite = make_suite("drawers", tasks=DRAWERS, obs_mode=args.obs_mode, num_points=512)
+    suite = make_suite(
+        "drawers", tasks=DRAWERS, observation=ObservationConfig(obs_mode=args.obs_mode, num_points=512)
+    )
     runner = untrained_runner(suite)
     address, cluster = ray_address(args.nodes, args.workers)
     local, remote = EnvWorkers(suite, args.workers), RayEnvWorkers(suite, args.workers, address)

@@ -42,9 +42,9 @@ def unique_mib() -> float:
 
 def make_envs(suite_name: str, obs_mode: str, count: int) -> list:
     """``count`` reset envs of the suite's first tasks (each reset renders an observation)."""
-    from lerobot_mtdagger.envs import make_suite
+    from lerobot_mtdagger.envs import ObservationConfig, make_suite
 
-    suite = make_suite(suite_name, obs_mode=obs_mode, num_points=512)
+    suite = make_suite(suite_name, observation=ObservationConfig(obs_mode=obs_mode, num_points=512))
     envs = []
     for index, task in enumerate(suite.task_names[:count]):
         env = suite.make_env(task)

@@ -21,7 +21,8 @@ from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
 from lerobot_mtdagger.datasets.rounds import ExperimentDir, writer_lock_holder
 from lerobot_mtdagger.envs import SuiteConfig
-from lerobot_mtdagger.runner.configs import DAggerConfig, RunConfig
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.option_groups import DAggerConfig
 from lerobot_mtdagger.studies.compare import (
     PARENT_PID_ENV,
     CompareConfig,

@@ -23,8 +23,10 @@ from lerobot_mtdagger.datasets.config_layout import (
 )
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
-from lerobot_mtdagger.runner.configs import PRESET_FIELDS, PRESETS, DAggerConfig, RunConfig, TrainingConfig
+from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
+from lerobot_mtdagger.runner.option_groups import DAggerConfig, TrainingConfig
+from lerobot_mtdagger.runner.presets import PRESET_FIELDS, PRESETS
 from lerobot_mtdagger.studies.results import results_rows
 from lerobot_mtdagger.utils import parsing
 from lerobot_mtdagger.utils.errors import UserError
@@ -271,7 +273,7 @@ def test_a_flat_config_migrates_into_the_groups():
     # Every option of today's config is either a migrated one or one added since (with its default).
     today = flatten(parse("--suite.name=toy").to_dict())
     added = set(today) - set(leaves)
-    expected = {"suite.episode_length", "rollout.worker_backend", "rollout.ray_address"}
+    expected = {"suite.episode_length", "suite.module", "rollout.worker_backend", "rollout.ray_address"}
     expected |= {"training.lr_schedule", "training.seed"}
     expected |= {"expert.noise", "expert.noise_correlation", "expert.noise_seed", "expert.labels"}
     expected |= {"expert.path", "expert.type", "expert.min_success", "expert.success_episodes"}

@@ -17,7 +17,7 @@ from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets.records import RoundRecord
 from lerobot_mtdagger.datasets.rounds import ExperimentDir, merge_rounds
 from lerobot_mtdagger.datasets.verify import verify_experiment
-from lerobot_mtdagger.envs.drawers import HELDOUT_TASKS
+from lerobot_mtdagger.envs.drawers.catalogue import HELDOUT_TASKS
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run

@@ -13,6 +13,7 @@ from lerobot_mtdagger.envs import (
     IMAGE_KEY,
     POINTCLOUD_KEY,
     STATE_KEY,
+    ObservationConfig,
     SuiteConfig,
     make_suite,
     suite_from_config,
@@ -273,7 +274,7 @@ def test_the_expert_holds_where_closing_catches_the_handle(name):
 
 @pytest.mark.parametrize("name", ALL_DRAWERS)
 def test_point_clouds_cover_the_handle(name):
-    suite = make_suite("drawers", obs_mode="pointcloud", num_points=1024)
+    suite = make_suite("drawers", observation=ObservationConfig(obs_mode="pointcloud", num_points=1024))
     env = suite.make_env(name, seed=1)
     try:
         observation, _ = env.reset()
@@ -291,7 +292,7 @@ def test_point_clouds_cover_the_handle(name):
 
 def test_rgb_and_state_observations_match_the_suite_features():
     for obs_mode in ("state", "rgb"):
-        suite = make_suite("drawers", obs_mode=obs_mode, image_size=64)
+        suite = make_suite("drawers", observation=ObservationConfig(obs_mode=obs_mode, image_size=64))
         env = suite.make_env("drawer-lip-wide", seed=0)
         try:
             observation, info = env.reset()

@@ -10,7 +10,14 @@ import pytest
 import torch
 
 from benchmarks.bench_cloud import former_cloud
-from lerobot_mtdagger.envs import IMAGE_KEY, POINTCLOUD_KEY, STATE_KEY, SUITE_NAMES, make_suite
+from lerobot_mtdagger.envs import (
+    IMAGE_KEY,
+    POINTCLOUD_KEY,
+    STATE_KEY,
+    SUITE_NAMES,
+    ObservationConfig,
+    make_suite,
+)
 from lerobot_mtdagger.envs.metaworld import METAWORLD_CROP, MT10_TASKS, MT25_TASKS, MT50_TASKS
 from lerobot_mtdagger.experts import CallableExpert, LeRobotPolicyExpert, make_expert
 from lerobot_mtdagger.experts import run_expert_episode as expert_episode
@@ -42,7 +49,9 @@ def test_suite_task_lists_are_metaworlds():
 @pytest.mark.parametrize("obs_mode", MODES)
 @pytest.mark.parametrize("task_name", MT10_TASKS)
 def test_observations_match_features(task_name, obs_mode):
-    suite = make_suite("metaworld-mt10", obs_mode=obs_mode, num_points=256, image_size=64)
+    suite = make_suite(
+        "metaworld-mt10", observation=ObservationConfig(obs_mode=obs_mode, num_points=256, image_size=64)
+    )
     env = suite.make_env(task_name, seed=0)
     try:
         observation, info = env.reset()
@@ -122,7 +131,7 @@ def test_scripted_expert_success_rate_over_mt10():
 
 
 def test_point_cloud_is_exact_finite_and_inside_the_crop():
-    suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=512)
+    suite = make_suite("metaworld-mt10", observation=ObservationConfig(obs_mode="pointcloud", num_points=512))
     env = suite.make_env("push-v3", seed=0)
     observation, _ = env.reset()
     cloud = observation[POINTCLOUD_KEY]
@@ -143,7 +152,10 @@ def test_point_cloud_is_exact_finite_and_inside_the_crop():
 )
 def test_the_cloud_is_the_former_row_by_row_back_projection(suite_name, task, color):
     """Back-projecting per coordinate plane (fast) keeps the points, their order and the sampling."""
-    suite = make_suite(suite_name, obs_mode="pointcloud", num_points=600, pointcloud_color=color)
+    suite = make_suite(
+        suite_name,
+        observation=ObservationConfig(obs_mode="pointcloud", num_points=600, pointcloud_color=color),
+    )
     env = suite.make_env(task, seed=2)
     env.reset(seed=2)
     camera, data = env.unwrapped._cloud, env.unwrapped._env.data
@@ -158,7 +170,9 @@ def test_the_cloud_is_the_former_row_by_row_back_projection(suite_name, task, co
 
 
 def test_point_cloud_follows_the_arm():
-    suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=4096)
+    suite = make_suite(
+        "metaworld-mt10", observation=ObservationConfig(obs_mode="pointcloud", num_points=4096)
+    )
     env = suite.make_env("reach-v3", seed=0)
     observation, info = env.reset()
     before = observation[POINTCLOUD_KEY]
@@ -184,7 +198,9 @@ def test_a_simplified_render_model_differs_only_on_the_meshes_it_simplified():
 
     from lerobot_mtdagger.envs.rendering import MIN_FACES_TO_SIMPLIFY, simplified_model
 
-    env = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=64).make_env("push-v3", seed=0)
+    env = make_suite(
+        "metaworld-mt10", observation=ObservationConfig(obs_mode="pointcloud", num_points=64)
+    ).make_env("push-v3", seed=0)
     env.reset()
     for _ in range(10):
         env.step(np.array([0.5, 0.5, -0.5, 0.0]))
@@ -220,7 +236,9 @@ def test_observation_renderers_have_no_shadow_map_and_the_same_frames(obs_mode):
     """64 MiB per env saved on Mesa: the context has no shadow map, the model keeps its size, frames agree."""
     import mujoco
 
-    env = make_suite("metaworld-mt10", obs_mode=obs_mode, num_points=64).make_env("push-v3", seed=0)
+    env = make_suite(
+        "metaworld-mt10", observation=ObservationConfig(obs_mode=obs_mode, num_points=64)
+    ).make_env("push-v3", seed=0)
     env.reset()
     for _ in range(10):
         env.step(np.array([0.5, 0.5, -0.5, 0.0]))
@@ -243,7 +261,10 @@ def test_observation_renderers_have_no_shadow_map_and_the_same_frames(obs_mode):
 def test_mesh_detail_gives_clouds_of_the_same_scene():
     clouds, faces = [], []
     for detail in (1.0, 0.2):
-        suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=512, mesh_detail=detail)
+        suite = make_suite(
+            "metaworld-mt10",
+            observation=ObservationConfig(obs_mode="pointcloud", num_points=512, mesh_detail=detail),
+        )
         env = suite.make_env("push-v3", seed=3)
         observation, _ = env.reset()
         clouds.append(observation[POINTCLOUD_KEY])
@@ -256,7 +277,7 @@ def test_mesh_detail_gives_clouds_of_the_same_scene():
 
 
 def test_same_seed_gives_the_same_cloud():
-    suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=300)
+    suite = make_suite("metaworld-mt10", observation=ObservationConfig(obs_mode="pointcloud", num_points=300))
     clouds = []
     for _ in range(2):
         env = suite.make_env("drawer-open-v3", seed=5)
@@ -268,7 +289,10 @@ def test_same_seed_gives_the_same_cloud():
 
 
 def test_point_cloud_with_color():
-    suite = make_suite("metaworld-mt10", obs_mode="pointcloud", num_points=128, pointcloud_color=True)
+    suite = make_suite(
+        "metaworld-mt10",
+        observation=ObservationConfig(obs_mode="pointcloud", num_points=128, pointcloud_color=True),
+    )
     env = suite.make_env("reach-v3", seed=0)
     observation, _ = env.reset()
     cloud = observation[POINTCLOUD_KEY]
@@ -293,7 +317,7 @@ def where_the_arm_was(frames: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]
 
 
 def test_rgb_image_is_upright_and_changes_with_the_arm():
-    suite = make_suite("metaworld-mt10", obs_mode="rgb", image_size=64)
+    suite = make_suite("metaworld-mt10", observation=ObservationConfig(obs_mode="rgb", image_size=64))
     env = suite.make_env("reach-v3", seed=0)
     observation, info = env.reset()
     assert observation[IMAGE_KEY].shape == (64, 64, 3) and observation[IMAGE_KEY].dtype == np.uint8
@@ -406,7 +430,11 @@ def test_vector_env_steps_several_tasks_in_parallel():
 def test_features_create_a_lerobot_dataset(tmp_path, obs_mode):
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    suite = make_suite("metaworld-mt10", tasks=["reach-v3"], obs_mode=obs_mode, num_points=64, image_size=32)
+    suite = make_suite(
+        "metaworld-mt10",
+        tasks=["reach-v3"],
+        observation=ObservationConfig(obs_mode=obs_mode, num_points=64, image_size=32),
+    )
     dataset = LeRobotDataset.create(
         repo_id="local/test", fps=80, features=suite.features, root=tmp_path / "ds", use_videos=False
     )
@@ -452,8 +480,10 @@ def test_features_create_a_lerobot_dataset(tmp_path, obs_mode):
     ],
 )
 def test_make_suite_rejects_bad_input(kwargs, match):
+    kwargs = dict(kwargs)
+    name, tasks = kwargs.pop("name"), kwargs.pop("tasks", None)
     with pytest.raises(ValueError, match=match):
-        make_suite(**kwargs)
+        make_suite(name, tasks=tasks, observation=ObservationConfig(**kwargs))
 
 
 def test_suite_names_are_listed():
@@ -464,7 +494,11 @@ def test_unknown_task_and_camera_in_make_env():
     suite = make_suite("metaworld-mt10", tasks=["reach-v3"])
     with pytest.raises(ValueError, match="not in suite"):
         suite.make_env("push-v3")
-    rgb = make_suite("metaworld-mt10", tasks=["reach-v3"], obs_mode="rgb", camera="frontview")
+    rgb = make_suite(
+        "metaworld-mt10",
+        tasks=["reach-v3"],
+        observation=ObservationConfig(obs_mode="rgb", camera="frontview"),
+    )
     with pytest.raises(ValueError, match="Unknown camera 'frontview'; the model has cameras"):
         rgb.make_env("reach-v3")
 

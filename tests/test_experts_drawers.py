@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.envs.drawers import DRAWER_STATE_NAMES, STATE_INDEX, VARIANTS
+from lerobot_mtdagger.envs.drawers.catalogue import VARIANTS
+from lerobot_mtdagger.envs.drawers.variants import DRAWER_STATE_NAMES, STATE_INDEX
 from lerobot_mtdagger.experts.drawers import (
     ALIGN_TOLERANCE,
     PAD_HALF_WIDTH,

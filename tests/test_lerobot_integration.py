@@ -13,7 +13,7 @@ import torch
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.policies.factory import make_pre_post_processors
 
-from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from tests.conftest import lerobot_train
 
@@ -95,7 +95,9 @@ def test_stock_lerobot_train_and_eval_on_state(tmp_path, expert_dataset_factory)
 
 @pytest.mark.slow  # rendered clouds and lerobot-eval, about 40 s
 def test_stock_lerobot_eval_on_point_clouds_through_the_rename_map(tmp_path, expert_dataset_factory):
-    suite = make_suite("metaworld-mt10", tasks=TASKS, obs_mode="pointcloud", num_points=128)
+    suite = make_suite(
+        "metaworld-mt10", tasks=TASKS, observation=ObservationConfig(obs_mode="pointcloud", num_points=128)
+    )
     root = expert_dataset_factory(suite, episodes_per_task=1, steps=20)
     checkpoint = lerobot_train(root, tmp_path / "train", steps=4)
     config = json.loads((checkpoint / "config.json").read_text())

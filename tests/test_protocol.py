@@ -13,6 +13,7 @@ comparison) and fails on it:
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -23,12 +24,18 @@ import torch
 
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.runner.collect import learner_success_by_task, run_episodes, success_by_task
-from lerobot_mtdagger.runner.configs import RolloutConfig, RunConfig, TrainingConfig
+from lerobot_mtdagger.runner.collect import (
+    EpisodeOptions,
+    learner_success_by_task,
+    run_episodes,
+    success_by_task,
+)
+from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.mixing import expert_episode_coin
 from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
+from lerobot_mtdagger.runner.option_groups import RolloutConfig, TrainingConfig
 from lerobot_mtdagger.runner.round_data import EPISODE_ID_STRIDE, TrainingData
 from lerobot_mtdagger.runner.splits import heldout_episodes, split_frames
 from lerobot_mtdagger.runner.steps import batch_sampler
@@ -54,10 +61,7 @@ def metaworld_rollouts():
     rollouts = {}
     with EnvWorkers(suite, 0) as workers:
         for mixing in ("step", "episode"):
-            rollouts[mixing] = run_episodes(
-                workers,
-                [4, 4, 4],
-                policy=zero_actions,
+            options = EpisodeOptions(
                 beta=0.5,
                 seed=100,
                 round_index=1,
@@ -67,6 +71,7 @@ def metaworld_rollouts():
                 steps_after_success=0,
                 mixing=mixing,
             )
+            rollouts[mixing] = run_episodes(workers, [4, 4, 4], options, policy=zero_actions)
     return rollouts
 
 
@@ -110,10 +115,19 @@ def test_rollouts_can_end_at_a_multiple_of_the_experts_length_on_the_same_seed()
     """``rollout_expert_multiple``: a failing learner is cut at ceil(m * the expert's steps to success)."""
     suite = make_suite("metaworld-mt10", tasks=REACH_PUSH_PICK)
     with EnvWorkers(suite, 0) as workers:
-        options = dict(policy=zero_actions, beta=0.5, seed=100, round_index=1, stream=COLLECT_STREAM)
-        options |= dict(record=True, max_steps=None, steps_after_success=10, mixing="episode")
-        episodes = run_episodes(workers, [2, 2, 2], **options, expert_multiple=1.5)
-        uncut = run_episodes(workers, [2, 2, 2], **options)
+        options = EpisodeOptions(
+            beta=0.5,
+            seed=100,
+            round_index=1,
+            stream=COLLECT_STREAM,
+            record=True,
+            max_steps=None,
+            steps_after_success=10,
+            mixing="episode",
+        )
+        cutting = dataclasses.replace(options, expert_multiple=1.5)
+        episodes = run_episodes(workers, [2, 2, 2], cutting, policy=zero_actions)
+        uncut = run_episodes(workers, [2, 2, 2], options, policy=zero_actions)
     for cut, whole in zip(episodes, uncut, strict=True):  # the expert's trial run leaves no trace
         states = [frame["observation.state"] for frame in cut.frames]
         assert np.array_equal(states, [frame["observation.state"] for frame in whole.frames[: len(states)]])
@@ -148,10 +162,7 @@ def test_episode_mixing_does_not_depend_on_the_worker_count(expert_multiple):
 
     def collect(workers: int):
         with EnvWorkers(suite, workers) as env_workers:
-            episodes = run_episodes(
-                env_workers,
-                [3, 2, 4],
-                policy=lambda obs, tasks: np.full((len(obs), 2), 0.1, dtype=np.float32),
+            options = EpisodeOptions(
                 beta=0.5,
                 seed=3,
                 round_index=1,
@@ -162,6 +173,8 @@ def test_episode_mixing_does_not_depend_on_the_worker_count(expert_multiple):
                 mixing="episode",
                 expert_multiple=expert_multiple,
             )
+            policy = lambda obs, tasks: np.full((len(obs), 2), 0.1, dtype=np.float32)  # noqa: E731
+            episodes = run_episodes(env_workers, [3, 2, 4], options, policy=policy)
         return [(e.task_index, e.episode, e.steps, e.learner_steps, e.success) for e in episodes]
 
     assert collect(0) == collect(2)

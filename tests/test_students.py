@@ -25,9 +25,10 @@ from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE, TaskOneHotProcessorStep, task_one_hot
-from lerobot_mtdagger.runner.configs import RunConfig, lerobot_students
+from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.evaluate import ChunkRunner, PolicyRunner, evaluate
+from lerobot_mtdagger.runner.student_options import lerobot_students
 from lerobot_mtdagger.runner.students import EpisodeWindows, LeRobotOps, lerobot_student_config
 from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.utils.errors import UserError

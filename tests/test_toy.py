@@ -19,10 +19,10 @@ from lerobot_mtdagger.datasets.records import (
 )
 from lerobot_mtdagger.datasets.rounds import STAGING_DIR, ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
-from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.envs.toy import MAX_EPISODE_STEPS, TOY_TASKS
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.runner.collect import episode_seed, run_episodes, success_by_task
+from lerobot_mtdagger.runner.collect import EpisodeOptions, episode_seed, run_episodes, success_by_task
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.round_data import TrainingData
@@ -50,10 +50,7 @@ def collect(
     suite, counts, beta, policy=zero_learner, seed=0, max_steps=MAX_EPISODE_STEPS, after=0, workers=0
 ):
     with EnvWorkers(suite, workers) as env_workers:
-        return run_episodes(
-            env_workers,
-            counts,
-            policy=policy,
+        options = EpisodeOptions(
             beta=beta,
             seed=seed,
             round_index=1,
@@ -62,6 +59,7 @@ def collect(
             max_steps=max_steps,
             steps_after_success=after,
         )
+        return run_episodes(env_workers, counts, options, policy=policy)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -91,7 +89,7 @@ def test_toy_reset_is_seeded_and_observations_match_the_features(suite):
 
 def test_toy_suite_refuses_visual_modes_and_unknown_tasks():
     with pytest.raises(ValueError, match="state observations only"):
-        make_suite("toy", obs_mode="rgb")
+        make_suite("toy", observation=ObservationConfig(obs_mode="rgb"))
     with pytest.raises(ValueError, match="Unknown toy task"):
         make_suite("toy", tasks=["toy-down"])
 

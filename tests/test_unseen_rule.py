@@ -13,7 +13,7 @@ from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.commands.eval import EvalConfig, eval_command
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.envs.drawers import HELDOUT_DRAWERS, TRAINING_DRAWERS, VARIANTS
+from lerobot_mtdagger.envs.drawers.catalogue import HELDOUT_DRAWERS, TRAINING_DRAWERS, VARIANTS
 from lerobot_mtdagger.envs.drawers.variants import nearest_variant
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
@@ -43,7 +43,7 @@ def test_no_nearest_drawer_across_handle_types():
     assert knob.handle_distance(VARIANTS["drawer-kitchen"]) == float("inf")
     assert nearest_variant(knob, [VARIANTS["drawer-kitchen"], VARIANTS["drawer-lip-wide"]]) is None
     assert nearest_variant(knob, []) is None
-    suite = make_suite("drawers", obs_mode="state")
+    suite = make_suite("drawers")
     with pytest.raises(UserError, match=r"No training drawer has a knob handle.*--unseen_rule=shared"):
         suite.nearest_training_task("drawer-knob-tall", TRAINED)
 

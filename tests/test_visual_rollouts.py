@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from lerobot_mtdagger.datasets.records import EXECUTED_ACTION, LEARNER_ACTED
-from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.runner.collect import run_episodes
+from lerobot_mtdagger.runner.collect import EpisodeOptions, run_episodes
 from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
@@ -38,16 +38,17 @@ def wandering_learner(observations, tasks):
 
 @pytest.fixture(scope="module")
 def suite():
-    return make_suite("drawers", tasks=DRAWERS, obs_mode="pointcloud", num_points=256, depth_size=48)
+    return make_suite(
+        "drawers",
+        tasks=DRAWERS,
+        observation=ObservationConfig(obs_mode="pointcloud", num_points=256, depth_size=48),
+    )
 
 
 @pytest.fixture(scope="module")
 def episodes(suite):
     with EnvWorkers(suite, 0) as workers:
-        return run_episodes(
-            workers,
-            [2, 1, 2],
-            policy=wandering_learner,
+        options = EpisodeOptions(
             beta=0.5,
             seed=11,
             round_index=1,
@@ -57,6 +58,7 @@ def episodes(suite):
             steps_after_success=3,
             mixing="step",
         )
+        return run_episodes(workers, [2, 1, 2], options, policy=wandering_learner)
 
 
 def replay(suite, episode):

@@ -13,10 +13,11 @@ import pytest
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.envs import SuiteConfig, make_suite
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.runner.collect import run_episodes
-from lerobot_mtdagger.runner.configs import RolloutConfig, RunConfig
+from lerobot_mtdagger.runner.collect import EpisodeOptions, run_episodes
+from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.evaluate import evaluate
+from lerobot_mtdagger.runner.option_groups import RolloutConfig
 from lerobot_mtdagger.runner.workers import EnvWorkers, RemoteWorkerError, WorkerDiedError
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
@@ -36,10 +37,7 @@ def tilted_learner(observations, tasks):
 
 def collect(suite, workers, counts=(4, 1, 6), beta=0.5, policy=tilted_learner):
     with EnvWorkers(suite, workers) as env_workers:
-        return run_episodes(
-            env_workers,
-            list(counts),
-            policy=policy,
+        options = EpisodeOptions(
             beta=beta,
             seed=7,
             round_index=1,
@@ -48,6 +46,7 @@ def collect(suite, workers, counts=(4, 1, 6), beta=0.5, policy=tilted_learner):
             max_steps=30,
             steps_after_success=3,
         )
+        return run_episodes(env_workers, list(counts), options, policy=policy)
 
 
 def episode_key(episode):
@@ -119,19 +118,17 @@ def test_a_worker_killed_mid_collection_raises_instead_of_hanging(suite):
                 os.kill(victim.pid, signal.SIGKILL)
             return tilted_learner(observations, tasks)
 
+        options = EpisodeOptions(
+            beta=0.0,
+            seed=0,
+            round_index=1,
+            stream=COLLECT_STREAM,
+            record=True,
+            max_steps=30,
+            steps_after_success=0,
+        )
         with pytest.raises(WorkerDiedError, match=r"Env worker 1 \(pid \d+\) died .* --resume=true"):
-            run_episodes(
-                env_workers,
-                [3, 3, 3],
-                policy=learner_that_kills_a_worker,
-                beta=0.0,
-                seed=0,
-                round_index=1,
-                stream=COLLECT_STREAM,
-                record=True,
-                max_steps=30,
-                steps_after_success=0,
-            )
+            run_episodes(env_workers, [3, 3, 3], options, policy=learner_that_kills_a_worker)
 
 
 class FailingExpert:

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from lerobot_mtdagger.envs import make_suite
+from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.studies.shift import ShiftResult, measure_shift
@@ -69,7 +69,7 @@ def main() -> int:
     torch.set_num_threads(1)
     chosen = policies(seed)
     config = json.loads((chosen[0][1].parents[1] / "config.json").read_text())
-    suite = make_suite(config["suite"], obs_mode=config["obs_mode"])
+    suite = make_suite(config["suite"], observation=ObservationConfig(obs_mode=config["obs_mode"]))
     print(f"{len(suite.task_names)} tasks, {EPISODES} evaluation episodes per task (seed {seed})\n")
     print(
         "| policy | success | error, own states | own, successful episodes | own, failed episodes "

@@ -18,8 +18,8 @@ from collections import Counter, defaultdict
 
 import numpy as np
 
-from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.envs.drawers import STATE_INDEX
+from lerobot_mtdagger.envs import ObservationConfig, make_suite
+from lerobot_mtdagger.envs.drawers.variants import STATE_INDEX
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.experts.drawers import BRANCHES
 from lerobot_mtdagger.runner.collect import EVAL_STREAM, episode_seed
@@ -40,7 +40,7 @@ def main(policy_path: str, episodes: int = 5, seed: int = 0, drawer: str | None 
     """Prints the branch table of one policy (module docstring)."""
     runner = PolicyRunner.from_pretrained(policy_path)
     num_points = runner.policy.config.input_features["observation.pointcloud"].shape[0]
-    suite = make_suite("drawers", obs_mode="pointcloud", num_points=num_points)
+    suite = make_suite("drawers", observation=ObservationConfig(obs_mode="pointcloud", num_points=num_points))
     names = suite.task_names if drawer is None else [drawer]
     counts: Counter[str] = Counter()
     errors: dict[str, list[float]] = defaultdict(list)

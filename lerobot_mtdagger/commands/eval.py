@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from lerobot_mtdagger.envs.config import DEFAULT_IMAGE_SIZE, DEFAULT_NUM_POINTS, SuiteConfig
-from lerobot_mtdagger.runner.configs import WorkerOptions
+from lerobot_mtdagger.runner.option_groups import WorkerOptions
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.paths import check_output_file
 

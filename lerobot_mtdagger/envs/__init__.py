@@ -1,6 +1,7 @@
 """Task suites with state, RGB and point-cloud observations.
 
-``make_suite(name, tasks=None, obs_mode="state", ...)`` builds a suite:
+``make_suite(name, tasks=None, observation=ObservationConfig(...), ...)`` builds the suite registered
+under ``name`` (``registry``); the package registers these:
 
 ==================  =====================================================================
 name                tasks
@@ -15,8 +16,9 @@ toy                 a point mass pushed to task-specific goals (``envs/toy.py``)
                     state only, for fast tests
 ==================  =====================================================================
 
+``register_suite(name, factory)`` adds a suite (``docs/suites.md``: "Add a suite");
 ``suite_from_config(config)`` builds the suite a ``SuiteConfig`` names (``run``, ``eval``, ``shift``
-and the LeRobot env plugin each hold one: ``envs/config.py``).
+and the LeRobot env plugin each hold one: ``envs/config.py``), after importing its ``module``.
 
 ``tasks=[...]`` with a named list selects a subset in the given order. Rendering uses MuJoCo's EGL
 backend unless ``MUJOCO_GL`` is already set (``osmesa`` is the fallback without EGL).
@@ -46,16 +48,19 @@ from lerobot_mtdagger.envs.config import (  # noqa: E402
     DEFAULT_NUM_POINTS,
     SuiteConfig,
 )
+from lerobot_mtdagger.envs.registry import (  # noqa: E402
+    BUILT_IN_SUITES,
+    SuiteFactory,
+    SuiteOptions,
+    build_suite,
+    import_suite_module,
+    register_suite,
+    suite_names,
+)
 from lerobot_mtdagger.utils.errors import UserError  # noqa: E402
 
-SUITE_NAMES: tuple[str, ...] = (
-    "metaworld-mt10",
-    "metaworld-mt25",
-    "metaworld-mt50",
-    "metaworld",
-    "drawers",
-    "toy",
-)
+SUITE_NAMES: tuple[str, ...] = tuple(BUILT_IN_SUITES)
+"""The package's own suites (``suite_names()``: every registered one)."""
 
 __all__ = [
     "IMAGE_KEY",
@@ -65,10 +70,14 @@ __all__ = [
     "SUITE_NAMES",
     "CropBox",
     "ObservationConfig",
-    "TaskSuite",
     "SuiteConfig",
+    "SuiteFactory",
+    "SuiteOptions",
+    "TaskSuite",
     "make_suite",
+    "register_suite",
     "suite_from_config",
+    "suite_names",
 ]
 
 
@@ -76,37 +85,19 @@ def make_suite(
     name: str,
     *,
     tasks: Sequence[str] | None = None,
-    obs_mode: str = "state",
-    image_size: int = 84,
-    camera: str | None = None,
-    num_points: int = 1024,
-    pointcloud_cameras: Sequence[str] | None = None,
-    depth_size: int = 84,
-    pointcloud_color: bool = False,
-    crop: CropBox | None = None,
-    include_goal: bool = True,
+    observation: ObservationConfig | None = None,
     max_episode_steps: int | None = None,
     placement: str | None = None,
-    mesh_detail: float = 1.0,
 ) -> TaskSuite:
-    """Builds a task suite.
+    """Builds a registered task suite.
 
     Args:
-        name: One of ``SUITE_NAMES``.
+        name: A registered suite name (``suite_names()``; the package's are ``SUITE_NAMES``).
         tasks: Task subset (any order); required for ``metaworld``, optional for the named lists.
-        obs_mode: ``state``, ``rgb`` or ``pointcloud``.
-        image_size: RGB image side in pixels.
-        camera: RGB camera name (suite default when None).
-        num_points: Points per cloud.
-        pointcloud_cameras: Depth cameras of the cloud (suite default when None).
-        depth_size: Depth image side in pixels.
-        pointcloud_color: Add per-point RGB.
-        crop: Crop box of the cloud (suite default when None).
-        include_goal: Append the goal position to the proprioceptive state in rgb/pointcloud modes.
+        observation: What the envs show the policy (None: ``ObservationConfig()``, state).
         max_episode_steps: Truncation length (the task's max path length when None).
         placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen``, the
             default, or ``narrow``; see ``lerobot_mtdagger.envs.drawers.PLACEMENTS``).
-        mesh_detail: Share of the faces of each large mesh the observation renderer keeps (1: all).
 
     Returns:
         The suite.
@@ -114,72 +105,45 @@ def make_suite(
     Raises:
         ValueError: On an unknown suite, task or observation setting.
     """
-    observation = ObservationConfig(
-        obs_mode=obs_mode,
-        image_size=image_size,
-        camera=camera,
-        num_points=num_points,
-        pointcloud_cameras=None if pointcloud_cameras is None else tuple(pointcloud_cameras),
-        depth_size=depth_size,
-        mesh_detail=mesh_detail,
-        pointcloud_color=pointcloud_color,
-        crop=crop,
-        include_goal=include_goal,
+    options = SuiteOptions(
+        name=name,
+        tasks=tuple(tasks or ()),
+        observation=observation or ObservationConfig(),
+        max_episode_steps=max_episode_steps,
+        placement=placement,
     )
-    if name not in SUITE_NAMES:
-        raise UserError(f"Unknown suite {name!r}; available suites: {list(SUITE_NAMES)}.")
-    if name == "drawers":
-        from lerobot_mtdagger.envs.drawers import DRAWER_TASKS, PLACEMENTS, DrawerSuite
-
-        if placement is not None and placement not in PLACEMENTS:
-            raise UserError(f"Unknown drawer placement {placement!r}; choose one of {sorted(PLACEMENTS)}.")
-        task_names = list(tasks) if tasks else list(DRAWER_TASKS)
-        return DrawerSuite(task_names, observation, max_episode_steps=max_episode_steps, placement=placement)
-    if placement is not None:
-        raise UserError(f"placement={placement!r} applies to the drawers suite only; drop it for {name!r}.")
-    if name == "toy":
-        from lerobot_mtdagger.envs.toy import TOY_TASKS, ToySuite
-
-        return ToySuite(list(tasks) if tasks else list(TOY_TASKS), observation, max_episode_steps)
-    from lerobot_mtdagger.envs.metaworld import MT10_TASKS, MT25_TASKS, MT50_TASKS, MetaWorldSuite
-
-    named_lists = {"metaworld-mt10": MT10_TASKS, "metaworld-mt25": MT25_TASKS, "metaworld-mt50": MT50_TASKS}
-    if name == "metaworld":
-        if not tasks:
-            raise UserError("Suite 'metaworld' needs an explicit tasks=[...] list of v3 task names.")
-        task_names = list(tasks)
-    else:
-        available = named_lists[name]
-        task_names = list(tasks) if tasks else list(available)
-        outside = [t for t in task_names if t not in available]
-        if outside:
-            raise UserError(f"Task(s) {outside} are not in {name}; its tasks: {list(available)}.")
-    return MetaWorldSuite(task_names, observation, max_episode_steps=max_episode_steps, name=name)
+    return build_suite(options)
 
 
 def suite_from_config(config: SuiteConfig, **overrides: Any) -> TaskSuite:
     """The suite a ``SuiteConfig`` names (unset observation options at their defaults).
+
+    Its ``module`` (``--suite.module``) is imported first, so that the suites it registers are known.
 
     Args:
         config: The command's suite options.
         **overrides: ``make_suite`` keyword arguments that replace the config's.
 
     Raises:
-        UserError: On an unknown suite, task or observation setting (one line, naming the option).
+        UserError: On an unknown suite or module, task or observation setting (one line, naming the option).
     """
     if config.name is None:
         raise UserError("No suite given: pass --suite.name (e.g. --suite.name=metaworld-mt10).")
     config.check()
-    options: dict[str, Any] = {
-        "tasks": list(config.tasks) if config.tasks else None,
-        "obs_mode": config.obs_mode or "state",
-        "image_size": config.image_size or DEFAULT_IMAGE_SIZE,
-        "num_points": config.num_points or DEFAULT_NUM_POINTS,
-        "max_episode_steps": config.episode_length,
-        "placement": config.placement,
-        "mesh_detail": config.mesh_detail,
-    }
+    if config.module is not None:
+        import_suite_module(config.module)
     try:
+        options: dict[str, Any] = {
+            "tasks": list(config.tasks) if config.tasks else None,
+            "observation": ObservationConfig(
+                obs_mode=config.obs_mode or "state",
+                image_size=config.image_size or DEFAULT_IMAGE_SIZE,
+                num_points=config.num_points or DEFAULT_NUM_POINTS,
+                mesh_detail=config.mesh_detail,
+            ),
+            "max_episode_steps": config.episode_length,
+            "placement": config.placement,
+        }
         return make_suite(config.name, **(options | overrides))
     except UserError:
         raise

@@ -26,8 +26,8 @@ class SuiteConfig:
     """A task suite and its observations.
 
     Attributes:
-        name: Suite name (``make_suite``: ``metaworld-mt10``, ``drawers``, ``toy``, ...). None: the
-            command's default (``run``: the preset's).
+        name: A registered suite name (``make_suite``: ``metaworld-mt10``, ``drawers``, ``toy``, ...,
+            or one that ``module`` registers). None: the command's default (``run``: the preset's).
         tasks: Subset of the suite's tasks (all when empty; ``eval`` and ``shift`` also take
             ``heldout``: the suite's unseen tasks).
         obs_mode: ``state``, ``rgb`` or ``pointcloud``. None: the command's default (``run``: the
@@ -40,6 +40,9 @@ class SuiteConfig:
         placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when
             None; ``narrow``: the suite's first ranges). Refused for other suites.
         episode_length: Steps after which an episode is truncated (None: each task's own horizon).
+        module: A module imported before the suite is built, which registers suites from outside
+            the package (``register_suite``), e.g. ``my_package.suites``; ``name`` may then be one
+            of them. None: the package's suites only.
     """
 
     name: str | None = None
@@ -50,6 +53,7 @@ class SuiteConfig:
     mesh_detail: float = 1.0
     placement: str | None = None
     episode_length: int | None = None
+    module: str | None = None
 
     def check(self) -> None:
         """Refuses options that cannot name a suite, before anything runs.
@@ -77,6 +81,10 @@ class SuiteConfig:
                 raise UserError(f"suite.{name} must be <= {limit} ({why}), got {value}.")
         if not 0.0 < self.mesh_detail <= 1.0:
             raise UserError(f"suite.mesh_detail must be in (0, 1], got {self.mesh_detail}.")
+        if self.module is not None and not all(part.isidentifier() for part in self.module.split(".")):
+            raise UserError(
+                f"suite.module must be a dotted module name (e.g. my_package.suites), got {self.module!r}."
+            )
 
     def fill_defaults(self) -> None:
         """Gives unset observation options their defaults (a run stores them resolved).

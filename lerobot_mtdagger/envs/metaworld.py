@@ -37,6 +37,7 @@ from lerobot_mtdagger.envs.base import (
     TaskSuite,
     observation_features,
 )
+from lerobot_mtdagger.envs.registry import SuiteOptions
 from lerobot_mtdagger.envs.rendering import (
     CropBox,
     PointCloudCamera,
@@ -52,6 +53,12 @@ MT10_TASKS: tuple[str, ...] = tuple(MT10_V3)
 MT25_TASKS: tuple[str, ...] = tuple(MT25_V3)
 MT50_TASKS: tuple[str, ...] = tuple(MT50_V3)
 ALL_TASKS: tuple[str, ...] = tuple(ALL_V3_ENVIRONMENTS)
+NAMED_TASK_LISTS: dict[str, tuple[str, ...]] = {
+    "metaworld-mt10": MT10_TASKS,
+    "metaworld-mt25": MT25_TASKS,
+    "metaworld-mt50": MT50_TASKS,
+}
+"""The suites named after one of MetaWorld's lists, and their tasks."""
 
 METAWORLD_CROP = CropBox(low=(-0.6, 0.2, 0.01), high=(0.6, 1.1, 0.7))
 DEFAULT_CAMERA = "corner"
@@ -319,3 +326,28 @@ class MetaWorldSuite(TaskSuite):
     def features(self) -> dict[str, dict[str, Any]]:
         """LeRobot features of the observations of the current mode, plus ``action``."""
         return observation_features(self.observation, observation_state_names(self.observation), ACTION_NAMES)
+
+
+def build_metaworld_suite(options: SuiteOptions) -> MetaWorldSuite:
+    """The factory of the MetaWorld suites (registered as ``metaworld-mt10/25/50`` and ``metaworld``).
+
+    A suite of ``NAMED_TASK_LISTS`` holds its list (``options.tasks``: a subset, in any order);
+    any other name (``metaworld``) holds exactly ``options.tasks``, v3 task names.
+
+    Raises:
+        UserError: On a placement, a task outside the named list, or no task for ``metaworld``.
+    """
+    options.refuse_placement()
+    available = NAMED_TASK_LISTS.get(options.name)
+    if available is None:
+        if not options.tasks:
+            raise UserError(f"Suite {options.name!r} needs an explicit tasks=[...] list of v3 task names.")
+        task_names = list(options.tasks)
+    else:
+        task_names = options.task_list(available)
+        outside = [t for t in task_names if t not in available]
+        if outside:
+            raise UserError(f"Task(s) {outside} are not in {options.name}; its tasks: {list(available)}.")
+    return MetaWorldSuite(
+        task_names, options.observation, max_episode_steps=options.max_episode_steps, name=options.name
+    )

@@ -22,6 +22,7 @@ import gymnasium as gym
 import numpy as np
 
 from lerobot_mtdagger.envs.base import STATE_KEY, ObservationConfig, TaskSuite, state_feature
+from lerobot_mtdagger.envs.registry import SuiteOptions
 
 STEP_SIZE = 0.05
 SUCCESS_RADIUS = 0.05
@@ -155,3 +156,14 @@ class ToySuite(TaskSuite):
     def features(self) -> dict[str, dict[str, Any]]:
         """``observation.state`` (x, y) and ``action`` (push x, y)."""
         return {STATE_KEY: state_feature(STATE_NAMES), "action": state_feature(ACTION_NAMES)}
+
+
+def build_toy_suite(options: SuiteOptions) -> ToySuite:
+    """The factory of the toy suite (registered as ``toy``): ``TOY_TASKS`` unless tasks are given.
+
+    Raises:
+        UserError: On a placement (the toy suite has none).
+        ValueError: On an unknown task or a mode other than ``state``.
+    """
+    options.refuse_placement()
+    return ToySuite(options.task_list(TOY_TASKS), options.observation, options.max_episode_steps)

@@ -104,21 +104,54 @@ class _Schedule:
         )
 
 
+@dataclass(frozen=True)
+class EpisodeOptions:
+    """How the episodes of one ``run_episodes`` call run (the same for every episode).
+
+    Attributes:
+        beta: Probability of executing the expert's action (at a step, or for a whole episode).
+        seed: Experiment seed.
+        round_index: DAgger round (part of the episode seeds, written into the recorded frames).
+        stream: ``COLLECT_STREAM`` or ``EVAL_STREAM``.
+        record: Keep the frames (observation, expert label, executed action, learner flag).
+        max_steps: Longest episode (None: the env's own truncation).
+        steps_after_success: Steps kept after the first success.
+        mixing: ``step`` (a beta coin per step) or ``episode`` (one per episode).
+        expert_multiple: Cut a learner's episode at this multiple of the expert's own steps to
+            success from the same reset seed (``RolloutRules.expert_multiple``; None: no such cut).
+    """
+
+    beta: float
+    seed: int
+    round_index: int
+    stream: int
+    record: bool
+    max_steps: int | None
+    steps_after_success: int
+    mixing: str = "step"
+    expert_multiple: float | None = None
+
+    def rules(self, learner: bool) -> RolloutRules:
+        """The workers' rules for these episodes (``learner``: whether a learner acts at all)."""
+        return RolloutRules(
+            beta=self.beta,
+            learner=learner,
+            record=self.record,
+            round_index=self.round_index,
+            max_steps=self.max_steps,
+            steps_after_success=self.steps_after_success,
+            mixing=self.mixing,
+            expert_multiple=self.expert_multiple,
+        )
+
+
 def run_episodes(
     workers: EnvWorkers,
     episodes_per_task: Sequence[int],
+    options: EpisodeOptions,
     *,
     policy: PolicyFn | None,
-    beta: float,
-    seed: int,
-    round_index: int,
-    stream: int,
-    record: bool,
-    max_steps: int | None,
-    steps_after_success: int,
     progress: Callable[[Episode], None] | None = None,
-    mixing: str = "step",
-    expert_multiple: float | None = None,
 ) -> list[Episode]:
     """Runs ``episodes_per_task[i]`` episodes of task i on the env workers, in lock-step.
 
@@ -131,18 +164,9 @@ def run_episodes(
     Args:
         workers: The run's env workers (their suite gives experts and task names).
         episodes_per_task: Episodes to run per task.
-        policy: The learner (None only when ``beta == 1``).
-        beta: Probability of executing the expert's action at a step.
-        seed: Experiment seed.
-        round_index: DAgger round (part of the episode seeds).
-        stream: ``COLLECT_STREAM`` or ``EVAL_STREAM``.
-        record: Keep the frames (observation, expert label, executed action, learner flag).
-        max_steps: Longest episode (None: the env's own truncation).
-        steps_after_success: Steps kept after the first success.
+        options: Beta, seeds, recording and episode cuts (``EpisodeOptions``).
+        policy: The learner (None only when ``options.beta == 1``).
         progress: Called with each finished episode.
-        mixing: ``step`` (a beta coin per step) or ``episode`` (one per episode).
-        expert_multiple: Cut a learner's episode at this multiple of the expert's own steps to
-            success from the same reset seed (``RolloutRules.expert_multiple``; None: no such cut).
 
     Returns:
         The episodes, ordered by (task, episode).
@@ -151,24 +175,14 @@ def run_episodes(
         ValueError: If ``policy`` is None while ``beta < 1``, or the counts do not match the tasks.
     """
     task_names = workers.suite.task_names
-    if policy is None and beta < 1.0:
-        raise ValueError(f"beta={beta} < 1 needs a learner policy.")
+    if policy is None and options.beta < 1.0:
+        raise ValueError(f"beta={options.beta} < 1 needs a learner policy.")
     if len(episodes_per_task) != len(task_names):
         raise ValueError(f"Got {len(episodes_per_task)} episode counts for {len(task_names)} tasks.")
-    learner = policy is not None and beta < 1.0
-    workers.set_rules(
-        RolloutRules(
-            beta=beta,
-            learner=learner,
-            record=record,
-            round_index=round_index,
-            max_steps=max_steps,
-            steps_after_success=steps_after_success,
-            mixing=mixing,
-            expert_multiple=expert_multiple,
-        )
-    )
-    schedule = _Schedule([deque(range(int(n))) for n in episodes_per_task], seed, round_index, stream)
+    learner = policy is not None and options.beta < 1.0
+    workers.set_rules(options.rules(learner))
+    queues = [deque(range(int(n))) for n in episodes_per_task]
+    schedule = _Schedule(queues, options.seed, options.round_index, options.stream)
     lanes = [_Lane(home_task=task, group=task % LANE_GROUPS) for task in range(len(task_names))]
     for handle in range(len(lanes)):
         _assign(lanes, handle, schedule, workers.slots)

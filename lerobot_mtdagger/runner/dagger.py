@@ -54,17 +54,24 @@ from lerobot_mtdagger.envs import suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.runner.collect import (
     Episode,
+    EpisodeOptions,
     learner_success_by_task,
     run_episodes,
     success_by_task,
 )
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.evaluate import EvalResult, PolicyRunner, evaluate, make_runner
-from lerobot_mtdagger.runner.expert_check import EXPERT_CHECK_FILE, ExpertCheck, measure_expert_check
+from lerobot_mtdagger.runner.expert_check import EXPERT_CHECK_FILE
+from lerobot_mtdagger.runner.run_setup import (
+    beta_for_round,
+    check_budget,
+    kept_tasks_check,
+    new_scheduler,
+    unseen_task_suite,
+)
 from lerobot_mtdagger.runner.train import RoundCache, check_heldout, student_config, train_on_rounds
 from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
-from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.quiet import quiet_third_party
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
@@ -93,19 +100,6 @@ class RunContext:
     def last_round(self) -> int:
         """Index of the last round of the experiment."""
         return 0 if self.config.is_bc else self.config.dagger.rounds
-
-
-def beta_for_round(config: RunConfig, round_index: int) -> float:
-    """Probability of executing the expert's action in a round (1 in round 0)."""
-    if round_index == 0:
-        return 1.0
-    dagger = config.dagger
-    return max(dagger.beta - (round_index - 1) * dagger.beta_decay, dagger.beta_min)
-
-
-def new_scheduler(config: RunConfig, num_tasks: int) -> Scheduler:
-    """A fresh scheduler of the run's method (its config class is the run's ``scheduler``)."""
-    return Scheduler(config.scheduler, num_tasks)
 
 
 # -------------------------------------------------------------------------------------------------
@@ -165,10 +159,7 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
     with tqdm(
         total=sum(counts), desc=f"round {round_index} collect", leave=False, disable=not ctx.show_progress
     ) as bar:
-        episodes = run_episodes(
-            ctx.workers,
-            counts,
-            policy=runner,
+        options = EpisodeOptions(
             beta=beta,
             seed=config.seed,
             round_index=round_index,
@@ -176,10 +167,10 @@ def collect_round(ctx: RunContext, round_index: int) -> None:
             record=True,
             max_steps=max_steps,
             steps_after_success=config.rollout.steps_after_success,
-            progress=lambda _: bar.update(1),
             mixing=config.dagger.mixing,
             expert_multiple=config.rollout.expert_multiple,
         )
+        episodes = run_episodes(ctx.workers, counts, options, policy=runner, progress=lambda _: bar.update(1))
     collected = time.perf_counter()
     dataset = ctx.experiment.write_round(
         round_index,
@@ -358,22 +349,6 @@ def summary_line(ctx: RunContext, round_index: int) -> str:
     )
 
 
-def check_budget(config: RunConfig, num_tasks: int) -> None:
-    """Refuses a round budget that cannot give every task n_min episodes, before anything runs.
-
-    Raises:
-        UserError: With the numbers and the fix.
-    """
-    budget = config.dagger.budget_for(num_tasks)
-    n_min = config.scheduler.min_episodes
-    if not config.is_bc and budget < n_min * num_tasks:
-        raise UserError(
-            f"budget={budget} is smaller than n_min * num_tasks = {n_min} * {num_tasks} = "
-            f"{n_min * num_tasks}: raise --dagger.budget to at least {n_min * num_tasks} or lower "
-            "--scheduler.n_min."
-        )
-
-
 PHASE_DETAIL_TIMINGS = ("steps_s", "task_loss_s")
 """Parts of ``train_s`` kept in the phase's record (``training.json``) but not in the summary line."""
 
@@ -420,41 +395,6 @@ def run(
         if on_start is not None:
             on_start()
         return _run_locked(config, suite, experiment, on_summary)
-
-
-def kept_tasks_check(config: RunConfig, suite: TaskSuite, experiment: ExperimentDir) -> ExpertCheck | None:
-    """The tasks ``--expert.min_success`` keeps: read back on a resume, else measured (None: no rule).
-
-    Raises:
-        UserError: If no task is kept, or a resumed experiment's ``expert_check.json`` is unreadable.
-    """
-    options = config.expert
-    if options.min_success is None:
-        return None
-    stored = experiment.root / EXPERT_CHECK_FILE
-    if config.resume:
-        return ExpertCheck.read(stored)
-    logger.info(
-        "Measuring each task's expert on %d episodes (--expert.min_success)", options.success_episodes
-    )
-    return measure_expert_check(suite, options.min_success, options.success_episodes, config.seed)
-
-
-def unseen_task_suite(config: RunConfig, suite: TaskSuite) -> TaskSuite | None:
-    """The held-out tasks every phase is also evaluated on.
-
-    None where the suite has none, the policy has no shared task embedding to act on them with
-    (``--policy.task_dropout=0``), or nothing is evaluated.
-    """
-    heldout = suite.heldout_suite()
-    if heldout is None or config.rollout.eval_episodes == 0:
-        return None
-    if config.policy.resolved_task_dropout(True) == 0.0:
-        logger.info(
-            "Unseen tasks are not evaluated: --policy.task_dropout=0 gives no embedding to act on them."
-        )
-        return None
-    return heldout
 
 
 def _run_locked(

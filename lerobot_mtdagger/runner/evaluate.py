@@ -20,7 +20,7 @@ from lerobot.utils.constants import OBS_IMAGES
 from lerobot_mtdagger.datasets.checkpoints import load_policy
 from lerobot_mtdagger.policies import TASK_FEATURE, MTDAggerPolicy
 from lerobot_mtdagger.policies.task_conditioning import TaskOneHotProcessorStep
-from lerobot_mtdagger.runner.collect import PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.runner.collect import EpisodeOptions, PolicyFn, run_episodes, success_by_task
 from lerobot_mtdagger.runner.workers import EnvWorkers, Episode
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
@@ -345,10 +345,7 @@ def evaluate(
         progress: Called with each finished episode.
     """
     suite = workers.suite
-    episodes = run_episodes(
-        workers,
-        [episodes_per_task] * len(suite.task_names),
-        policy=runner,
+    options = EpisodeOptions(
         beta=0.0,
         seed=seed,
         round_index=0,
@@ -356,7 +353,9 @@ def evaluate(
         record=False,
         max_steps=None,
         steps_after_success=steps_after_success,
-        progress=progress,
+    )
+    episodes = run_episodes(
+        workers, [episodes_per_task] * len(suite.task_names), options, policy=runner, progress=progress
     )
     rates, counts = success_by_task(episodes, len(suite.task_names))
     progress = None

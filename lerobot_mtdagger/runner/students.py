@@ -3,7 +3,7 @@
 The runner trains its student through one seam (``steps.phase_ops``): a training batch at given
 frames, the loss of one step, the per-task imitation loss and the optimiser. ``mtdagger`` has its
 fast implementation in ``steps.py``; ``LeRobotOps`` here implements it for any LeRobot
-``PreTrainedPolicy`` of ``configs.lerobot_students()`` from what LeRobot's policies declare:
+``PreTrainedPolicy`` of ``student_options.lerobot_students()`` from what LeRobot's policies declare:
 
 - **Windows of frames**, as LeRobot's ``delta_timestamps`` give them: a frame's observation history
   (``observation_delta_indices``: Diffusion's ``n_obs_steps``) and its action chunk
@@ -38,7 +38,7 @@ from lerobot_mtdagger.policies.task_conditioning import (
     task_feature,
     task_one_hot,
 )
-from lerobot_mtdagger.runner.configs import lerobot_policy_config
+from lerobot_mtdagger.runner.student_options import lerobot_policy_config
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 
 LOSS_CHUNK = 256

@@ -22,7 +22,7 @@ from tqdm import tqdm
 
 from lerobot_mtdagger.datasets.records import PhaseRecord
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
-from lerobot_mtdagger.runner.configs import UNSEEN_TASK_DROPOUT, PolicyOptions, RunConfig
+from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
 from lerobot_mtdagger.runner.plateau import plateau_stop
@@ -30,6 +30,7 @@ from lerobot_mtdagger.runner.provenance import training_environment
 from lerobot_mtdagger.runner.round_data import TrainingData, load_round
 from lerobot_mtdagger.runner.splits import heldout_mask, normalisation_frames, split_frames
 from lerobot_mtdagger.runner.steps import PhaseResult, StepOptions, phase_ops, train_phase
+from lerobot_mtdagger.runner.student_options import UNSEEN_TASK_DROPOUT, PolicyOptions
 from lerobot_mtdagger.runner.task_loss import per_task_loss_of, performance_gain
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features

@@ -38,7 +38,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar
 
-from lerobot_mtdagger.runner.configs import RunConfig, default_worker_count
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.option_groups import default_worker_count
 from lerobot_mtdagger.scheduler import scheduling_methods
 from lerobot_mtdagger.studies.launchers import PARENT_PID_ENV, Job, RayRunPool, RunPool
 from lerobot_mtdagger.utils.errors import UserError

@@ -30,7 +30,7 @@ import gymnasium as gym
 import numpy as np
 
 from lerobot_mtdagger.envs.base import TaskSuite
-from lerobot_mtdagger.runner.collect import PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.runner.collect import EpisodeOptions, PolicyFn, run_episodes, success_by_task
 from lerobot_mtdagger.runner.workers import EnvWorkers, Episode
 from lerobot_mtdagger.utils.seeds import EVAL_STREAM
 
@@ -168,10 +168,7 @@ def _labelled_rollouts(
     workers: EnvWorkers, counts: Sequence[int], policy: PolicyFn | None, seed: int
 ) -> list[Episode]:
     """Recorded evaluation episodes with the expert's label at every state; the expert acts if no policy."""
-    return run_episodes(
-        workers,
-        counts,
-        policy=policy,
+    options = EpisodeOptions(
         beta=1.0 if policy is None else 0.0,
         seed=seed,
         round_index=0,
@@ -180,6 +177,7 @@ def _labelled_rollouts(
         max_steps=None,
         steps_after_success=0,
     )
+    return run_episodes(workers, counts, options, policy=policy)
 
 
 def _episode_errors(

@@ -54,110 +54,37 @@ neither MuJoCo, MetaWorld nor gymnasium):
 ``pictures``     ``render_drawer_picture``
 ===============  ==================================================================================
 
-Every public name is re-exported here (``from lerobot_mtdagger.envs.drawers import DrawerSuite``),
-lazily: a name's module is imported on first access, so importing ``variants`` or ``catalogue``
-(as the drawer expert does) loads neither the MuJoCo scene nor MetaWorld.
+The names a user of the suite needs are importable from here too (``DrawerSuite``,
+``DrawerVariant``, ``DRAWER_TASKS``, ``HELDOUT_TASKS``, ``PLACEMENTS``, ``DRAWER_STATE_NAMES``,
+``SUCCESS_FRACTION``), lazily: a name's module is imported on first access, so importing ``variants``
+or ``catalogue`` (as the drawer expert does) loads neither the MuJoCo scene nor MetaWorld. Every other
+name is imported from the module that defines it.
 """
 
 from __future__ import annotations
 
 import importlib
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-# Public name (all of ``__all__``) -> the submodule that defines it.
 _EXPORTS: dict[str, str] = {
-    **dict.fromkeys(
-        ("DRAWER_TASKS", "HELDOUT_DRAWERS", "HELDOUT_TASKS", "TRAINING_DRAWERS", "VARIANTS"), "catalogue"
-    ),
-    **dict.fromkeys(("PAD_HALF_HEIGHT", "PAD_OFFSET_Y", "drawer_body_xml", "drawer_mjcf"), "mjcf"),
-    "render_drawer_picture": "pictures",
-    "DrawerSceneEnv": "scene",
-    **dict.fromkeys(("DRAWER_CROP", "DrawerSuite", "DrawerTaskEnv", "drawer_state_names"), "suite"),
-    **dict.fromkeys(
-        (
-            "DRAWER_STATE_NAMES",
-            "HANDLE_TYPES",
-            "MAX_EPISODE_STEPS",
-            "DEFAULT_PLACEMENT",
-            "PLACEMENTS",
-            "PLACEMENT_RANGE",
-            "PULL_FRACTION",
-            "STATE_INDEX",
-            "SUCCESS_FRACTION",
-            "TABLE_X_LIMIT",
-            "TABLE_Y_RANGE",
-            "DrawerVariant",
-            "Placement",
-            "placement_named",
-        ),
-        "variants",
-    ),
+    "DRAWER_TASKS": "catalogue",
+    "HELDOUT_TASKS": "catalogue",
+    "DRAWER_STATE_NAMES": "variants",
+    "PLACEMENTS": "variants",
+    "SUCCESS_FRACTION": "variants",
+    "DrawerVariant": "variants",
+    "DrawerSuite": "suite",
 }
-
-if TYPE_CHECKING:
-    from lerobot_mtdagger.envs.drawers.catalogue import (
-        DRAWER_TASKS,
-        HELDOUT_DRAWERS,
-        HELDOUT_TASKS,
-        TRAINING_DRAWERS,
-        VARIANTS,
-    )
-    from lerobot_mtdagger.envs.drawers.mjcf import PAD_HALF_HEIGHT, PAD_OFFSET_Y, drawer_body_xml, drawer_mjcf
-    from lerobot_mtdagger.envs.drawers.pictures import render_drawer_picture
-    from lerobot_mtdagger.envs.drawers.scene import DrawerSceneEnv
-    from lerobot_mtdagger.envs.drawers.suite import (
-        DRAWER_CROP,
-        DrawerSuite,
-        DrawerTaskEnv,
-        drawer_state_names,
-    )
-    from lerobot_mtdagger.envs.drawers.variants import (
-        DEFAULT_PLACEMENT,
-        DRAWER_STATE_NAMES,
-        HANDLE_TYPES,
-        MAX_EPISODE_STEPS,
-        PLACEMENT_RANGE,
-        PLACEMENTS,
-        PULL_FRACTION,
-        STATE_INDEX,
-        SUCCESS_FRACTION,
-        TABLE_X_LIMIT,
-        TABLE_Y_RANGE,
-        DrawerVariant,
-        Placement,
-        placement_named,
-    )
+"""Public name -> the submodule that defines it."""
 
 __all__ = [
-    "DEFAULT_PLACEMENT",
-    "DRAWER_CROP",
     "DRAWER_STATE_NAMES",
     "DRAWER_TASKS",
-    "HANDLE_TYPES",
-    "HELDOUT_DRAWERS",
     "HELDOUT_TASKS",
-    "MAX_EPISODE_STEPS",
-    "PAD_HALF_HEIGHT",
-    "PAD_OFFSET_Y",
     "PLACEMENTS",
-    "PLACEMENT_RANGE",
-    "PULL_FRACTION",
-    "STATE_INDEX",
     "SUCCESS_FRACTION",
-    "TABLE_X_LIMIT",
-    "TABLE_Y_RANGE",
-    "TRAINING_DRAWERS",
-    "VARIANTS",
-    "DrawerSceneEnv",
     "DrawerSuite",
-    "DrawerTaskEnv",
     "DrawerVariant",
-    "Placement",
-    "drawer_body_xml",
-    "drawer_mjcf",
-    "drawer_state_names",
-    "placement_named",
-    "render_drawer_picture",
 ]
 
 
@@ -172,4 +99,5 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
+    """The module's names and the lazily imported public ones."""
     return sorted(set(globals()) | set(_EXPORTS))

@@ -14,10 +14,11 @@ from typing import Any
 import numpy as np
 
 from lerobot_mtdagger.envs.base import ObservationConfig, TaskSuite, observation_features
-from lerobot_mtdagger.envs.drawers.catalogue import HELDOUT_TASKS, VARIANTS
+from lerobot_mtdagger.envs.drawers.catalogue import DRAWER_TASKS, HELDOUT_TASKS, VARIANTS
 from lerobot_mtdagger.envs.drawers.scene import DrawerSceneEnv
 from lerobot_mtdagger.envs.drawers.variants import (
     DRAWER_STATE_NAMES,
+    PLACEMENTS,
     STATE_INDEX,
     DrawerVariant,
     Placement,
@@ -25,6 +26,7 @@ from lerobot_mtdagger.envs.drawers.variants import (
     placement_named,
 )
 from lerobot_mtdagger.envs.metaworld import ACTION_DIM, ACTION_NAMES, PROPRIO_NAMES, MetaWorldTaskEnv
+from lerobot_mtdagger.envs.registry import SuiteOptions
 from lerobot_mtdagger.envs.rendering import CropBox
 from lerobot_mtdagger.utils.errors import UserError
 
@@ -165,3 +167,22 @@ class DrawerSuite(TaskSuite):
     def features(self) -> dict[str, dict[str, Any]]:
         """LeRobot features of the observations of the current mode, plus ``action``."""
         return observation_features(self.observation, drawer_state_names(self.observation), ACTION_NAMES)
+
+
+def build_drawer_suite(options: SuiteOptions) -> DrawerSuite:
+    """The factory of the drawer suite (registered as ``drawers``): ``DRAWER_TASKS`` unless tasks are given.
+
+    Raises:
+        UserError: On a placement that is not one of ``PLACEMENTS``.
+        ValueError: On an unknown drawer.
+    """
+    if options.placement is not None and options.placement not in PLACEMENTS:
+        raise UserError(
+            f"Unknown drawer placement {options.placement!r}; choose one of {sorted(PLACEMENTS)}."
+        )
+    return DrawerSuite(
+        options.task_list(DRAWER_TASKS),
+        options.observation,
+        max_episode_steps=options.max_episode_steps,
+        placement=options.placement,
+    )

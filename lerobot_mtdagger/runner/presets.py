@@ -1,0 +1,138 @@
+"""The paper's presets of ``lerobot-mtdagger run`` and the values each fills.
+
+Every option a preset fills (``PRESET_FIELDS``) has one home, its own field; None there means "from
+the preset" (``--preset``, default ``small``: MT10 state, a few rounds, minutes on a 2-core CPU), so
+a value given on the command line always wins. The ``*-paper`` presets follow the paper's "Setup"
+and hyperparameter table (n_min is ``scheduler.n_min``; lr and batch are ``policy.lr`` and
+``policy.batch_size``; points is ``suite.num_points``) and are sized for a GPU; ``metaworld-pixels``
+and ``drawers-pointcloud`` keep the paper's rounds and scale the demonstrations, steps and batch down
+to a 2-core CPU (the visual-collapse study's reduced run, ``experiments/visual-collapse-dev``):
+
+=========================  ==========  ======  =======  ==========  =====  =====  ====  =====  ======
+preset                     obs_mode    rounds  initial  per round   steps  n_min  lr    batch  points
+=========================  ==========  ======  =======  ==========  =====  =====  ====  =====  ======
+small                      state       3       3        3           1500   1      3e-4  256
+metaworld-state            state       10      3        3           3000   1      3e-4  1024
+metaworld-pixels           rgb         5       10       10          1500   2      3e-4  64
+metaworld-pixels-paper     rgb         5       40       20          3000   1      3e-4  1024
+drawers-pointcloud         pointcloud  10      10       5           1500   2      3e-4  64     512
+drawers-pointcloud-paper   pointcloud  10      30       30          3000   5      1e-4  256    1024
+=========================  ==========  ======  =======  ==========  =====  =====  ====  =====  ======
+
+(initial and per round: expert demonstrations per task; steps: ``training.steps_per_round``. Every
+preset samples batches ``uniform``ly except ``metaworld-pixels``, whose runs (DAgger and BC) sample
+``balanced``: ``PIXELS_SAMPLING``.)
+
+The DAgger mixing coefficient ``beta`` is the probability that the EXPERT's action is executed at
+a step (classic DAgger; the paper's text is ambiguous): 0.5 in the first DAgger round, decayed by
+0.5 per round to 0. ``--mode=bc`` runs the one-round behaviour-cloning baseline instead.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from lerobot_mtdagger.envs.config import DEFAULT_NUM_POINTS
+
+PIXELS_SAMPLING = "balanced"
+"""``metaworld-pixels``' batch sampling, DAgger and BC, chosen on development seeds 100-102. DAgger
+(200 evaluation episodes per phase, ``experiments/visual-collapse-dev`` 6c): with uniform sampling
+the rounds lowered success (0.680 -> 0.678 -> 0.630), with balanced sampling they raised it (0.627 ->
+0.678 -> 0.685). BC (``experiments/pixels-bc-dev``, a rule fixed before its runs): uniform BC is
+ahead at 10 demos per task (0.670 against 0.600) but loses success from 10 to 30 (0.645); balanced
+BC rises (0.762 at 30, 0.795 at 60 against uniform's 0.755) and has the higher mean."""
+
+
+PRESETS: dict[str, dict[str, Any]] = {
+    "small": {
+        "suite.name": "metaworld-mt10",
+        "suite.obs_mode": "state",
+        "suite.num_points": DEFAULT_NUM_POINTS,
+        "dagger.rounds": 3,
+        "dagger.initial_demos": 3,
+        "dagger.budget_per_task": 3,
+        "training.steps_per_round": 1500,
+        "rollout.eval_episodes": 5,
+        "scheduler.n_min": 1,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 256,
+        "training.sampling": "uniform",
+    },
+    "metaworld-state": {
+        "suite.name": "metaworld-mt50",
+        "suite.obs_mode": "state",
+        "suite.num_points": DEFAULT_NUM_POINTS,
+        "dagger.rounds": 10,
+        "dagger.initial_demos": 3,
+        "dagger.budget_per_task": 3,
+        "training.steps_per_round": 3000,
+        "rollout.eval_episodes": 10,
+        "scheduler.n_min": 1,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 1024,
+        "training.sampling": "uniform",
+    },
+    "metaworld-pixels": {
+        "suite.name": "metaworld-mt10",
+        "suite.obs_mode": "rgb",
+        "suite.num_points": DEFAULT_NUM_POINTS,
+        "dagger.rounds": 5,
+        "dagger.initial_demos": 10,
+        "dagger.budget_per_task": 10,
+        "training.steps_per_round": 1500,
+        "rollout.eval_episodes": 5,
+        "scheduler.n_min": 2,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 64,
+        "training.sampling": PIXELS_SAMPLING,
+    },
+    "metaworld-pixels-paper": {
+        "suite.name": "metaworld-mt10",
+        "suite.obs_mode": "rgb",
+        "suite.num_points": DEFAULT_NUM_POINTS,
+        "dagger.rounds": 5,
+        "dagger.initial_demos": 40,
+        "dagger.budget_per_task": 20,
+        "training.steps_per_round": 3000,
+        "rollout.eval_episodes": 10,
+        "scheduler.n_min": 1,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 1024,
+        "training.sampling": "uniform",
+    },
+    "drawers-pointcloud": {
+        "suite.name": "drawers",
+        "suite.obs_mode": "pointcloud",
+        "suite.num_points": 512,
+        "dagger.rounds": 10,
+        "dagger.initial_demos": 10,
+        "dagger.budget_per_task": 5,
+        "training.steps_per_round": 1500,
+        "rollout.eval_episodes": 5,
+        "scheduler.n_min": 2,
+        "policy.lr": 3e-4,
+        "policy.batch_size": 64,
+        "training.sampling": "uniform",
+    },
+    "drawers-pointcloud-paper": {
+        "suite.name": "drawers",
+        "suite.obs_mode": "pointcloud",
+        "suite.num_points": DEFAULT_NUM_POINTS,
+        "dagger.rounds": 10,
+        "dagger.initial_demos": 30,
+        "dagger.budget_per_task": 30,
+        "training.steps_per_round": 3000,
+        "rollout.eval_episodes": 10,
+        "scheduler.n_min": 5,
+        "policy.lr": 1e-4,
+        "policy.batch_size": 256,
+        "training.sampling": "uniform",
+    },
+}
+"""Preset values by option path (the command-line spelling without ``--``). Each option filled by a
+preset has ONE home: its field (None there means "from the preset"); a value given on the command
+line or in Python always wins. A value that is a mapping is keyed by ``RunConfig.mode``."""
+
+
+PRESET_FIELDS: tuple[str, ...] = tuple(PRESETS["small"])
+"""The options every preset fills."""
