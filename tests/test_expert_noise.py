@@ -216,7 +216,7 @@ NOISY_08 = ["--expert.noise=0.8", "--expert.noise_correlation=0.9", "--expert.su
 def test_min_success_keeps_the_tasks_whose_noisy_expert_passes_and_records_them(
     tmp_path, capsys, monkeypatch
 ):
-    from lerobot_mtdagger.runner import dagger
+    from lerobot_mtdagger.runner import run_setup
     from lerobot_mtdagger.runner.expert_check import expert_success
 
     suite = make_suite("toy").with_expert_noise(ExpertNoise(scale=0.8, correlation=0.9))
@@ -231,7 +231,7 @@ def test_min_success_keeps_the_tasks_whose_noisy_expert_passes_and_records_them(
     record = json.loads((out / "rounds" / "round-001" / "meta" / "mtdagger.json").read_text())
     assert record["task_names"] == kept and record["config"]["expert"]["min_success"] == threshold
     # a resume reads the measurement back and measures nothing
-    monkeypatch.setattr(dagger, "measure_expert_check", lambda *args: pytest.fail("measured again"))
+    monkeypatch.setattr(run_setup, "measure_expert_check", lambda *args: pytest.fail("measured again"))
     args = [*TOY, *NOISY_08, f"--expert.min_success={threshold}", "--dagger.rounds=2"]
     assert main(["run", *args, f"--output_dir={out}", "--resume=true"]) == 0
     assert main(["verify", f"--experiment_dir={out}"]) == 0
