@@ -20,14 +20,13 @@ from lerobot.configs.policies import PreTrainedConfig
 from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 from lerobot.processor.pipeline import ProcessorStepRegistry
 
+from lerobot_mtdagger.datasets.student_types import student_policy_types
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 PROCESSOR_FILES = ("policy_preprocessor.json", "policy_postprocessor.json")
 POLICY_TYPE = "mtdagger"
-POLICY_TYPES = ("mtdagger", "act", "diffusion")
-"""Policy types this toolkit trains and evaluates (``--policy.type``)."""
 HUB_ID_PATTERN = re.compile(r"[A-Za-z0-9][\w.-]*/[A-Za-z0-9][\w.-]*")
 """``owner/name``: a ``--policy_path`` of this form that is not a local folder is read from the Hub."""
 
@@ -116,7 +115,9 @@ def check_policy_path(path: str | Path) -> None:
 
 
 def check_local_policy(folder: Path) -> None:
-    """Checks that a local folder is a complete policy of ``POLICY_TYPES`` with readable safetensors files.
+    """Checks that a local folder is a complete policy of a student's type with readable safetensors files.
+
+    The types are ``student_types.student_policy_types()``: the built-in students' and those registered.
 
     Raises:
         UserError: If it is a file, a dataset, an experiment, another policy type, or a file of it is
@@ -141,9 +142,10 @@ def check_local_policy(folder: Path) -> None:
         raise UserError(
             f"{config} is not a policy config (unreadable JSON); the checkpoint is corrupt."
         ) from None
-    if policy_type not in POLICY_TYPES:
+    if policy_type not in student_policy_types():
         raise UserError(
-            f"{config} describes a {policy_type!r} policy; this command evaluates {list(POLICY_TYPES)} "
+            f"{config} describes a {policy_type!r} policy; this command evaluates "
+            f"{list(student_policy_types())} "
             "policies (stock lerobot-eval evaluates the others)."
         )
     if not (folder / "model.safetensors").is_file():
@@ -169,7 +171,7 @@ def _check_safetensors(path: Path) -> None:
 def load_policy(
     path: str | Path, device: str = "cpu", trust_checkpoint: bool = False
 ) -> tuple[Any, Any, Any]:
-    """Loads a policy folder or Hub id (``POLICY_TYPES``) with its saved processors, after the checks above.
+    """Loads a policy folder or Hub id (a student's type) with its saved processors, after the checks above.
 
     Args:
         path: A local policy folder or a Hub repo id.

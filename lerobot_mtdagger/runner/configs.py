@@ -28,14 +28,12 @@ from lerobot_mtdagger.runner.option_groups import (
     check_device,
 )
 from lerobot_mtdagger.runner.presets import PRESETS
+from lerobot_mtdagger.runner.student import Student, student_names, student_of_options
 from lerobot_mtdagger.runner.student_options import (
-    LEROBOT_STUDENT_TYPES,
-    UNSUPPORTED_STUDENT_OPTIONS,
     PolicyOptions,
     StudentOptions,
     names_lerobot_student,
     policy_options_dict,
-    student_type,
     students_for,
 )
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
@@ -105,7 +103,7 @@ class RunConfig:
                 return None
             if asked:
                 return dict(StudentOptions.get_known_choices())
-            return {"mtdagger": PolicyOptions, **dict.fromkeys(LEROBOT_STUDENT_TYPES)}
+            return {**dict.fromkeys(student_names()), "mtdagger": PolicyOptions}
 
         return choices
 
@@ -146,7 +144,7 @@ class RunConfig:
         self.rollout.check()
         self.training.check()
         self.expert.check()
-        lr_name = "lr" if isinstance(self.policy, PolicyOptions) else "optimizer_lr"
+        lr_name = self.student.lr_option
         lr = getattr(self.policy, lr_name)
         if self.policy.batch_size <= 0 or not (math.isfinite(lr) and lr > 0):
             raise ValueError(
@@ -155,38 +153,17 @@ class RunConfig:
             )
         check_device(self.policy.device)
         check_output_dir(self.output_dir, "--output_dir")
-        self._check_student()
+        self.student.check_run(self)
 
-    def _check_student(self) -> None:
-        """Refuses what a LeRobot student cannot do here: point clouds, temporal ensembling, ignored options.
-
-        The options are those of its LeRobot config the runner would ignore (``UNSUPPORTED_STUDENT_OPTIONS``).
-        """
-        if self.student_type == "mtdagger":
-            return
-        for name, reason in UNSUPPORTED_STUDENT_OPTIONS.items():
-            if getattr(self.policy, name, None) not in (None, False):
-                raise ValueError(f"--policy.{name} is not supported by run: {reason}; drop the option.")
-        if self.training.lr_schedule != "constant":
-            raise ValueError(
-                f"--training.lr_schedule={self.training.lr_schedule} is for the mtdagger policy; "
-                f"--policy.type={self.student_type} follows its own scheduler preset: drop the option."
-            )
-        if self.suite.obs_mode == "pointcloud":
-            raise ValueError(
-                f"--policy.type={self.student_type} cannot read point clouds (a LeRobot policy takes "
-                "state and images): use --policy.type=mtdagger or --suite.obs_mode=state|rgb."
-            )
-        if getattr(self.policy, "temporal_ensemble_coeff", None) is not None:
-            raise ValueError(
-                "--policy.temporal_ensemble_coeff is not supported for a DAgger student (its action "
-                "queue is kept per episode): drop it and set --policy.n_action_steps instead."
-            )
+    @property
+    def student(self) -> Student:
+        """The student of ``--policy.type`` (``runner.student``)."""
+        return student_of_options(self.policy)
 
     @property
     def student_type(self) -> str:
-        """``--policy.type``: ``mtdagger`` or a LeRobot policy type."""
-        return student_type(self.policy)
+        """``--policy.type``: ``mtdagger``, a LeRobot policy type or another registered student."""
+        return self.student.name
 
     @property
     def is_bc(self) -> bool:

@@ -18,9 +18,10 @@ import torch
 from lerobot.utils.constants import OBS_IMAGES
 
 from lerobot_mtdagger.datasets.checkpoints import load_policy
-from lerobot_mtdagger.policies import TASK_FEATURE, MTDAggerPolicy
+from lerobot_mtdagger.policies import TASK_FEATURE
 from lerobot_mtdagger.policies.task_conditioning import TaskOneHotProcessorStep
 from lerobot_mtdagger.runner.collect import EpisodeOptions, PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.runner.student import student_of_policy
 from lerobot_mtdagger.runner.workers import EnvWorkers, Episode
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
@@ -79,11 +80,9 @@ class PolicyRunner:
         """Whether the policy has an input for a task outside ``task_names``.
 
         An ``mtdagger`` policy has one only when trained with task dropout (its shared embedding); a
-        LeRobot student's one-hot vector is all zeros for such a task.
+        LeRobot student's one-hot vector is all zeros for such a task (``ChunkRunner``).
         """
-        if isinstance(self.policy, MTDAggerPolicy):
-            return self.policy.any_task_index is not None
-        return True
+        return self.policy.any_task_index is not None
 
     def act_as(self, aliases: dict[str, str]) -> None:
         """Makes the policy act on each key task with the task input of its value (a training task).
@@ -186,6 +185,11 @@ class ChunkRunner(PolicyRunner):
     """
 
     tracks_episodes = True
+
+    @property
+    def acts_on_unseen_tasks(self) -> bool:
+        """Always: a task outside ``task_names`` gets the all-zero one-hot vector."""
+        return True
 
     def __init__(self, policy: Any, preprocessor: Any, postprocessor: Any) -> None:
         """Wraps a LeRobot policy in eval mode with its processors."""
@@ -291,9 +295,14 @@ class ChunkRunner(PolicyRunner):
 
 
 def make_runner(policy: Any, preprocessor: Any, postprocessor: Any) -> PolicyRunner:
-    """The runner of a policy: ``PolicyRunner`` for ``mtdagger``, ``ChunkRunner`` for LeRobot's."""
-    runner_class = PolicyRunner if isinstance(policy, MTDAggerPolicy) else ChunkRunner
-    return runner_class(policy, preprocessor, postprocessor)
+    """The runner of a policy, its student's (``Student.make_runner``).
+
+    ``PolicyRunner`` for ``mtdagger``, ``ChunkRunner`` for LeRobot's.
+
+    Raises:
+        UserError: If no registered student builds policies of its type.
+    """
+    return student_of_policy(policy).make_runner(policy, preprocessor, postprocessor)
 
 
 @dataclass

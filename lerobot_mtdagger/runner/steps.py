@@ -25,6 +25,7 @@ from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE
 from lerobot_mtdagger.runner.normalise import NormalisedData
 from lerobot_mtdagger.runner.plateau import PlateauStop, PlateauTracker
+from lerobot_mtdagger.runner.student import student_of_policy
 from lerobot_mtdagger.runner.task_loss import per_task_loss, performance_gain
 from lerobot_mtdagger.utils.errors import UserError
 
@@ -126,12 +127,8 @@ class MTDAggerOps:
 
 
 def phase_ops(policy: Any, data: NormalisedData, options: StepOptions) -> Any:
-    """The training seam of ``policy``: ``MTDAggerOps`` or ``students.LeRobotOps``."""
-    if isinstance(policy, MTDAggerPolicy):
-        return MTDAggerOps(policy, data, options.lr, options.lr_schedule)
-    from lerobot_mtdagger.runner.students import LeRobotOps
-
-    return LeRobotOps(policy, data, options.task_dropout, options.seed)
+    """The training seam of ``policy``: ``Student.phase_ops`` of its student (``MTDAggerOps`` for ours)."""
+    return student_of_policy(policy).phase_ops(policy, data, options)
 
 
 class _LossWindow:

@@ -15,6 +15,9 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from lerobot_mtdagger.datasets.student_types import BUILTIN_STUDENT_TYPES, MTDAGGER_TYPE
+from lerobot_mtdagger.runner.student import get_student, student_names, student_of_options
+
 
 @dataclass
 class PolicyOptions:
@@ -89,17 +92,18 @@ UNSUPPORTED_STUDENT_OPTIONS: dict[str, str] = {
 """Options of LeRobot's policy configs that ``run`` would otherwise ignore: refused, naming why."""
 
 
-LEROBOT_STUDENT_TYPES: tuple[str, ...] = ("act", "diffusion")
-"""``--policy.type`` values other than ``mtdagger``: LeRobot's own policies as the student."""
-
-
 @functools.cache
-def lerobot_students() -> dict[str, type]:
-    """The options class of each LeRobot student type (LeRobot's policies imported on first use)."""
-    from lerobot.policies.act.configuration_act import ACTConfig
-    from lerobot.policies.diffusion.configuration_diffusion import DiffusionConfig
+def lerobot_options_class(policy_type: str) -> type:
+    """The options class of a LeRobot policy type as a student (LeRobot's policies imported on first use)."""
+    import lerobot.policies  # noqa: F401  (registers LeRobot's policy configs)
+    from lerobot.configs.policies import PreTrainedConfig
 
-    return {"act": _lerobot_student(ACTConfig), "diffusion": _lerobot_student(DiffusionConfig)}
+    return _lerobot_student(PreTrainedConfig.get_choice_class(policy_type))
+
+
+def lerobot_students() -> dict[str, type]:
+    """The options class of each built-in LeRobot student type (every one but ``mtdagger``)."""
+    return {name: lerobot_options_class(name) for name in BUILTIN_STUDENT_TYPES if name != MTDAGGER_TYPE}
 
 
 _LEROBOT_STUDENTS_PARSED: contextvars.ContextVar[bool] = contextvars.ContextVar(
@@ -112,6 +116,9 @@ def names_lerobot_student(options: Sequence[str]) -> bool:
     """Whether command-line options may choose a LeRobot student.
 
     They may with a ``--policy.type`` other than ``mtdagger``, or a ``--config_path`` file.
+
+    Raises:
+        UserError: If ``--policy.type`` names no registered student (one line listing them).
     """
     for position, option in enumerate(options):
         name, separator, value = option.partition("=")
@@ -120,7 +127,7 @@ def names_lerobot_student(options: Sequence[str]) -> bool:
         if name == "--policy.type":
             if not separator:
                 value = options[position + 1] if position + 1 < len(options) else ""
-            return value != "mtdagger"
+            return get_student(value).name != MTDAGGER_TYPE
     return False
 
 
@@ -141,8 +148,9 @@ def students_for(options: Sequence[str]) -> Iterator[None]:
 class StudentOptions:
     """The student policy and its options: ``--policy.type`` (draccus choice type; default ``mtdagger``).
 
-    ``mtdagger`` takes ``PolicyOptions``; ``act`` and ``diffusion`` take LeRobot's own config of that
-    policy (``lerobot_students()``) plus ``batch_size``. A stored config without ``type`` is ``mtdagger``.
+    Each registered student (``runner.student``) gives its options class: ``mtdagger`` takes
+    ``PolicyOptions``; ``act`` and ``diffusion`` take LeRobot's own config of that policy
+    (``lerobot_students()``) plus ``batch_size``. A stored config without ``type`` is ``mtdagger``.
     """
 
     @classmethod
@@ -154,11 +162,11 @@ class StudentOptions:
     def get_known_choices(cls) -> dict[str, type]:
         """Every ``--policy.type`` and its options class.
 
-        ``mtdagger`` alone while options that name no LeRobot student are parsed (``students_for``).
+        ``mtdagger`` alone while options that name no other student are parsed (``students_for``).
         """
         if not _LEROBOT_STUDENTS_PARSED.get():
-            return {"mtdagger": PolicyOptions}
-        return {"mtdagger": PolicyOptions, **lerobot_students()}
+            return {MTDAGGER_TYPE: get_student(MTDAGGER_TYPE).options_class()}
+        return {name: get_student(name).options_class() for name in student_names()}
 
     @classmethod
     def get_choice_name(cls, subcls: type) -> str:
@@ -175,14 +183,12 @@ class StudentOptions:
     @classmethod
     def default_choice_name(cls) -> str:
         """``mtdagger``."""
-        return "mtdagger"
+        return MTDAGGER_TYPE
 
 
 def student_type(options: Any) -> str:
     """The ``--policy.type`` of a run's policy options."""
-    if isinstance(options, PolicyOptions):
-        return "mtdagger"
-    return StudentOptions.get_choice_name(type(options))
+    return student_of_options(options).name
 
 
 def lerobot_policy_config(options: Any) -> Any:
@@ -193,10 +199,5 @@ def lerobot_policy_config(options: Any) -> Any:
 
 
 def policy_options_dict(options: Any) -> dict[str, Any]:
-    """JSON-ready policy options: ``mtdagger``'s fields as before (no ``type``), else type + LeRobot's."""
-    if isinstance(options, PolicyOptions):
-        return dataclasses.asdict(options)
-    import draccus
-
-    encoded = draccus.encode(lerobot_policy_config(options))
-    return {"type": student_type(options), "batch_size": options.batch_size, **encoded}
+    """JSON-ready policy options: ``mtdagger``'s fields as before (no ``type``), else type + its own."""
+    return student_of_options(options).options_dict(options)

@@ -3,7 +3,8 @@
 The runner trains its student through one seam (``steps.phase_ops``): a training batch at given
 frames, the loss of one step, the per-task imitation loss and the optimiser. ``mtdagger`` has its
 fast implementation in ``steps.py``; ``LeRobotOps`` here implements it for any LeRobot
-``PreTrainedPolicy`` of ``student_options.lerobot_students()`` from what LeRobot's policies declare:
+``PreTrainedPolicy`` of ``student_options.lerobot_students()`` from what LeRobot's policies declare
+(``LeRobotStudent`` is their ``runner.student.Student``, registered as ``act`` and ``diffusion``):
 
 - **Windows of frames**, as LeRobot's ``delta_timestamps`` give them: a frame's observation history
   (``observation_delta_indices``: Diffusion's ``n_obs_steps``) and its action chunk
@@ -38,7 +39,13 @@ from lerobot_mtdagger.policies.task_conditioning import (
     task_feature,
     task_one_hot,
 )
-from lerobot_mtdagger.runner.student_options import lerobot_policy_config
+from lerobot_mtdagger.runner.student import Student
+from lerobot_mtdagger.runner.student_options import (
+    UNSEEN_TASK_DROPOUT,
+    UNSUPPORTED_STUDENT_OPTIONS,
+    lerobot_options_class,
+    lerobot_policy_config,
+)
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 
 LOSS_CHUNK = 256
@@ -232,3 +239,77 @@ class LeRobotOps:
         schedule = self.policy.config.get_scheduler_preset()
         scheduler = None if schedule is None else schedule.build(optimizer, steps)
         return optimizer, scheduler, float(preset.grad_clip_norm)
+
+
+class LeRobotStudent(Student):
+    """A LeRobot policy as the DAgger student, its ``--policy.type`` LeRobot's (``act``, ``diffusion``).
+
+    Its options are LeRobot's config of the policy plus ``batch_size`` (``lerobot_options_class``);
+    its training seam ``LeRobotOps``; its evaluation runner ``evaluate.ChunkRunner`` (an action queue
+    per episode).
+    """
+
+    lr_option = "optimizer_lr"
+
+    def options_class(self) -> type:
+        """LeRobot's config of the policy type, with ``batch_size`` (``lerobot_options_class``)."""
+        return lerobot_options_class(self.saved_type)
+
+    def options_dict(self, options: Any) -> dict[str, Any]:
+        """``type``, ``batch_size`` and LeRobot's own encoding of its config."""
+        import draccus
+
+        encoded = draccus.encode(lerobot_policy_config(options))
+        return {"type": self.name, "batch_size": options.batch_size, **encoded}
+
+    def check_run(self, config: Any) -> None:
+        """Refuses point clouds, temporal ensembling, ``lr_schedule`` and the options ``run`` ignores.
+
+        The ignored options are those of ``student_options.UNSUPPORTED_STUDENT_OPTIONS``.
+
+        Raises:
+            ValueError: Naming the option and the fix.
+        """
+        for name, reason in UNSUPPORTED_STUDENT_OPTIONS.items():
+            if getattr(config.policy, name, None) not in (None, False):
+                raise ValueError(f"--policy.{name} is not supported by run: {reason}; drop the option.")
+        if config.training.lr_schedule != "constant":
+            raise ValueError(
+                f"--training.lr_schedule={config.training.lr_schedule} is for the mtdagger policy; "
+                f"--policy.type={self.name} follows its own scheduler preset: drop the option."
+            )
+        if config.suite.obs_mode == "pointcloud":
+            raise ValueError(
+                f"--policy.type={self.name} cannot read point clouds (a LeRobot policy takes "
+                "state and images): use --policy.type=mtdagger or --suite.obs_mode=state|rgb."
+            )
+        if getattr(config.policy, "temporal_ensemble_coeff", None) is not None:
+            raise ValueError(
+                "--policy.temporal_ensemble_coeff is not supported for a DAgger student (its action "
+                "queue is kept per episode): drop it and set --policy.n_action_steps instead."
+            )
+
+    def policy_config(
+        self, options: Any, suite_features: dict[str, Any], task_names: Sequence[str], unseen: bool
+    ) -> LeRobotStudentConfig:
+        """``lerobot_student_config`` (task dropout ``UNSEEN_TASK_DROPOUT`` with held-out tasks, else 0)."""
+        task_dropout = UNSEEN_TASK_DROPOUT if unseen else 0.0
+        return lerobot_student_config(options, suite_features, task_names, task_dropout)
+
+    def make_policy(self, policy_cfg: Any, stats: dict[str, dict[str, Any]]) -> tuple[Any, Any, Any]:
+        """``make_lerobot_student`` and ``make_lerobot_processors``."""
+        return make_lerobot_student(policy_cfg), *make_lerobot_processors(policy_cfg, stats)
+
+    def phase_ops(self, policy: Any, data: Any, options: Any) -> LeRobotOps:
+        """``LeRobotOps`` with the phase's task dropout and seed."""
+        return LeRobotOps(policy, data, options.task_dropout, options.seed)
+
+    def previous_losses(self, runner: Any, data: Any, index: Any, options: Any) -> list[float | None]:
+        """Its own training loss per task on this phase's normalised frames (``LeRobotOps.task_losses``)."""
+        return self.phase_ops(runner.policy, data, options).task_losses(index, len(data.task_names))[0]
+
+    def make_runner(self, policy: Any, preprocessor: Any, postprocessor: Any) -> Any:
+        """``evaluate.ChunkRunner``: an action queue per running episode."""
+        from lerobot_mtdagger.runner.evaluate import ChunkRunner
+
+        return ChunkRunner(policy, preprocessor, postprocessor)

@@ -29,9 +29,8 @@ from lerobot_mtdagger.runner.plateau import plateau_stop
 from lerobot_mtdagger.runner.provenance import training_environment
 from lerobot_mtdagger.runner.round_data import TrainingData, load_round
 from lerobot_mtdagger.runner.splits import heldout_mask, normalisation_frames, split_frames
-from lerobot_mtdagger.runner.steps import PhaseResult, StepOptions, phase_ops, train_phase
-from lerobot_mtdagger.runner.student_options import UNSEEN_TASK_DROPOUT, PolicyOptions
-from lerobot_mtdagger.runner.task_loss import per_task_loss_of, performance_gain
+from lerobot_mtdagger.runner.steps import PhaseResult, StepOptions, train_phase
+from lerobot_mtdagger.runner.task_loss import performance_gain
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 from lerobot_mtdagger.utils.seeds import TRAINING_STREAM, stream_seed
@@ -93,42 +92,10 @@ def student_config(
 ) -> Any:
     """The student's policy config for a run on a suite's ``features`` (``unseen``: it has held-out tasks).
 
-    An ``MTDAggerConfig`` for ``--policy.type=mtdagger``, else a ``students.LeRobotStudentConfig``
-    (task dropout ``UNSEEN_TASK_DROPOUT`` on a suite with held-out tasks, else 0).
+    ``Student.policy_config`` of the run's student: an ``MTDAggerConfig`` for ``--policy.type=mtdagger``,
+    a ``students.LeRobotStudentConfig`` for a LeRobot student.
     """
-    if isinstance(config.policy, PolicyOptions):
-        task_dropout = config.policy.resolved_task_dropout(unseen)
-        return policy_config(features, task_names, config.policy, config.policy.device, task_dropout)
-    from lerobot_mtdagger.runner.students import lerobot_student_config
-
-    return lerobot_student_config(config.policy, features, task_names, UNSEEN_TASK_DROPOUT if unseen else 0.0)
-
-
-def _new_student(policy_cfg: Any, stats: dict[str, dict[str, np.ndarray]]) -> tuple[Any, Any, Any]:
-    """A freshly initialised student on its config's device, and its processors for ``stats``.
-
-    The weights are drawn on the CPU and then moved, so a seed gives the same initial weights on
-    every device (LeRobot's policy constructors leave a policy on the CPU; its ``make_policy`` moves it).
-    """
-    if isinstance(policy_cfg, MTDAggerConfig):
-        return MTDAggerPolicy(policy_cfg).to(policy_cfg.device), *build_processors(policy_cfg, stats)
-    from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
-
-    return make_lerobot_student(policy_cfg), *make_lerobot_processors(policy_cfg, stats)
-
-
-def _previous_losses(
-    runner: PolicyRunner, normalised: NormalisedData, index: torch.Tensor, options: StepOptions
-) -> list[float | None]:
-    """The previous phase's policy's per-task loss on this phase's loss frames (performance gain's start).
-
-    ``mtdagger``: the MSE of its actions (through its own processors) in this phase's normalisation;
-    a LeRobot student: its own training loss on this phase's normalised frames.
-    """
-    num_tasks = len(normalised.task_names)
-    if isinstance(runner.policy, MTDAggerPolicy):
-        return per_task_loss_of(runner.predict, normalised, index, num_tasks)
-    return phase_ops(runner.policy, normalised, options).task_losses(index, num_tasks)[0]
+    return config.student.policy_config(config.policy, features, task_names, unseen)
 
 
 @dataclass
@@ -229,7 +196,8 @@ def train_on_rounds(
     )
     stats = compute_stats(data, image_keys, normalisation_frames(config, data, split.train))
     torch.manual_seed(phase_seed)
-    policy, preprocessor, postprocessor = _new_student(policy_cfg, stats)
+    student = config.student
+    policy, preprocessor, postprocessor = student.make_policy(policy_cfg, stats)
     runner = None if previous is None else PolicyRunner.from_pretrained(previous, config.policy.device)
     if runner is not None and config.training.warm_start:
         policy.load_state_dict(runner.policy.state_dict())
@@ -237,14 +205,16 @@ def train_on_rounds(
     options = StepOptions(
         steps=config.phase_steps(len(split.train)),
         batch_size=config.policy.batch_size,
-        lr=getattr(config.policy, "lr", None) or config.policy.optimizer_lr,
+        lr=getattr(config.policy, student.lr_option),
         seed=phase_seed,
         sampling=config.training.sampling,
         lr_schedule=config.training.lr_schedule,
         plateau=plateau_stop(config, split),
         task_dropout=getattr(policy_cfg, "task_dropout", 0.0),
     )
-    loss_previous = None if runner is None else _previous_losses(runner, normalised, split.loss, options)
+    loss_previous = (
+        None if runner is None else student.previous_losses(runner, normalised, split.loss, options)
+    )
     prepared = time.perf_counter()
     with tqdm(
         total=options.steps, desc=f"round {round_index} train", leave=False, disable=not show_progress
