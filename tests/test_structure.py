@@ -303,3 +303,37 @@ def test_cli_only_dispatches_to_one_module_per_command():
         assert function.__module__ == home, (name, function.__module__)
         assert config_class.__module__ == SHARED_CONFIGS.get(name, home), (name, config_class.__module__)
         assert vars(sys.modules[home]).get(config_class.__name__) is config_class, (name, "config not named")
+
+
+STUDENT_CLASSES = {"MTDAggerPolicy", "MTDAggerConfig", "PolicyOptions"}
+"""Classes of one student: the runner asks the student (``runner/student.py``) instead of testing for them."""
+
+STUDENT_MODULES = {"lerobot_mtdagger.runner.mtdagger_student", "lerobot_mtdagger.runner.students"}
+"""The student implementations: the only modules that may test a value for a student's class."""
+
+
+def student_type_forks(source: str) -> list[int]:
+    """Lines of ``isinstance(value, C)`` in ``source`` where ``C`` names a class of ``STUDENT_CLASSES``."""
+    lines = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "isinstance":
+            names = {
+                getattr(part, "id", getattr(part, "attr", None))
+                for argument in node.args[1:]
+                for part in ast.walk(argument)
+            }
+            if names & STUDENT_CLASSES:
+                lines.append(node.lineno)
+    return lines
+
+
+def test_only_the_students_fork_on_a_student_type():
+    """Everywhere else the runner asks the run's ``Student`` (``get_student``, ``student_of_policy``)."""
+    forks = {
+        name: student_type_forks(module_path(name).read_text())
+        for name in package_modules()
+        if name not in STUDENT_MODULES
+    }
+    assert {name: lines for name, lines in forks.items() if lines} == {}
+    assert student_type_forks("isinstance(policy, (int, MTDAggerPolicy))") == [1]
+    assert student_type_forks("isinstance(options, student_options.PolicyOptions)") == [1]
