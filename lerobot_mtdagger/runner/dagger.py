@@ -60,7 +60,7 @@ from lerobot_mtdagger.runner.collect import (
     success_by_task,
 )
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.evaluate import EvalResult, PolicyRunner, evaluate, make_runner
+from lerobot_mtdagger.runner.evaluate import EvalResult, PolicyRunner, evaluate
 from lerobot_mtdagger.runner.expert_check import EXPERT_CHECK_FILE
 from lerobot_mtdagger.runner.run_setup import (
     beta_for_round,
@@ -282,7 +282,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     staging = ctx.experiment.staging_policy_root(round_index)
     trained.save(staging)
     evaluations = evaluate_student(
-        ctx, make_runner(trained.policy, trained.preprocessor, trained.postprocessor)
+        ctx, ctx.config.student.make_runner(trained.policy, trained.preprocessor, trained.postprocessor)
     )
     timing = {
         "load_s": loaded - start + trained.prepare_s,

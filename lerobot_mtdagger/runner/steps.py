@@ -25,7 +25,7 @@ from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE
 from lerobot_mtdagger.runner.normalise import NormalisedData
 from lerobot_mtdagger.runner.plateau import PlateauStop, PlateauTracker
-from lerobot_mtdagger.runner.student import student_of_policy
+from lerobot_mtdagger.runner.student import Student, student_of_policy
 from lerobot_mtdagger.runner.task_loss import per_task_loss, performance_gain
 from lerobot_mtdagger.utils.errors import UserError
 
@@ -126,9 +126,17 @@ class MTDAggerOps:
         return optimizer, scheduler, self.policy.config.optimizer_grad_clip_norm
 
 
-def phase_ops(policy: Any, data: NormalisedData, options: StepOptions) -> Any:
-    """The training seam of ``policy``: ``Student.phase_ops`` of its student (``MTDAggerOps`` for ours)."""
-    return student_of_policy(policy).phase_ops(policy, data, options)
+def phase_ops(policy: Any, data: NormalisedData, options: StepOptions, student: Student | None = None) -> Any:
+    """The training seam of ``policy``: ``Student.phase_ops`` (``MTDAggerOps`` for ``mtdagger``).
+
+    Args:
+        policy: The policy to train.
+        data: The phase's normalised frames.
+        options: How the phase steps.
+        student: The run's student (None: the student registered for the policy's type).
+    """
+    student = student_of_policy(policy) if student is None else student
+    return student.phase_ops(policy, data, options)
 
 
 class _LossWindow:
@@ -191,6 +199,7 @@ def train_phase(
     loss_index: torch.Tensor,
     options: StepOptions,
     on_step: Callable[[int, float], None] | None = None,
+    student: Student | None = None,
 ) -> PhaseResult:
     """Trains ``policy`` for ``options.steps`` steps (or until a plateau); measures the per-task loss drop.
 
@@ -206,6 +215,7 @@ def train_phase(
         options: Steps, batch size, learning rate, sampling seed and rule, plateau stop.
         on_step: Progress callback ``on_step(steps_done, mean_loss)``, every ``log_interval`` steps
             and after the last one (the mean training loss over the steps since the previous call).
+        student: The run's student, whose seam trains (None: the one registered for the policy's type).
 
     Returns:
         The per-task losses at the start and at the end, the gain, the last FINAL_LOSSES step
@@ -218,7 +228,7 @@ def train_phase(
     """
     _check_phase_inputs(policy, data, options.log_interval, options.plateau)
     num_tasks = len(data.task_names)
-    ops = phase_ops(policy, data, options)
+    ops = phase_ops(policy, data, options, student)
     started = time.perf_counter()
     loss_start, _ = ops.task_losses(loss_index, num_tasks)
     measured = time.perf_counter()

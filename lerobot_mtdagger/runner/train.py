@@ -226,6 +226,7 @@ def train_on_rounds(
             split.loss,
             options,
             on_step=lambda done, _: bar.update(done - bar.n),
+            student=student,
         )
     return TrainedPhase(
         policy=policy,
