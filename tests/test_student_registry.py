@@ -15,6 +15,7 @@ import pytest
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets.checkpoints import check_local_policy
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.runner import student as student_registry
 from lerobot_mtdagger.runner.mtdagger_student import MTDAggerStudent
 from lerobot_mtdagger.runner.student import Student, get_student, register_student, student_names
 from lerobot_mtdagger.runner.student_options import PolicyOptions
@@ -60,12 +61,17 @@ class CopyStudent(MTDAggerStudent):
         return super().make_runner(policy, preprocessor, postprocessor)
 
 
-if NAME not in student_names():
+@pytest.fixture
+def copy_registered(monkeypatch):
+    """``CopyStudent`` registered for one test (the registry is restored after it)."""
+    monkeypatch.setattr(student_registry, "_STUDENTS", dict(student_registry._STUDENTS))
     register_student(NAME, CopyStudent)
-
-
-def test_a_student_from_outside_the_package_runs_a_dagger_round(tmp_path):
     CopyStudent.calls.clear()
+    yield
+    assert NAME in student_names()
+
+
+def test_a_student_from_outside_the_package_runs_a_dagger_round(tmp_path, copy_registered):
     root = tmp_path / "copy"
     assert main(["run", *TINY_RUN, f"--policy.type={NAME}", f"--output_dir={root}"]) == 0
     experiment = ExperimentDir(root)
@@ -76,7 +82,7 @@ def test_a_student_from_outside_the_package_runs_a_dagger_round(tmp_path):
     assert CopyStudent.calls.count("phase_ops") == 2 and CopyStudent.calls.count("make_runner") == 2
 
 
-def test_the_registry_refuses_an_unknown_type_a_taken_name_and_a_non_student(capsys):
+def test_the_registry_refuses_an_unknown_type_a_taken_name_and_a_non_student(capsys, copy_registered):
     assert main(["run", "--policy.type=pi0", "--suite.name=toy"]) == 2
     error = capsys.readouterr().err.strip()
     assert len(error.splitlines()) == 1
@@ -90,6 +96,7 @@ def test_the_registry_refuses_an_unknown_type_a_taken_name_and_a_non_student(cap
 
 
 def test_every_builtin_student_meets_the_contract():
+    assert student_names() == ["mtdagger", "act", "diffusion"]  # nothing left registered by the tests
     for name in ("mtdagger", "act", "diffusion"):
         student = get_student(name)
         assert isinstance(student, Student) and student.name == name
