@@ -82,7 +82,7 @@ class PolicyRunner:
         An ``mtdagger`` policy has one only when trained with task dropout (its shared embedding); a
         LeRobot student's one-hot vector is all zeros for such a task (``ChunkRunner``).
         """
-        return self.policy.any_task_index is not None
+        return getattr(self.policy, "any_task_index", None) is not None
 
     def act_as(self, aliases: dict[str, str]) -> None:
         """Makes the policy act on each key task with the task input of its value (a training task).

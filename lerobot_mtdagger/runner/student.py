@@ -15,6 +15,7 @@ Reading this module imports no torch and no LeRobot.
 from __future__ import annotations
 
 import abc
+import dataclasses
 import functools
 import importlib
 from collections.abc import Sequence
@@ -62,8 +63,6 @@ class Student(abc.ABC):
         Args:
             options: Its options (an instance of ``options_class()``).
         """
-        import dataclasses
-
         values = dataclasses.asdict(options)
         return values if self.name == MTDAGGER_TYPE else {"type": self.name, **values}
 

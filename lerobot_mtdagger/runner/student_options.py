@@ -1,8 +1,9 @@
 """The student's options, ``--policy.*``: ``mtdagger``'s own (``PolicyOptions``) or a LeRobot policy's.
 
-``--policy.type`` chooses the student (``StudentOptions``); LeRobot's students (``act``,
-``diffusion``) take LeRobot's own config of that policy plus ``batch_size``, offered by the parser
-only when the options name one (``students_for``), so a run of ``mtdagger`` never imports them.
+``--policy.type`` chooses the student (``StudentOptions``, over the students registered in
+``runner.student``); LeRobot's students (``act``, ``diffusion``) take LeRobot's own config of that
+policy plus ``batch_size``, offered by the parser only when the options name a student other than
+``mtdagger`` (``students_for``), so a run of ``mtdagger`` never imports them.
 """
 
 from __future__ import annotations
@@ -113,9 +114,9 @@ _LEROBOT_STUDENTS_PARSED: contextvars.ContextVar[bool] = contextvars.ContextVar(
 
 
 def names_lerobot_student(options: Sequence[str]) -> bool:
-    """Whether command-line options may choose a LeRobot student.
+    """Whether command-line options may choose a student other than ``mtdagger`` (a LeRobot one).
 
-    They may with a ``--policy.type`` other than ``mtdagger``, or a ``--config_path`` file.
+    They may with a registered ``--policy.type`` other than ``mtdagger``, or a ``--config_path`` file.
 
     Raises:
         UserError: If ``--policy.type`` names no registered student (one line listing them).
