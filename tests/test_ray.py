@@ -99,8 +99,8 @@ def test_a_ray_actor_killed_mid_round_is_named_nothing_is_committed_and_resume_g
     run_toy(reference, "--rollout.workers=2")
     collect = dagger.run_episodes
 
-    def killing_collect(workers, *args, **kwargs):
-        if kwargs["round_index"] == 1 and isinstance(workers, RayEnvWorkers):
+    def killing_collect(workers, episodes_per_task, options, **kwargs):
+        if options.round_index == 1 and isinstance(workers, RayEnvWorkers):
             progress = kwargs.get("progress")
 
             def kill_after_first(episode):
@@ -110,7 +110,7 @@ def test_a_ray_actor_killed_mid_round_is_named_nothing_is_committed_and_resume_g
                     progress(episode)
 
             kwargs["progress"] = kill_after_first
-        return collect(workers, *args, **kwargs)
+        return collect(workers, episodes_per_task, options, **kwargs)
 
     monkeypatch.setattr(dagger, "run_episodes", killing_collect)
     root = tmp_path / "killed"
