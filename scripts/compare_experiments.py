@@ -28,7 +28,8 @@ from pathlib import Path
 import pyarrow.parquet as pq
 from safetensors.numpy import load_file
 
-from lerobot_mtdagger.datasets.config_layout import flatten, migrate_run_config
+from lerobot_mtdagger.datasets.config_layout import flatten
+from lerobot_mtdagger.datasets.migrations import migrate_run_config
 from lerobot_mtdagger.datasets.rounds import RESULT_NEUTRAL_OPTIONS
 
 PROVENANCE_FIELDS = {"timings", "environment"}

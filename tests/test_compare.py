@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
+from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS
 from lerobot_mtdagger.datasets.rounds import ExperimentDir, writer_lock_holder
 from lerobot_mtdagger.envs import SuiteConfig
 from lerobot_mtdagger.runner.configs import RunConfig

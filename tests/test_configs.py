@@ -14,13 +14,8 @@ import draccus
 import pytest
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.datasets.config_layout import (
-    FLAT_OPTION_PATHS,
-    flatten,
-    is_flat,
-    migrate_run_config,
-    option,
-)
+from lerobot_mtdagger.datasets.config_layout import flatten, option
+from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS, is_flat, migrate_run_config
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.runner.configs import RunConfig
@@ -308,3 +303,19 @@ def test_a_result_changing_option_differing_from_a_flat_stored_config_is_refused
     assert json.loads((root / "config.json").read_text()) == json.loads(
         (OLD_EXPERIMENT / "config.json").read_text()
     )
+
+
+def test_the_migrations_are_one_ordered_list_of_known_options():
+    """Oldest first, named once; each former value is an option of today's config with a plain default."""
+    from lerobot_mtdagger.datasets.migrations import MIGRATIONS, former_option_values
+
+    assert [m.since for m in MIGRATIONS] == sorted(m.since for m in MIGRATIONS)
+    assert len({m.name for m in MIGRATIONS}) == len(MIGRATIONS)
+    today = flatten(parse("--suite.name=toy").to_dict())
+    former = former_option_values()
+    assert former == {"suite.placement": "narrow", "training.sampling": "uniform"}
+    assert set(former) <= set(today)
+    assert {path: RunConfig.option_defaults()[path] for path in former} == former
+    # A migration's rewrite leaves today's layout as it is.
+    grouped = parse("--suite.name=toy").to_dict()
+    assert migrate_run_config(grouped) == grouped and migrate_run_config(grouped) is not grouped

@@ -34,7 +34,7 @@ def test_the_readme_is_short_and_its_links_resolve():
 
 def test_the_changelog_lists_every_renamed_run_option():
     """Each option that moved into a group: its group, its name today and (if renamed) its old name."""
-    from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
+    from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS
 
     changelog = README.read_text().split("## Changelog", 1)[1]
     words = set(re.findall(r"\w+", changelog))

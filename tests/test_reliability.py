@@ -549,6 +549,27 @@ def test_a_run_of_a_rescaled_preset_resumes_with_its_paper_preset(finished, tmp_
     assert "--preset=drawers-pointcloud-paper" in str(info.value)
 
 
+def test_a_drawer_run_made_before_placement_settings_is_told_to_add_narrow(finished, tmp_path):
+    """A stored config without ``suite.placement`` resumes with ``narrow`` (what it drew), and a resume
+    with today's default names that option, also for a rescaled preset's run."""
+    older_root = tmp_path / "older-drawers"
+    shutil.copytree(finished, older_root)
+    for preset in ("drawers-pointcloud-paper", "drawers-pointcloud"):
+        narrow = RunConfig(preset=preset, output_dir=older_root).to_dict()
+        narrow["suite"]["placement"] = "narrow"
+        stored = json.loads(json.dumps(narrow))
+        del stored["suite"]["placement"]
+        (older_root / "config.json").write_text(json.dumps(stored))
+        experiment = ExperimentDir(older_root)
+        experiment.check_resumable(narrow, added_defaults=RunConfig.option_defaults())
+        today = RunConfig(preset=preset, output_dir=older_root).to_dict()
+        with pytest.raises(UserError) as info:
+            experiment.check_resumable(today, added_defaults=RunConfig.option_defaults())
+        message = str(info.value)
+        assert "suite.placement: None -> 'kitchen'" in message, message
+        assert "used --suite.placement=narrow)" in message and "-paper" not in message, message
+
+
 def test_a_pixel_run_made_before_balanced_sampling_is_told_to_add_uniform(finished, tmp_path):
     """``metaworld-pixels`` samples balanced (DAgger since 2026-11-26, BC since 2026-11-27); older runs
     resume uniform."""

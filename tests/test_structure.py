@@ -5,6 +5,7 @@ from __future__ import annotations
 import ast
 import functools
 import pkgutil
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -337,3 +338,44 @@ def test_only_the_students_fork_on_a_student_type():
     assert {name: lines for name, lines in forks.items() if lines} == {}
     assert student_type_forks("isinstance(policy, (int, MTDAggerPolicy))") == [1]
     assert student_type_forks("isinstance(options, student_options.PolicyOptions)") == [1]
+
+
+MIGRATIONS_MODULE = "lerobot_mtdagger.datasets.migrations"
+"""The one module that keeps the rules about runs stored by earlier versions (``MIGRATIONS``)."""
+
+OLDER_RUN_PHRASE = re.compile(r"(made|stored) before|before \d{4}-\d{2}-\d{2}")
+"""How a user-facing message about an older run reads ("a run made before ...")."""
+
+
+def older_run_messages(source: str) -> list[int]:
+    """Lines of string literals (docstrings aside) in ``source`` that speak of older runs."""
+    tree = ast.parse(source)
+    docstrings = {
+        id(body[0].value)
+        for node in ast.walk(tree)
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
+        and (body := node.body)
+        and isinstance(body[0], ast.Expr)
+        and isinstance(body[0].value, ast.Constant)
+    }
+    return [
+        node.lineno
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Constant)
+        and isinstance(node.value, str)
+        and id(node) not in docstrings
+        and OLDER_RUN_PHRASE.search(node.value)
+    ]
+
+
+def test_the_rules_about_older_runs_live_in_the_migrations():
+    """Hints and rewrites for runs of earlier versions are migrations, not scattered conditions."""
+    messages = {
+        name: older_run_messages(module_path(name).read_text())
+        for name in package_modules()
+        if name != MIGRATIONS_MODULE
+    }
+    assert {name: lines for name, lines in messages.items() if lines} == {}
+    assert older_run_messages(module_path(MIGRATIONS_MODULE).read_text())  # the hints are there
+    assert older_run_messages('x = f" (a run made before {date})"') == [1]
+    assert older_run_messages('def f():\n    """A config stored before the groups."""\n') == []

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from lerobot_mtdagger.datasets.config_layout import migrate_run_config
+from lerobot_mtdagger.datasets.migrations import migrate_run_config
 
 RECORD_KEY = "mtdagger"
 """Key of the round record's mirror in a round dataset's ``meta/info.json``."""

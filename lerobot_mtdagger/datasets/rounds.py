@@ -44,14 +44,10 @@ import pyarrow.parquet as pq
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import update_chunk_file_indices
 
-from lerobot_mtdagger.datasets.config_layout import (
-    RESCALED_PRESETS,
-    flatten,
-    later_preset_values,
-    migrate_run_config,
-)
+from lerobot_mtdagger.datasets.config_layout import flatten
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.datasets.ledger import Ledger
+from lerobot_mtdagger.datasets.migrations import migrate_run_config, resume_hint
 from lerobot_mtdagger.datasets.records import (
     FORMAT_VERSION,
     RECORD_KEY,
@@ -183,6 +179,10 @@ def adds_dagger_rounds(stored: Mapping[str, Any], given: Mapping[str, Any]) -> b
 
 
 ROUNDS_OPTION = "dagger.rounds"
+ROUNDS_HINT = (
+    " (--dagger.rounds may only grow, and only for a DAgger run: BC's one round holds the demos of "
+    "every round)"
+)
 
 
 def _only(frame: Mapping[str, Any], features: Mapping[str, Any]) -> dict[str, Any]:
@@ -326,24 +326,10 @@ class ExperimentDir:
         differing = sorted(key for key in set(stored) | set(given) if stored.get(key) != given.get(key))
         if differing:
             details = ", ".join(f"{k}: {stored.get(k)!r} -> {given.get(k)!r}" for k in differing)
-            hint = ""
             if ROUNDS_OPTION in differing:
-                hint = (
-                    " (--dagger.rounds may only grow, and only for a DAgger run: BC's one round holds "
-                    "the demos of every round)"
-                )
-            elif "suite.placement" in differing and "suite.placement" not in stored:
-                hint = " (drawer runs made before --suite.placement existed used --suite.placement=narrow)"
-            elif changed := later_preset_values(stored_config.get("preset"), differing):
-                name = stored_config["preset"]
-                options = " ".join(f"--{key}={value}" for key, value in changed.items())
-                hint = f" (a run made before 2026-11-27 with --preset={name} used {options}: add it)"
-            elif stored_config.get("preset") in RESCALED_PRESETS:
-                name = stored_config["preset"]
-                hint = (
-                    f" (a run made before 2026-11-26 with --preset={name} has the values of today's "
-                    f"--preset={RESCALED_PRESETS[name]}: resume it with that preset)"
-                )
+                hint = ROUNDS_HINT
+            else:
+                hint = resume_hint(stored_config, differing, stored)
             raise UserError(
                 f"Cannot resume {self.root} with a different config ({details}){hint}: resume with "
                 "the stored values, or start a new --output_dir."

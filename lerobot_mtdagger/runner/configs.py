@@ -16,9 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from lerobot_mtdagger.datasets.config_layout import FLAT_OPTION_PATHS
+from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS, former_option_values
 from lerobot_mtdagger.envs.config import SuiteConfig
-from lerobot_mtdagger.envs.drawers.variants import LEGACY_PLACEMENT
 from lerobot_mtdagger.runner.option_groups import (
     RUN_MODES,
     DAggerConfig,
@@ -50,7 +49,7 @@ class RunConfig:
     Thirteen top-level options; the rest sit in their group (``--suite.obs_mode``, ``--dagger.rounds``,
     ``--rollout.eval_episodes``, ``--training.steps_rule``, ``--policy.lr``, ``--scheduler.n_min``).
     A flat config stored before the groups existed is migrated on reading
-    (``datasets/config_layout.py``), and the old spellings are refused with the new one named.
+    (``datasets/migrations.py``), and the old spellings are refused with the new one named.
 
     Attributes:
         preset: One of ``PRESETS``; fills every option of ``PRESET_FIELDS`` left unset (None).
@@ -202,9 +201,9 @@ class RunConfig:
     def option_defaults(cls) -> dict[str, Any]:
         """What each option was before it existed, by dotted path (e.g. ``training.plateau_every: 200``).
 
-        Its plain default, except ``suite.placement`` (drawer runs made before it existed used
-        ``narrow``) and ``training.sampling`` (``uniform`` before presets filled it). Policy options
-        are those of ``mtdagger`` (the only student then).
+        Its plain default, except where a migration names what runs made before it had
+        (``migrations.former_option_values``). Policy options are those of ``mtdagger`` (the only
+        student then).
         """
         defaults: dict[str, Any] = {}
         for group, options in (
@@ -219,7 +218,7 @@ class RunConfig:
                 if option.default is not dataclasses.MISSING:
                     defaults[f"{group}.{option.name}"] = option.default
         top = {f.name: f.default for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
-        return top | defaults | {"suite.placement": LEGACY_PLACEMENT, "training.sampling": "uniform"}
+        return top | defaults | former_option_values()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (stored in every round's record; ``migrate_run_config``'s layout)."""

@@ -28,7 +28,8 @@ from typing import Any
 import numpy as np
 import pyarrow.parquet as pq
 
-from lerobot_mtdagger.datasets.config_layout import flatten, migrate_run_config, option
+from lerobot_mtdagger.datasets.config_layout import flatten, option
+from lerobot_mtdagger.datasets.migrations import migrate_run_config
 from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, SavedRunRecords, open_run
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.studies.report import CurvePoint, RunPoints, average_runs, curve_name

@@ -93,7 +93,6 @@ PLACEMENTS: dict[str, Placement] = {
     )
 }
 DEFAULT_PLACEMENT = "kitchen"
-LEGACY_PLACEMENT = "narrow"  # what drawer runs and envs made before placement settings existed used
 
 
 def placement_named(name: str | None) -> Placement:
