@@ -336,6 +336,12 @@ def test_only_the_students_fork_on_a_student_type():
         if name not in STUDENT_MODULES
     }
     assert {name: lines for name, lines in forks.items() if lines} == {}
+    reaching_in = [  # a LeRobot policy's internals (Diffusion's denoiser) are its student's business
+        name
+        for name in package_modules()
+        if name not in STUDENT_MODULES and ".generate_actions(" in module_path(name).read_text()
+    ]
+    assert reaching_in == []
     assert student_type_forks("isinstance(policy, (int, MTDAggerPolicy))") == [1]
     assert student_type_forks("isinstance(options, student_options.PolicyOptions)") == [1]
 

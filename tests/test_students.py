@@ -28,6 +28,7 @@ from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE, TaskOneHot
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.evaluate import ChunkRunner, PolicyRunner, evaluate
+from lerobot_mtdagger.runner.student import get_student
 from lerobot_mtdagger.runner.student_options import lerobot_students
 from lerobot_mtdagger.runner.students import EpisodeWindows, LeRobotOps, lerobot_student_config
 from lerobot_mtdagger.runner.workers import EnvWorkers
@@ -226,10 +227,10 @@ def test_the_task_vector_is_one_hot_over_the_training_tasks_and_zero_for_an_unse
     assert step(untouched) is untouched
 
 
-def tiny_act_policy(suite, n_action_steps: int = 3):
-    """A tiny untrained ACT student of the toy suite, with identity normalisation."""
+def tiny_act_policy(suite, n_action_steps: int = 3, student: list[str] = TINY_ACT):
+    """A tiny untrained ACT (or ``student``) policy of the toy suite, with identity normalisation."""
     options = parse_options(
-        RunConfig, ["--suite.name=toy", *TINY_ACT, f"--policy.n_action_steps={n_action_steps}"], "t"
+        RunConfig, ["--suite.name=toy", *student, f"--policy.n_action_steps={n_action_steps}"], "t"
     )
     spec = lerobot_student_config(options.policy, suite.features, suite.task_names, task_dropout=0.0)
     from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
@@ -271,6 +272,28 @@ def test_each_running_episode_keeps_its_own_action_queue(suite):
             with torch.inference_mode():
                 alone.append(postprocessor(policy.select_action(batch))[0].numpy())
         np.testing.assert_allclose(np.stack(batched[lane]), np.stack(alone), atol=1e-5)
+
+
+def test_a_diffusion_episode_sees_its_own_observation_history_as_lerobot_gives_it(suite):
+    """With ``n_obs_steps=2`` the runner hands Diffusion each episode's history (the first observation
+    repeated at the start), as LeRobot's own ``select_action`` loop does; the noise is seeded alike."""
+    policy, preprocessor, postprocessor = tiny_act_policy(suite, n_action_steps=2, student=TINY_DIFFUSION)
+    assert policy.config.n_obs_steps == 2
+    runner = get_student("diffusion").make_runner(policy, preprocessor, postprocessor)
+    states = np.random.default_rng(1).normal(size=(7, suite.features["observation.state"]["shape"][0]))
+    states = states.astype(np.float32)
+    batched = []
+    for step, state in enumerate(states):
+        torch.manual_seed(step)
+        batched.append(runner([{"observation.state": state}], ["toy-left"], lanes=[3], starts=[step == 0])[0])
+    policy.reset()
+    alone = []
+    for step, state in enumerate(states):
+        torch.manual_seed(step)
+        batch = preprocessor({"observation.state": torch.from_numpy(state)[None], "task": "toy-left"})
+        with torch.inference_mode():
+            alone.append(postprocessor(policy.select_action(batch))[0].numpy())
+    np.testing.assert_allclose(np.stack(batched), np.stack(alone), atol=1e-5)
 
 
 def test_a_new_episode_on_a_lane_restarts_its_queue(suite):

@@ -15,7 +15,6 @@ from typing import Any
 
 import numpy as np
 import torch
-from lerobot.utils.constants import OBS_IMAGES
 
 from lerobot_mtdagger.datasets.checkpoints import load_policy
 from lerobot_mtdagger.policies import TASK_FEATURE
@@ -173,6 +172,15 @@ class PolicyRunner:
             return self.preprocessor(batch)
 
 
+ChunkPredictor = Callable[[Any, dict[str, torch.Tensor]], torch.Tensor]
+"""``(policy, batch) -> (B, n, action_dim)``: a policy's normalised action chunks for a batch."""
+
+
+def predict_action_chunk(policy: Any, batch: dict[str, torch.Tensor]) -> torch.Tensor:
+    """LeRobot's ``predict_action_chunk`` of ``policy`` for ``batch``."""
+    return policy.predict_action_chunk(batch)
+
+
 class ChunkRunner(PolicyRunner):
     """A LeRobot policy that acts in chunks (ACT, Diffusion Policy), one action queue PER EPISODE.
 
@@ -181,7 +189,9 @@ class ChunkRunner(PolicyRunner):
     observation history (``n_obs_steps``, the first observation repeated at the start, as LeRobot
     does) and its own queue of the chunk's first ``n_action_steps`` actions; the policy is queried,
     batched, for the episodes whose queue is empty. Called without lanes (``shift``, a plain call),
-    every row is a fresh episode: the first action of a new chunk.
+    every row is a fresh episode: the first action of a new chunk. The chunk itself comes from
+    ``predict_chunk(policy, batch)``, the student's (``LeRobotStudent.predict_chunk``): LeRobot's
+    ``predict_action_chunk`` unless the policy needs its history handed over another way.
     """
 
     tracks_episodes = True
@@ -191,9 +201,25 @@ class ChunkRunner(PolicyRunner):
         """Always: a task outside ``task_names`` gets the all-zero one-hot vector."""
         return True
 
-    def __init__(self, policy: Any, preprocessor: Any, postprocessor: Any) -> None:
-        """Wraps a LeRobot policy in eval mode with its processors."""
+    def __init__(
+        self,
+        policy: Any,
+        preprocessor: Any,
+        postprocessor: Any,
+        predict_chunk: ChunkPredictor | None = None,
+    ) -> None:
+        """Wraps a LeRobot policy in eval mode with its processors.
+
+        Args:
+            policy: A LeRobot ``PreTrainedPolicy`` that acts in chunks.
+            preprocessor: Its saved pre-processor.
+            postprocessor: Its saved post-processor.
+            predict_chunk: ``(policy, batch) -> (B, n, action_dim)`` normalised chunks for batches of
+                current observations or of histories (B, n_obs_steps, ...); None: LeRobot's
+                ``predict_action_chunk``.
+        """
         super().__init__(policy, preprocessor, postprocessor)
+        self.predict_chunk = predict_chunk or predict_action_chunk
         deltas = policy.config.observation_delta_indices
         self.history_length = 1 if deltas is None else len(deltas)
         self.action_steps = int(policy.config.n_action_steps)
@@ -286,12 +312,7 @@ class ChunkRunner(PolicyRunner):
 
     def _predict_chunk(self, batch: dict[str, torch.Tensor]) -> torch.Tensor:
         """The policy's normalised action chunk (B, n, action_dim) for current observations or histories."""
-        if self.history_length == 1:
-            return self.policy.predict_action_chunk(batch)
-        image_keys = list(self.policy.config.image_features)
-        if image_keys:
-            batch = {**batch, OBS_IMAGES: torch.stack([batch[key] for key in image_keys], dim=-4)}
-        return self.policy.diffusion.generate_actions(batch)
+        return self.predict_chunk(self.policy, batch)
 
 
 def make_runner(policy: Any, preprocessor: Any, postprocessor: Any) -> PolicyRunner:

@@ -216,6 +216,9 @@ def student_of_policy(policy: Any) -> Student:
     return get_student(policy_type)  # refused, listing the registered students
 
 
-_BUILTIN_ENTRIES = {MTDAGGER_TYPE: "lerobot_mtdagger.runner.mtdagger_student:MTDAggerStudent"}
+_BUILTIN_ENTRIES = {
+    MTDAGGER_TYPE: "lerobot_mtdagger.runner.mtdagger_student:MTDAggerStudent",
+    "diffusion": "lerobot_mtdagger.runner.students:DiffusionStudent",
+}
 for _name in BUILTIN_STUDENT_TYPES:
     register_student(_name, _BUILTIN_ENTRIES.get(_name, "lerobot_mtdagger.runner.students:LeRobotStudent"))

@@ -4,7 +4,8 @@ The runner trains its student through one seam (``steps.phase_ops``): a training
 frames, the loss of one step, the per-task imitation loss and the optimiser. ``mtdagger`` has its
 fast implementation in ``steps.py``; ``LeRobotOps`` here implements it for any LeRobot
 ``PreTrainedPolicy`` of ``student_options.lerobot_students()`` from what LeRobot's policies declare
-(``LeRobotStudent`` is their ``runner.student.Student``, registered as ``act`` and ``diffusion``):
+(``LeRobotStudent`` is their ``runner.student.Student``, registered as ``act``, and
+``DiffusionStudent`` as ``diffusion``):
 
 - **Windows of frames**, as LeRobot's ``delta_timestamps`` give them: a frame's observation history
   (``observation_delta_indices``: Diffusion's ``n_obs_steps``) and its action chunk
@@ -32,6 +33,7 @@ from typing import Any
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.policies.factory import get_policy_class, make_pre_post_processors
+from lerobot.utils.constants import OBS_IMAGES
 
 from lerobot_mtdagger.policies.task_conditioning import (
     TASK_FEATURE,
@@ -309,7 +311,33 @@ class LeRobotStudent(Student):
         return self.phase_ops(runner.policy, data, options).task_losses(index, len(data.task_names))[0]
 
     def make_runner(self, policy: Any, preprocessor: Any, postprocessor: Any) -> Any:
-        """``evaluate.ChunkRunner``: an action queue per running episode."""
+        """``evaluate.ChunkRunner``: an action queue per running episode, chunks from ``predict_chunk``."""
         from lerobot_mtdagger.runner.evaluate import ChunkRunner
 
-        return ChunkRunner(policy, preprocessor, postprocessor)
+        return ChunkRunner(policy, preprocessor, postprocessor, predict_chunk=self.predict_chunk)
+
+    def predict_chunk(self, policy: Any, batch: dict[str, torch.Tensor]) -> torch.Tensor:
+        """Normalised action chunks (B, n, action_dim): LeRobot's ``predict_action_chunk``.
+
+        ``batch`` holds one current observation per row, or (with ``n_obs_steps > 1``) each row's
+        history (B, n_obs_steps, ...), which ``DiffusionStudent`` hands over.
+        """
+        return policy.predict_action_chunk(batch)
+
+
+class DiffusionStudent(LeRobotStudent):
+    """Diffusion Policy: its observation history goes to the denoiser directly.
+
+    LeRobot's ``predict_action_chunk`` reads the history from the policy's own queues (one for the
+    whole batch); the runner keeps a history per episode, so with ``n_obs_steps > 1`` the images are
+    stacked as Diffusion's ``forward`` stacks them and ``generate_actions`` is called.
+    """
+
+    def predict_chunk(self, policy: Any, batch: dict[str, torch.Tensor]) -> torch.Tensor:
+        """Normalised action chunks (B, horizon, action_dim) for current observations or histories."""
+        if policy.config.n_obs_steps == 1:
+            return policy.predict_action_chunk(batch)
+        image_keys = list(policy.config.image_features)
+        if image_keys:
+            batch = {**batch, OBS_IMAGES: torch.stack([batch[key] for key in image_keys], dim=-4)}
+        return policy.diffusion.generate_actions(batch)
