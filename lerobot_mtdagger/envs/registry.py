@@ -9,7 +9,8 @@ suite never imports MuJoCo or MetaWorld::
 
 ``build_suite(options)`` then builds the suite ``options.name`` names; ``--suite.name`` takes any
 registered name, and ``--suite.module`` imports a module (one that registers suites) before the suite
-is built (``import_suite_module``).
+is built (``import_suite_module``). An installed package registers its suites by entry point (group
+``lerobot_mtdagger.suites``, ``utils.plugins``).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from dataclasses import dataclass, field
 
 from lerobot_mtdagger.envs.base import ObservationConfig, TaskSuite
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.plugins import SUITE_ENTRY_POINTS, register_installed
 
 logger = logging.getLogger(__name__)
 
@@ -115,7 +117,8 @@ def build_suite(options: SuiteOptions) -> TaskSuite:
         raise UserError(
             f"Unknown suite {options.name!r}; available suites: {', '.join(suite_names())} (a suite from "
             "outside the package is registered with lerobot_mtdagger.envs.register_suite by the module "
-            "--suite.module names)."
+            "--suite.module names, or installed by a package's entry point in the group "
+            f"{SUITE_ENTRY_POINTS!r})."
         )
     return _resolve(factory)(options)
 
@@ -148,3 +151,4 @@ BUILT_IN_SUITES: dict[str, str] = {
 
 for _name, _entry_point in BUILT_IN_SUITES.items():
     register_suite(_name, _entry_point)
+register_installed(SUITE_ENTRY_POINTS, _FACTORIES, register_suite)

@@ -9,6 +9,9 @@ imported on first use, so parsing the options of ``mtdagger`` never imports LeRo
 
     register_student("my-student", MyStudent)  # MyStudent(Student) or "my_package.students:MyStudent"
 
+An installed package registers its students by entry point (group ``lerobot_mtdagger.students``,
+``utils.plugins``), so ``lerobot-mtdagger run --policy.type=<its name>`` finds them.
+
 Reading this module imports no torch and no LeRobot.
 """
 
@@ -27,6 +30,7 @@ from lerobot_mtdagger.datasets.student_types import (
     add_student_policy_type,
 )
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.plugins import STUDENT_ENTRY_POINTS, register_installed
 
 
 class Student(abc.ABC):
@@ -153,6 +157,7 @@ def register_student(name: str, student: StudentEntry) -> None:
     if isinstance(student, str):
         if ":" not in student:
             raise TypeError(f"The student {name!r} must be a 'module:attribute' string, got {student!r}.")
+        add_student_policy_type(name)  # another saved type is added when the student is built
     elif not (isinstance(student, type) and issubclass(student, Student)):
         raise TypeError(f"The student {name!r} must be a Student subclass, got {student!r}.")
     else:
@@ -174,7 +179,8 @@ def get_student(name: str) -> Student:
     if name not in _STUDENTS:
         raise UserError(
             f"Unknown --policy.type {name!r}; registered students: {', '.join(student_names())} (a student "
-            "from outside the package is registered with lerobot_mtdagger.runner.student.register_student)."
+            "from outside the package is registered with lerobot_mtdagger.runner.student.register_student, "
+            f"or installed by a package's entry point in the group {STUDENT_ENTRY_POINTS!r})."
         )
     return _student(name, _STUDENTS[name])
 
@@ -185,7 +191,9 @@ def _student(name: str, entry: StudentEntry) -> Student:
     if isinstance(entry, str):
         module_name, _, attribute = entry.partition(":")
         entry = getattr(importlib.import_module(module_name), attribute)
-    return entry(name)
+    student = entry(name)
+    add_student_policy_type(student.saved_type)
+    return student
 
 
 def student_of_options(options: Any) -> Student:
@@ -222,3 +230,4 @@ _BUILTIN_ENTRIES = {
 }
 for _name in BUILTIN_STUDENT_TYPES:
     register_student(_name, _BUILTIN_ENTRIES.get(_name, "lerobot_mtdagger.runner.students:LeRobotStudent"))
+register_installed(STUDENT_ENTRY_POINTS, _STUDENTS, register_student)

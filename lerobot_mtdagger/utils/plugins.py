@@ -1,0 +1,55 @@
+"""Plugins installed as Python packages: the entry points a registry reads at import.
+
+A package adds a student or a suite to the command line by declaring an entry point in its
+``pyproject.toml``; the registry registers it (lazily, as a ``"module:attribute"`` string, so nothing
+is imported until it is asked for)::
+
+    [project.entry-points."lerobot_mtdagger.students"]
+    mtdagger-wide = "my_package.students:WideStudent"
+
+    [project.entry-points."lerobot_mtdagger.suites"]
+    my-suite = "my_package.suites:make_my_suite"
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Collection
+from importlib.metadata import entry_points
+
+logger = logging.getLogger(__name__)
+
+STUDENT_ENTRY_POINTS = "lerobot_mtdagger.students"
+"""The entry-point group of installed students (``--policy.type`` -> ``"module:Student"``)."""
+
+SUITE_ENTRY_POINTS = "lerobot_mtdagger.suites"
+"""The entry-point group of installed suites (``--suite.name`` -> ``"module:factory"``)."""
+
+
+def register_installed(
+    group: str, registered: Collection[str], register: Callable[[str, str], None]
+) -> list[str]:
+    """Registers every entry point of ``group`` whose name is not taken yet.
+
+    Args:
+        group: The entry-point group.
+        registered: The names the registry holds already (the built-in ones win: a clash is logged).
+        register: ``register(name, "module:attribute")``.
+
+    Returns:
+        The names registered.
+    """
+    added = []
+    for point in sorted(entry_points(group=group), key=lambda point: point.name):
+        if point.name in registered or point.name in added:
+            logger.warning(
+                "Entry point %s = %s (group %s) is not registered: the name is taken; rename it in its "
+                "package.",
+                point.name,
+                point.value,
+                group,
+            )
+            continue
+        register(point.name, point.value)
+        added.append(point.name)
+    return added
