@@ -6,11 +6,18 @@
 # change a running one):
 #   mkdir -p outputs && cp experiments/resume.sh outputs/resume-running.sh
 #   nohup bash outputs/resume-running.sh >> outputs/resume.log 2>&1 &
+# To change the queue while studies run: stop the earlier copy's chains (its bash processes, not the
+# studies' run.sh: `pkill -f outputs/resume-running.sh` before copying), then start the new copy; a
+# study still running is waited for, then its core's chain goes on.
 #
-# Running (2026-11-28): on core 0 paper-regime-training-dev, then paper-regime-eval (which starts
-# only once the former has decided every arm's training); on core 1 plateau-dagger-training-dev, then
-# pixels-dagger-epochs-dev (paused until then; it runs from its own commit's docs/results/ layout).
-# paper-regime-pertask-dev is complete (skipped at once); drawers-preset-dev stopped (its README).
+# Running (2026-11-28): on core 0 paper-regime-training-dev, then paper-regime-eval seeds 0 and 2
+# (it starts only once the former has decided every arm's training); on core 1
+# plateau-dagger-training-dev, then plateau-dagger-eval (it starts only once the former has decided),
+# then paper-regime-eval seed 1, then pixels-dagger-epochs-dev (paused until then; it runs from its own
+# commit's docs/results/ layout). On core 1 a study that refuses to start (its development study
+# undecided) or stops passes the core to the next one; run this again once it has decided. On core 0
+# paper-regime-eval waits for its development study in the same chain. paper-regime-pertask-dev is complete
+# (skipped at once); drawers-preset-dev stopped (its README).
 set -uo pipefail
 
 PLATEAU_COMMIT=${PLATEAU_COMMIT:-fe972b0}  # the commit that added plateau-dagger-training-dev
@@ -18,6 +25,7 @@ PERTASK_COMMIT=${PERTASK_COMMIT:-b76672e}  # the commit that added paper-regime-
 TRAINING_COMMIT=${TRAINING_COMMIT:-b05f863}  # the commit that added paper-regime-training-dev
 EVAL_COMMIT=${EVAL_COMMIT:-ba3f594}  # the commit that added paper-regime-eval
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
+PLATEAU_EVAL_COMMIT=${PLATEAU_EVAL_COMMIT:-631c388}  # the commit that added plateau-dagger-eval
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
@@ -31,22 +39,32 @@ worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checko
 }
 
 study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh there, pinned to CORE
-  local name=$1 tree=$2 commit=$3 core=$4 folder=${5:-experiments}
+  # With SEEDS set (a study that splits its seeds over cores), only that seed subset, and a second
+  # process for the same subset is refused by a lock instead of by the process list.
+  local name=$1 tree=$2 commit=$3 core=$4 folder=${5:-experiments} part=""
   worktree "$tree" "$commit" || { log "cannot make ../$tree"; return 1; }
-  if pgrep -f "$name/run.sh" > /dev/null; then
-    log "$name is already running: stop it first (a second process would share its runs)"
-    return 1
+  if [ -n "${SEEDS:-}" ]; then
+    part=" (seeds ${SEEDS})"
+    exec {lock}> "outputs/.$name-seeds-${SEEDS// /-}.lock"
+    flock -n "$lock" || { log "$name$part is already running: stop it first"; return 1; }
+  elif pgrep -f "$name/run.sh" > /dev/null; then  # started by an earlier copy of this script
+    log "$name is already running (a second process would share its runs): waiting for it to end"
+    while pgrep -f "$name/run.sh" > /dev/null; do sleep 60; done
+    log "$name ended (run by the earlier process)"
+    return 0
   fi
-  log "$name on core $core"
+  log "$name$part on core $core"
   (cd "../$tree" && PYTHONPATH=$PWD JOBS=1 taskset -c "$core" bash "$folder/$name/run.sh") \
     >> "outputs/$name.log" 2>&1
-  log "$name ended with status $?"
+  log "$name$part ended with status $?"
 }
 
 mkdir -p outputs
 (study paper-regime-pertask-dev study-code-pertask "$PERTASK_COMMIT" 0 &&
   study paper-regime-training-dev study-code-training "$TRAINING_COMMIT" 0 &&
-  study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0) &
+  SEEDS="0 2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0) &
 (study plateau-dagger-training-dev study-code-plateau-dagger "$PLATEAU_COMMIT" 1 &&
-  OMP_NUM_THREADS=1 study pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 1 docs/results) &
+  { study plateau-dagger-eval study-code-plateau-eval "$PLATEAU_EVAL_COMMIT" 1
+    SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 1
+    OMP_NUM_THREADS=1 study pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 1 docs/results; }) &
 wait
