@@ -306,6 +306,46 @@ def test_cli_only_dispatches_to_one_module_per_command():
         assert vars(sys.modules[home]).get(config_class.__name__) is config_class, (name, "config not named")
 
 
+WORKER_FIELDS = {"workers", "worker_backend"}
+"""The env worker options, defined once (``option_groups.WorkerOptions``)."""
+
+
+def option_groups(config_class: type) -> list[type]:
+    """``config_class`` and every dataclass among its fields' types, recursively."""
+    import dataclasses
+    import typing
+
+    groups, pending = [], [config_class]
+    while pending:
+        group = pending.pop()
+        if group in groups:
+            continue
+        groups.append(group)
+        hints = typing.get_type_hints(group)
+        pending += [hints[f.name] for f in dataclasses.fields(group) if isinstance(hints[f.name], type)]
+        pending = [candidate for candidate in pending if dataclasses.is_dataclass(candidate)]
+    return groups
+
+
+def test_every_command_takes_its_worker_options_from_one_group():
+    """A command's option group with env worker options inherits them from ``WorkerOptions``."""
+    import dataclasses
+
+    from lerobot_mtdagger.cli import COMMANDS
+    from lerobot_mtdagger.runner.option_groups import WorkerOptions
+
+    own, with_workers = [], []
+    for name, (config_class, _) in COMMANDS.items():
+        for group in option_groups(config_class):
+            fields = {field.name for field in dataclasses.fields(group)} & WORKER_FIELDS
+            if fields:
+                with_workers.append(name)
+                if not issubclass(group, WorkerOptions):
+                    own.append(f"{name}: {group.__qualname__} {sorted(fields)}")
+    assert own == [], own
+    assert {"run", "eval", "shift"} <= set(with_workers), with_workers  # compare passes run's on
+
+
 STUDENT_CLASSES = {"MTDAggerPolicy", "MTDAggerConfig", "PolicyOptions"}
 """Classes of one student: the runner asks the student (``runner/student.py``) instead of testing for them."""
 
