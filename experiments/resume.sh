@@ -14,7 +14,7 @@
 # (it starts only once the former has decided every arm's training); on core 1
 # plateau-dagger-training-dev, then plateau-dagger-eval (it starts only once the former has decided),
 # then paper-regime-eval seed 1, then pixels-dagger-epochs-dev (paused until then; it runs from its own
-# commit's docs/results/ layout). On core 1 a study that refuses to start (its development study
+# commit's docs/results/ layout), then pixels-matched-eval (it runs only if that study's rule says so). On core 1 a study that refuses to start (its development study
 # undecided) or stops passes the core to the next one; run this again once it has decided. On core 0
 # paper-regime-eval waits for its development study in the same chain. paper-regime-pertask-dev is complete
 # (skipped at once); drawers-preset-dev stopped (its README).
@@ -26,6 +26,7 @@ TRAINING_COMMIT=${TRAINING_COMMIT:-b05f863}  # the commit that added paper-regim
 EVAL_COMMIT=${EVAL_COMMIT:-ba3f594}  # the commit that added paper-regime-eval
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
 PLATEAU_EVAL_COMMIT=${PLATEAU_EVAL_COMMIT:-631c388}  # the commit that added plateau-dagger-eval
+PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-91949d1}  # the commit that added pixels-matched-eval
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
@@ -66,5 +67,6 @@ mkdir -p outputs
 (study plateau-dagger-training-dev study-code-plateau-dagger "$PLATEAU_COMMIT" 1 &&
   { study plateau-dagger-eval study-code-plateau-eval "$PLATEAU_EVAL_COMMIT" 1
     SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 1
-    OMP_NUM_THREADS=1 study pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 1 docs/results; }) &
+    OMP_NUM_THREADS=1 study pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 1 docs/results
+    OMP_NUM_THREADS=1 study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 1; }) &
 wait
