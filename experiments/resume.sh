@@ -14,8 +14,9 @@
 # (it starts only once the former has decided every arm's training); on core 1
 # plateau-dagger-training-dev, then plateau-dagger-eval (it starts only once the former has decided),
 # then paper-regime-eval seed 1, then pixels-dagger-epochs-dev (paused until then; it runs from its own
-# commit's docs/results/ layout), then pixels-matched-eval (it runs only if that study's rule says so). On core 1 a study that refuses to start (its development study
-# undecided) or stops passes the core to the next one; run this again once it has decided. On core 0
+# commit's docs/results/ layout), then pixels-matched-eval (it runs only if that study's rule says
+# so). On core 1 a study that refuses to start (its development study undecided) or stops passes the
+# core to the next one; run this again once it has decided. On core 0
 # paper-regime-eval waits for its development study in the same chain. paper-regime-pertask-dev is complete
 # (skipped at once); drawers-preset-dev stopped (its README).
 set -uo pipefail
