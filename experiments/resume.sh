@@ -16,9 +16,9 @@
 # then paper-regime-eval seed 1, then pixels-dagger-epochs-dev (paused until then; it runs from its own
 # commit's docs/results/ layout), then pixels-matched-eval (it runs only if that study's rule says
 # so). On core 1 a study that refuses to start (its development study undecided) or stops passes the
-# core to the next one; run this again once it has decided. On core 0
-# paper-regime-eval waits for its development study in the same chain. paper-regime-pertask-dev is complete
-# (skipped at once); drawers-preset-dev stopped (its README).
+# core to the next one; run this again once it has decided. Core 0 then takes paper-regime-eval's seed
+# 1 too unless core 1 holds it (a lock per seed subset). paper-regime-pertask-dev is complete (skipped
+# at once); drawers-preset-dev stopped (its README).
 set -uo pipefail
 
 PLATEAU_COMMIT=${PLATEAU_COMMIT:-fe972b0}  # the commit that added plateau-dagger-training-dev
@@ -64,7 +64,8 @@ study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh t
 mkdir -p outputs
 (study paper-regime-pertask-dev study-code-pertask "$PERTASK_COMMIT" 0 &&
   study paper-regime-training-dev study-code-training "$TRAINING_COMMIT" 0 &&
-  SEEDS="0 2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0) &
+  SEEDS="0 2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0 &&
+  SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0) &  # if core 1 has not taken it
 (study plateau-dagger-training-dev study-code-plateau-dagger "$PLATEAU_COMMIT" 1 &&
   { study plateau-dagger-eval study-code-plateau-eval "$PLATEAU_EVAL_COMMIT" 1
     SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 1
