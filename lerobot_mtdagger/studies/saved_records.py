@@ -25,10 +25,9 @@ logger = logging.getLogger(__name__)
 ARCHIVE_NAME = "runs-records.tar.gz"
 """The archive of a folder of runs' records."""
 
-_UNPACKED: dict[Path, Path] = {}
-"""Each archive read (resolved path) -> the folder it was unpacked into."""
-_SHOWN_AS: dict[Path, Path] = {}
-"""Each unpacked folder -> the folder its runs are named in (the archive's own folder)."""
+_UNPACKED: dict[Path, tuple[Path, Path]] = {}
+"""Each archive read (resolved path) -> (the folder it was unpacked into, the folder its runs are named
+in: the archive's own folder)."""
 
 
 def saved_records_runs(path: Path) -> list[Path]:
@@ -81,14 +80,13 @@ def unpack(archive: Path) -> Path:
         except (tarfile.TarError, OSError) as error:
             raise UserError(f"--records: cannot read {archive} as a tar archive ({error}).") from error
         logger.debug("Unpacked %s into %s", archive, folder)
-        _UNPACKED[key] = folder
-        _SHOWN_AS[folder] = archive.parent
-    return _UNPACKED[key]
+        _UNPACKED[key] = (folder, archive.parent)
+    return _UNPACKED[key][0]
 
 
 def shown_name(run: Path) -> str:
     """How a run is named in tables: unpacked from an archive, as if beside the archive."""
-    for folder, shown in _SHOWN_AS.items():
+    for folder, shown in _UNPACKED.values():
         if run.is_relative_to(folder):
             return str(shown / run.relative_to(folder))
     return str(run)
