@@ -85,3 +85,19 @@ def small_drawer_cloud_args(output_dir: Path) -> list[str]:
         "--progress=false",
         f"--output_dir={output_dir}",
     ]
+
+
+TINY_ROUND = [
+    "--dagger.rounds=1",
+    "--dagger.initial_demos=1",
+    "--dagger.budget_per_task=1",
+    "--training.steps_per_round=5",
+    "--rollout.eval_episodes=1",
+    "--rollout.max_steps=20",
+    "--rollout.workers=0",
+    "--policy.batch_size=8",
+    "--policy.state_hidden_dims=[16]",
+    "--policy.head_hidden_dims=[16]",
+    "--progress=false",
+]
+"""One DAgger round of a tiny ``mtdagger`` policy, in-process envs (add the suite and ``--output_dir``)."""

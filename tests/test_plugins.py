@@ -14,6 +14,7 @@ import textwrap
 from pathlib import Path
 
 from lerobot_mtdagger.utils.plugins import STUDENT_ENTRY_POINTS, SUITE_ENTRY_POINTS, register_installed
+from tests.helpers import TINY_ROUND
 
 PLUGIN_MODULE = '''
 from dataclasses import dataclass
@@ -46,20 +47,6 @@ def two_task_suite(options):
     return TwoTaskSuite(options.task_list([t.name for t in tasks]), options.observation,
                         options.max_episode_steps, tasks=tasks)
 '''
-
-TINY_RUN = [
-    "--dagger.rounds=1",
-    "--dagger.initial_demos=1",
-    "--dagger.budget_per_task=1",
-    "--training.steps_per_round=5",
-    "--rollout.eval_episodes=1",
-    "--rollout.max_steps=20",
-    "--rollout.workers=0",
-    "--policy.batch_size=8",
-    "--policy.state_hidden_dims=[16]",
-    "--policy.head_hidden_dims=[16]",
-    "--progress=false",
-]
 
 
 def install_plugin(root: Path, entry_points: str) -> dict[str, str]:
@@ -94,7 +81,7 @@ def test_an_installed_student_and_suite_run_from_the_command_line(tmp_path):
     )
     out = tmp_path / "run"
     done = lerobot_mtdagger(
-        env, "run", "--suite.name=toy-two", "--policy.type=plugin-student", *TINY_RUN, f"--output_dir={out}"
+        env, "run", "--suite.name=toy-two", "--policy.type=plugin-student", *TINY_ROUND, f"--output_dir={out}"
     )
     assert done.returncode == 0, done.stderr[-3000:]
     config = json.loads((out / "config.json").read_text())
@@ -106,7 +93,7 @@ def test_an_installed_student_and_suite_run_from_the_command_line(tmp_path):
     # Without the package, the names are unknown, and the refusal lists what is registered.
     bare = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path.cwd()), os.environ.get("PYTHONPATH", "")])}
     missing = tmp_path / "x"
-    refused = lerobot_mtdagger(bare, "run", "--suite.name=toy-two", *TINY_RUN, f"--output_dir={missing}")
+    refused = lerobot_mtdagger(bare, "run", "--suite.name=toy-two", *TINY_ROUND, f"--output_dir={missing}")
     assert refused.returncode != 0 and "Unknown suite 'toy-two'" in refused.stderr, refused.stderr[-2000:]
     assert not missing.exists()
 

@@ -20,23 +20,11 @@ from lerobot_mtdagger.runner.mtdagger_student import MTDAggerStudent
 from lerobot_mtdagger.runner.student import Student, get_student, register_student, student_names
 from lerobot_mtdagger.runner.student_options import PolicyOptions
 from lerobot_mtdagger.utils.errors import UserError
+from tests.helpers import TINY_ROUND
 
 NAME = "mtdagger-copy"
 
-TINY_RUN = [
-    "--suite.name=toy",
-    "--dagger.rounds=1",
-    "--dagger.initial_demos=1",
-    "--dagger.budget_per_task=1",
-    "--training.steps_per_round=5",
-    "--rollout.eval_episodes=1",
-    "--rollout.max_steps=20",
-    "--rollout.workers=0",
-    "--policy.batch_size=8",
-    "--policy.state_hidden_dims=[16]",
-    "--policy.head_hidden_dims=[16]",
-    "--progress=false",
-]
+TINY_RUN = ["--suite.name=toy", *TINY_ROUND]
 
 
 @dataclass
