@@ -17,8 +17,10 @@
 # commit's docs/results/ layout), then pixels-matched-eval (it runs only if that study's rule says
 # so). On core 1 a study that refuses to start (its development study undecided) or stops passes the
 # core to the next one; run this again once it has decided. Core 0 then takes paper-regime-eval's seed
-# 1 too unless core 1 holds it (a lock per seed subset). paper-regime-pertask-dev is complete (skipped
-# at once); drawers-preset-dev stopped (its README).
+# 1 too unless core 1 holds it (a lock per seed subset). paper-regime-pertask-dev,
+# plateau-dagger-training-dev and plateau-dagger-eval are complete (their runs skipped at once, so core 1
+# goes on to paper-regime-eval seed 1 or, while that refuses, pixels-dagger-epochs-dev);
+# drawers-preset-dev stopped (its README).
 set -uo pipefail
 
 PLATEAU_COMMIT=${PLATEAU_COMMIT:-fe972b0}  # the commit that added plateau-dagger-training-dev
