@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lerobot_mtdagger.studies.saved_records import ARCHIVE_NAME, saved_records_runs
+
 ARMS = ("bc", "uniform", "need")
 TRAININGS = ("plain", "cosine")
 SEEDS = (100, 101)
@@ -62,21 +64,33 @@ def choose(success: dict, arm: str) -> tuple[str | None, list[str]]:
     return chosen, lines
 
 
+def run_folders(folder: Path, training: str, seed: int) -> list[Path]:
+    """The runs of one training and seed: ``runs/`` of a compare folder, or its saved records' archive."""
+    compare = folder / f"{training}-seed{seed}"
+    if (compare / "runs").is_dir():
+        compare = compare / "runs"
+    elif not (compare / ARCHIVE_NAME).is_file():
+        return []
+    return saved_records_runs(compare)
+
+
 def passes(folder: Path) -> list[str]:
-    """Mean, min and max passes over a task's frames per arm and training, phase by phase (seed 100)."""
+    """Mean, min and max passes over a task's frames per arm, training and seed, phase by phase."""
     lines = []
     for training in TRAININGS:
-        runs = folder / f"{training}-seed100" / "runs"
-        for run in sorted(runs.glob("*")) if runs.is_dir() else []:
-            cells = []
-            for record in sorted(run.glob("policies/round-*/training.json")):
-                per_task = [
-                    p for p in json.loads(record.read_text()).get("passes_per_task") or [] if p is not None
-                ]
-                if per_task:
-                    cells.append(f"{np.mean(per_task):.0f} [{min(per_task):.0f}-{max(per_task):.0f}]")
-            if cells:
-                lines.append(f"| {training} | {run.name} | " + "; ".join(cells) + " |")
+        for seed in SEEDS:
+            for run in run_folders(folder, training, seed):
+                cells = []
+                for record in sorted(run.glob("policies/round-*/training.json")):
+                    per_task = [
+                        p
+                        for p in json.loads(record.read_text()).get("passes_per_task") or []
+                        if p is not None
+                    ]
+                    if per_task:
+                        cells.append(f"{np.mean(per_task):.0f} [{min(per_task):.0f}-{max(per_task):.0f}]")
+                if cells:
+                    lines.append(f"| {training} | {run.name} | " + "; ".join(cells) + " |")
     return lines
 
 
@@ -92,7 +106,7 @@ def main() -> None:
                 cells = [success.get((arm, training, seed, b)) for b in BUDGETS]
                 shown = " | ".join("-" if c is None else f"{c:.3f}" for c in cells)
                 print(f"| {arm} | {training} | {seed} | {shown} |")
-    print("\nPasses over each task's frames per phase (mean [min-max] over tasks), seed 100:\n")
+    print("\nPasses over each task's frames per phase (mean [min-max] over tasks):\n")
     print("| training | run | phases 0, 1, ... |\n|---|---|---|")
     print("\n".join(passes(folder)))
     print()
