@@ -10,17 +10,16 @@
 # studies' run.sh: `pkill -f outputs/resume-running.sh` before copying), then start the new copy; a
 # study still running is waited for, then its core's chain goes on.
 #
-# Running (2026-11-28): on core 0 paper-regime-training-dev, then paper-regime-eval seeds 0 and 2
-# (it starts only once the former has decided every arm's training); on core 1
-# plateau-dagger-training-dev, then plateau-dagger-eval (it starts only once the former has decided),
-# then paper-regime-eval seed 1, then pixels-dagger-epochs-dev (paused until then; it runs from its own
-# commit's docs/results/ layout), then pixels-matched-eval (it runs only if that study's rule says
-# so). On core 1 a study that refuses to start (its development study undecided) or stops passes the
-# core to the next one; run this again once it has decided. Core 0 then takes paper-regime-eval's seed
-# 1 too unless core 1 holds it (a lock per seed subset). paper-regime-pertask-dev,
-# plateau-dagger-training-dev and plateau-dagger-eval are complete (their runs skipped at once, so core 1
-# goes on to paper-regime-eval seed 1 or, while that refuses, pixels-dagger-epochs-dev);
-# drawers-preset-dev stopped (its README).
+# Running (2026-11-28 21:29): on core 0 paper-regime-eval seeds 0 and 2 (paper-regime-training-dev
+# decided every arm's training at 21:28), then its seed 1 unless core 1 holds it (a lock per seed
+# subset); on core 1 pixels-dagger-epochs-dev (it runs from its own commit's docs/results/ layout),
+# started while paper-regime-eval still refused. On a restart core 1 takes paper-regime-eval seed 1
+# first (decided now: the paper's regime is the principal question), then pixels-dagger-epochs-dev
+# (resumed where it was cut), then pixels-matched-eval (it runs only if pixels-dagger-epochs-dev's rule
+# says so). On core 1 a study that refuses to start or stops passes the core to the next one.
+# paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev and
+# plateau-dagger-eval are complete (their runs are skipped at once); drawers-preset-dev stopped (its
+# README).
 set -uo pipefail
 
 PLATEAU_COMMIT=${PLATEAU_COMMIT:-fe972b0}  # the commit that added plateau-dagger-training-dev
