@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lab.passes import compare_runs, phase_passes
 from lerobot_mtdagger.studies.figures import format_difference
 from lerobot_mtdagger.studies.stats import Interval, demos_to_reach, paired_difference
 
@@ -222,18 +223,13 @@ def analysis(folder: Path) -> list[str]:
 
 
 def passes(folder: Path) -> list[str]:
-    """Each run's passes over each task's frames, phase by phase (from its training.json files)."""
+    """Each run's passes over each task's frames, phase by phase (from ``outputs/`` or saved records)."""
     lines = []
-    for run in sorted(folder.glob("*-seed*/runs/*")):
-        cells = []
-        for record in sorted(run.glob("policies/round-*/training.json")):
-            per_task = [
-                p for p in json.loads(record.read_text()).get("passes_per_task") or [] if p is not None
-            ]
-            if per_task:
-                cells.append(f"{np.mean(per_task):.0f} [{min(per_task):.0f}-{max(per_task):.0f}]")
-        if cells:
-            lines.append(f"  {run.parent.parent.name}/{run.name}: " + "; ".join(cells))
+    for compare in sorted(folder.glob("*-seed*")):
+        for run in compare_runs(compare):
+            cells = phase_passes(run)
+            if cells:
+                lines.append(f"  {compare.name}/{run.name}: " + "; ".join(cells))
     return lines
 
 

@@ -12,13 +12,12 @@ are what the evaluation study reads.
 from __future__ import annotations
 
 import csv
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.studies.saved_records import ARCHIVE_NAME, saved_records_runs
+from lab.passes import compare_runs, phase_passes
 
 ARMS = ("bc", "uniform", "need")
 TRAININGS = ("plain", "cosine")
@@ -64,31 +63,13 @@ def choose(success: dict, arm: str) -> tuple[str | None, list[str]]:
     return chosen, lines
 
 
-def run_folders(folder: Path, training: str, seed: int) -> list[Path]:
-    """The runs of one training and seed: ``runs/`` of a compare folder, or its saved records' archive."""
-    compare = folder / f"{training}-seed{seed}"
-    if (compare / "runs").is_dir():
-        compare = compare / "runs"
-    elif not (compare / ARCHIVE_NAME).is_file():
-        return []
-    return saved_records_runs(compare)
-
-
 def passes(folder: Path) -> list[str]:
     """Mean, min and max passes over a task's frames per arm, training and seed, phase by phase."""
     lines = []
     for training in TRAININGS:
         for seed in SEEDS:
-            for run in run_folders(folder, training, seed):
-                cells = []
-                for record in sorted(run.glob("policies/round-*/training.json")):
-                    per_task = [
-                        p
-                        for p in json.loads(record.read_text()).get("passes_per_task") or []
-                        if p is not None
-                    ]
-                    if per_task:
-                        cells.append(f"{np.mean(per_task):.0f} [{min(per_task):.0f}-{max(per_task):.0f}]")
+            for run in compare_runs(folder / f"{training}-seed{seed}"):
+                cells = phase_passes(run)
                 if cells:
                     lines.append(f"| {training} | {run.name} | " + "; ".join(cells) + " |")
     return lines
