@@ -24,6 +24,7 @@ import numpy as np
 
 from lab.passes import compare_runs, phase_passes
 from lerobot_mtdagger.studies.figures import format_difference
+from lerobot_mtdagger.studies.results import experiment_rows
 from lerobot_mtdagger.studies.stats import Interval, demos_to_reach, paired_difference
 
 ARMS = ("bc", "uniform", "need", "need_raw", "gain")
@@ -47,20 +48,37 @@ def load_training_table():
 
 
 def read_rows(folder: Path) -> list[dict]:
-    """Every ``results.csv`` row under ``folder/<training>-seed<seed>/``, with ``arm`` and ``training``."""
+    """Every row under ``folder/<training>-seed<seed>/``, with ``arm`` and ``training``.
+
+    A compare folder's ``results.csv`` when it has one; while its compare is still running (no table
+    yet), its runs' own records, from ``outputs/`` or the saved archive: the same rows, including the
+    phases of a run not finished yet (an incomplete curve counts for no seed in the analysis).
+    """
     rows = []
-    for path in sorted(folder.glob("*-seed*/results.csv")):
-        training = path.parent.name.split("-seed")[0]
-        with path.open() as handle:
-            for row in csv.DictReader(handle):
-                row["arm"] = "bc" if row["bc"] == "True" else row["method"]
-                row["training"] = training
-                row["seed"] = int(row["seed"])
-                row["demos"] = round(float(row["demos_per_task_mean"]), 1)
-                row["success"] = float(row["eval_success_mean"])
-                row["per_task"] = json.loads(row["eval_success"])
-                rows.append(row)
+    for compare in sorted(path for path in folder.glob("*-seed*") if path.is_dir()):
+        training = compare.name.split("-seed")[0]
+        table = compare / "results.csv"
+        if table.is_file():
+            with table.open() as handle:
+                found = list(csv.DictReader(handle))
+        else:
+            found = [row for run in compare_runs(compare) for row in experiment_rows(run)]
+        rows += [table_row(row, training) for row in found]
     return rows
+
+
+def table_row(row: dict, training: str) -> dict:
+    """One results row (a ``results.csv`` line or ``experiment_rows``'s dict) with the fields used here."""
+    per_task = row["eval_success"]
+    return {
+        **row,
+        "arm": "bc" if str(row["bc"]) == "True" else row["method"],
+        "training": training,
+        "seed": int(row["seed"]),
+        "demos": round(float(row["demos_per_task_mean"]), 1),
+        "success": float(row["eval_success_mean"]),
+        "per_task": json.loads(per_task) if isinstance(per_task, str) else list(per_task),
+    }
 
 
 def settings(dev: Path, check: Path) -> list[str] | None:
@@ -198,7 +216,10 @@ def analysis(folder: Path) -> list[str]:
         interval = paired_difference([means["need"][s] for s in seeds], [means["uniform"][s] for s in seeds])
     out += ["", primary, f"Verdict (run.sh's rule): {verdict(interval)}", ""]
     out.append(f"Co-primary: demos per task to reach {LEVEL:.2f} (None: not reached by the last budget)")
-    reached = {arm: {s: reach(c) for s, c in seeds_.items()} for arm, seeds_ in grouped.items()}
+    reached = {  # complete curves only: a run still going is not censored
+        arm: {s: reach(c) for s, c in seeds_.items() if set(budgets) <= {row["demos"] for row in c}}
+        for arm, seeds_ in grouped.items()
+    }
     for arm in ARMS:
         cells = []
         for s in EVAL_SEEDS:

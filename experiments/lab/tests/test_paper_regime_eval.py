@@ -138,3 +138,29 @@ def test_two_seeds_decide_nothing(table, tmp_path):
         write_results(out / f"cosine-seed{seed}" / "results.csv", dagger_rows("uniform", seed, 0.6))
     text = "\n".join(table.analysis(out))
     assert "Verdict (run.sh's rule): not yet decided" in text
+
+
+def test_a_running_compare_folder_is_read_from_its_runs(table):
+    """The committed records: seed 0's compare was still running when saved (no ``results.csv``)."""
+    records = EXPERIMENTS / "paper-regime-eval" / "records"
+    rows = [row for row in table.read_rows(records) if row["seed"] == 0]
+    bc = sorted((row["demos"], round(row["success"], 3)) for row in rows if row["arm"] == "bc")
+    assert bc == [(6.0, 0.527), (12.0, 0.65), (18.0, 0.703), (24.0, 0.816), (30.0, 0.871)]
+    uniform = [row for row in rows if row["arm"] == "uniform"]
+    assert [row["demos"] for row in sorted(uniform, key=lambda r: r["round"])] == [
+        3.0 + 3 * r for r in range(10)
+    ]
+    assert all(len(row["per_task"]) == 43 for row in rows)
+
+
+def test_a_curve_still_running_is_not_censored(table, tmp_path):
+    out = tmp_path / "eval"
+    write_dev(tmp_path / "dev", need_level=0.65)
+    write_check(tmp_path / "check")
+    out.mkdir()
+    (out / "settings.txt").write_text("\n".join(table.settings(tmp_path / "dev", tmp_path / "check")) + "\n")
+    write_results(out / "plain-seed0" / "results.csv", dagger_rows("need", 0, 0.1, rounds=5))
+    write_results(out / "cosine-seed0" / "results.csv", dagger_rows("uniform", 0, 0.1))
+    text = "\n".join(table.analysis(out))
+    assert "  need: - / - / -" in text  # stopped at 18 demos: running, not "never reached"
+    assert "  uniform: >30 / - / -" in text
