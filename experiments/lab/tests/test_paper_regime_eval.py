@@ -5,6 +5,8 @@ from __future__ import annotations
 import csv
 import importlib.util
 import json
+import operator
+import shutil
 from pathlib import Path
 
 import pytest
@@ -140,17 +142,20 @@ def test_two_seeds_decide_nothing(table, tmp_path):
     assert "Verdict (run.sh's rule): not yet decided" in text
 
 
-def test_a_running_compare_folder_is_read_from_its_runs(table):
-    """The committed records: seed 0's compare was still running when saved (no ``results.csv``)."""
-    records = EXPERIMENTS / "paper-regime-eval" / "records"
-    rows = [row for row in table.read_rows(records) if row["seed"] == 0]
-    bc = sorted((row["demos"], round(row["success"], 3)) for row in rows if row["arm"] == "bc")
+def test_a_running_compare_folder_is_read_from_its_runs(table, tmp_path):
+    """Seed 0's saved runs without their ``results.csv`` (as while compare runs) give the table's rows."""
+    saved = EXPERIMENTS / "paper-regime-eval" / "records" / "cosine-seed0"
+    (tmp_path / "cosine-seed0").mkdir()
+    shutil.copy(saved / "runs-records.tar.gz", tmp_path / "cosine-seed0")
+    from_runs = table.read_rows(tmp_path)
+    bc = sorted((row["demos"], round(row["success"], 3)) for row in from_runs if row["arm"] == "bc")
     assert bc == [(6.0, 0.527), (12.0, 0.65), (18.0, 0.703), (24.0, 0.816), (30.0, 0.871)]
-    uniform = [row for row in rows if row["arm"] == "uniform"]
-    assert [row["demos"] for row in sorted(uniform, key=lambda r: r["round"])] == [
-        3.0 + 3 * r for r in range(10)
+    key = operator.itemgetter("arm", "demos")
+    from_table = sorted(table.read_rows(saved.parent), key=key)
+    assert [(r["arm"], r["demos"], r["success"], r["per_task"]) for r in sorted(from_runs, key=key)] == [
+        (r["arm"], r["demos"], r["success"], r["per_task"]) for r in from_table if r["seed"] == 0
     ]
-    assert all(len(row["per_task"]) == 43 for row in rows)
+    assert len(from_runs) == 5 + 4 * 10 and all(len(row["per_task"]) == 43 for row in from_runs)
 
 
 def test_a_curve_still_running_is_not_censored(table, tmp_path):
