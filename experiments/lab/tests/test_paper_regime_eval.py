@@ -85,6 +85,16 @@ def write_check(folder: Path) -> None:
     (folder / "kept.txt").write_text("tasks: " + ",".join(TASKS) + "\nmap: {}\n")
 
 
+def eval_folder(table, tmp_path: Path) -> Path:
+    """An evaluation folder with the settings read from stand-in development results (need at 0.65)."""
+    out = tmp_path / "eval"
+    write_dev(tmp_path / "dev", need_level=0.65)
+    write_check(tmp_path / "check")
+    out.mkdir()
+    (out / "settings.txt").write_text("\n".join(table.settings(tmp_path / "dev", tmp_path / "check")) + "\n")
+    return out
+
+
 def test_settings_follow_the_development_rules(table, tmp_path):
     write_dev(tmp_path / "dev", need_level=0.65)  # need at 30 demos: 0.65 + 0.18 + task terms >= 0.80
     write_check(tmp_path / "check")
@@ -112,11 +122,7 @@ def test_settings_wait_for_every_decision(table, tmp_path):
 
 
 def test_analysis_reports_the_primary_and_its_verdict(table, tmp_path):
-    out = tmp_path / "eval"
-    write_dev(tmp_path / "dev", need_level=0.65)
-    write_check(tmp_path / "check")
-    out.mkdir()
-    (out / "settings.txt").write_text("\n".join(table.settings(tmp_path / "dev", tmp_path / "check")) + "\n")
+    out = eval_folder(table, tmp_path)
     for seed, gap in zip((0, 1, 2), (0.04, 0.05, 0.06), strict=True):
         write_results(
             out / f"plain-seed{seed}" / "results.csv",
@@ -130,11 +136,7 @@ def test_analysis_reports_the_primary_and_its_verdict(table, tmp_path):
 
 
 def test_two_seeds_decide_nothing(table, tmp_path):
-    out = tmp_path / "eval"
-    write_dev(tmp_path / "dev", need_level=0.65)
-    write_check(tmp_path / "check")
-    out.mkdir()
-    (out / "settings.txt").write_text("\n".join(table.settings(tmp_path / "dev", tmp_path / "check")) + "\n")
+    out = eval_folder(table, tmp_path)
     for seed in (0, 1):
         write_results(out / f"plain-seed{seed}" / "results.csv", dagger_rows("need", seed, 0.1))
         write_results(out / f"cosine-seed{seed}" / "results.csv", dagger_rows("uniform", seed, 0.6))
@@ -159,11 +161,7 @@ def test_a_running_compare_folder_is_read_from_its_runs(table, tmp_path):
 
 
 def test_a_curve_still_running_is_not_censored(table, tmp_path):
-    out = tmp_path / "eval"
-    write_dev(tmp_path / "dev", need_level=0.65)
-    write_check(tmp_path / "check")
-    out.mkdir()
-    (out / "settings.txt").write_text("\n".join(table.settings(tmp_path / "dev", tmp_path / "check")) + "\n")
+    out = eval_folder(table, tmp_path)
     write_results(out / "plain-seed0" / "results.csv", dagger_rows("need", 0, 0.1, rounds=5))
     write_results(out / "cosine-seed0" / "results.csv", dagger_rows("uniform", 0, 0.1))
     text = "\n".join(table.analysis(out))
