@@ -10,13 +10,14 @@
 # studies' run.sh: `pkill -f outputs/resume-running.sh` before copying), then start the new copy; a
 # study still running is waited for, then its core's chain goes on.
 #
-# Running (2026-11-28 21:29): on core 0 paper-regime-eval seeds 0 and 2 (paper-regime-training-dev
-# decided every arm's training at 21:28), then its seed 1 unless core 1 holds it (a lock per seed
-# subset); on core 1 pixels-dagger-epochs-dev (it runs from its own commit's docs/results/ layout),
-# started while paper-regime-eval still refused. On a restart core 1 takes paper-regime-eval seed 1
-# first (decided now: the paper's regime is the principal question), then pixels-dagger-epochs-dev
-# (resumed where it was cut), then pixels-matched-eval (it runs only if pixels-dagger-epochs-dev's rule
-# says so). On core 1 a study that refuses to start or stops passes the core to the next one.
+# Running (2026-11-29 03:40): both cores on paper-regime-eval, seed 2 then seed 1 (what is left of
+# it: need_raw and gain), each core its own `compare` on the same folder; compare shares a folder's
+# runs between processes with the same options (each skips the runs another has finished or is
+# writing), so the two cores finish the primary analysis's last seed first. A compare that skipped a
+# run the other core was writing ends with an error and no results.csv; core 0's last step tabulates
+# every seed once the runs are done. Then core 1 goes on to pixels-dagger-epochs-dev (it runs from its
+# own commit's docs/results/ layout) and pixels-matched-eval (it runs only if pixels-dagger-epochs-dev's
+# rule says so). A study that refuses to start or stops passes the core to the next one.
 # paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev and
 # plateau-dagger-eval are complete (their runs are skipped at once); drawers-preset-dev stopped (its
 # README).
@@ -43,12 +44,13 @@ worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checko
 
 study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh there, pinned to CORE
   # With SEEDS set (a study that splits its seeds over cores), only that seed subset, and a second
-  # process for the same subset is refused by a lock instead of by the process list.
+  # process for the same subset on the same core is refused by a lock instead of by the process list
+  # (the other core may share the subset: compare shares a folder's runs).
   local name=$1 tree=$2 commit=$3 core=$4 folder=${5:-experiments} part=""
   worktree "$tree" "$commit" || { log "cannot make ../$tree"; return 1; }
   if [ -n "${SEEDS:-}" ]; then
     part=" (seeds ${SEEDS})"
-    exec {lock}> "outputs/.$name-seeds-${SEEDS// /-}.lock"
+    exec {lock}> "outputs/.$name-seeds-${SEEDS// /-}-core$core.lock"
     flock -n "$lock" || { log "$name$part is already running: stop it first"; return 1; }
   elif pgrep -f "$name/run.sh" > /dev/null; then  # started by an earlier copy of this script
     log "$name is already running (a second process would share its runs): waiting for it to end"
@@ -65,10 +67,12 @@ study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh t
 mkdir -p outputs
 (study paper-regime-pertask-dev study-code-pertask "$PERTASK_COMMIT" 0 &&
   study paper-regime-training-dev study-code-training "$TRAINING_COMMIT" 0 &&
-  SEEDS="0 2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0 &&
-  SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0) &  # if core 1 has not taken it
+  { SEEDS="2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0
+    SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0
+    SEEDS="0 1 2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0; }) &  # tabulates
 (study plateau-dagger-training-dev study-code-plateau-dagger "$PLATEAU_COMMIT" 1 &&
   { study plateau-dagger-eval study-code-plateau-eval "$PLATEAU_EVAL_COMMIT" 1
+    SEEDS="2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 1
     SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 1
     OMP_NUM_THREADS=1 study pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 1 docs/results
     OMP_NUM_THREADS=1 study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 1; }) &
