@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from lab.passes import compare_runs, phase_passes
+from lerobot_mtdagger.datasets.rounds import open_run
 from lerobot_mtdagger.studies.figures import format_difference
 from lerobot_mtdagger.studies.results import experiment_rows
 from lerobot_mtdagger.studies.stats import Interval, demos_to_reach, paired_difference
@@ -52,7 +53,8 @@ def read_rows(folder: Path) -> list[dict]:
 
     A compare folder's ``results.csv`` when it has one; while its compare is still running (no table
     yet), its runs' own records, from ``outputs/`` or the saved archive: the same rows, including the
-    phases of a run not finished yet (an incomplete curve counts for no seed in the analysis).
+    phases of a run not finished yet (an incomplete curve counts for no seed in the analysis); a run
+    that has committed no round yet gives none.
     """
     rows = []
     for compare in sorted(path for path in folder.glob("*-seed*") if path.is_dir()):
@@ -62,9 +64,14 @@ def read_rows(folder: Path) -> list[dict]:
             with table.open() as handle:
                 found = list(csv.DictReader(handle))
         else:
-            found = [row for run in compare_runs(compare) for row in experiment_rows(run)]
+            found = [row for run in compare_runs(compare) if has_round(run) for row in experiment_rows(run)]
         rows += [table_row(row, training) for row in found]
     return rows
+
+
+def has_round(run: Path) -> bool:
+    """Whether ``run`` has committed a round (a run just started has none, and no row yet)."""
+    return bool(open_run(run).committed_rounds())
 
 
 def table_row(row: dict, training: str) -> dict:

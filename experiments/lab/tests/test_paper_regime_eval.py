@@ -167,3 +167,19 @@ def test_a_curve_still_running_is_not_censored(table, tmp_path):
     text = "\n".join(table.analysis(out))
     assert "  need: - / - / -" in text  # stopped at 18 demos: running, not "never reached"
     assert "  uniform: >30 / - / -" in text
+
+
+def test_a_run_just_started_gives_no_row(table, tmp_path):
+    """A run with its config written and no round committed yet (compare has just started it) is skipped."""
+    from lerobot_mtdagger.studies.saved_records import saved_records_runs
+
+    saved = EXPERIMENTS / "paper-regime-eval" / "records" / "cosine-seed0"
+    runs = tmp_path / "cosine-seed0" / "runs"
+    for run in saved_records_runs(saved):
+        shutil.copytree(run, runs / run.name)
+    started = runs / "gain-seed9"
+    (started / "rounds").mkdir(parents=True)
+    (started / "policies").mkdir()
+    shutil.copy(runs / "gain-seed0" / "config.json", started / "config.json")
+    rows = table.read_rows(tmp_path)
+    assert len(rows) == 5 + 4 * 10 and {row["seed"] for row in rows} == {0}
