@@ -13,12 +13,15 @@
 # Running (2026-11-29 03:40): both cores on paper-regime-eval, seed 2 then seed 1 (what is left of
 # it: need_raw and gain), each core its own `compare` on the same folder; compare shares a folder's
 # runs between processes with the same options (each skips the runs another has finished or is
-# writing), so the two cores finish the primary analysis's last seed first. A compare that skipped a
-# run the other core was writing ends with an error and no results.csv; core 0's last step tabulates
-# every seed once the runs are done. Then core 1 goes on to pixels-dagger-epochs-dev (it runs from its
-# own commit's docs/results/ layout) and pixels-matched-eval (it runs only if pixels-dagger-epochs-dev's
-# rule says so). A study that refuses to start or stops passes the core to the next one.
-# paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev and
+# writing). A compare that skipped a run the other core was writing ends with an error and no
+# results.csv; core 0's third step tabulates every seed once the runs are done. A study that refuses to
+# start or stops passes the core to the next one.
+# Queued after it (written 2026-11-29 04:50, first used at the next restart): both cores on
+# pixels-dagger-epochs-dev (it runs from its own commit's docs/results/ layout): run.sh on core 1
+# (epochs, then fixed) and its second_core.sh on core 0 (fixed, then epochs; `shared` retries while the
+# other core's compare runs, so the last to end writes the tables); then pixels-matched-eval (it runs
+# only if pixels-dagger-epochs-dev's rule says so) with seed 0 on core 0, seed 1 on core 1, and seed 2
+# shared. paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev and
 # plateau-dagger-eval are complete (their runs are skipped at once); drawers-preset-dev stopped (its
 # README).
 set -uo pipefail
@@ -42,16 +45,18 @@ worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checko
   ln -sfn ../main/outputs "../$1/outputs"
 }
 
-study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh there, pinned to CORE
-  # With SEEDS set (a study that splits its seeds over cores), only that seed subset, and a second
-  # process for the same subset on the same core is refused by a lock instead of by the process list
-  # (the other core may share the subset: compare shares a folder's runs).
-  local name=$1 tree=$2 commit=$3 core=$4 folder=${5:-experiments} part=""
+study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh (or $SCRIPT) there, pinned to CORE
+  # With SEEDS set (a study that splits its seeds over cores) only that seed subset. With SEEDS or SHARE
+  # set, a second process for it on the same core is refused by a lock, and the other core may work on
+  # the same folders (compare shares a folder's runs); otherwise a study that an earlier copy of this
+  # script runs is waited for. Returns the study's status.
+  local name=$1 tree=$2 commit=$3 core=$4 folder=${5:-experiments} part="" status lock
+  local script=${SCRIPT:-$folder/$name/run.sh}
   worktree "$tree" "$commit" || { log "cannot make ../$tree"; return 1; }
-  if [ -n "${SEEDS:-}" ]; then
-    part=" (seeds ${SEEDS})"
-    exec {lock}> "outputs/.$name-seeds-${SEEDS// /-}-core$core.lock"
-    flock -n "$lock" || { log "$name$part is already running: stop it first"; return 1; }
+  if [ -n "${SEEDS:-}${SHARE:-}" ]; then
+    part="${SEEDS:+ (seeds ${SEEDS})}${SHARE:+ (shared)}"
+    exec {lock}> "outputs/.$name${SEEDS:+-seeds-${SEEDS// /-}}-core$core.lock"
+    flock -n "$lock" || { log "$name$part is already running on core $core: stop it first"; exec {lock}>&-; return 1; }
   elif pgrep -f "$name/run.sh" > /dev/null; then  # started by an earlier copy of this script
     log "$name is already running (a second process would share its runs): waiting for it to end"
     while pgrep -f "$name/run.sh" > /dev/null; do sleep 60; done
@@ -59,21 +64,43 @@ study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh t
     return 0
   fi
   log "$name$part on core $core"
-  (cd "../$tree" && PYTHONPATH=$PWD JOBS=1 taskset -c "$core" bash "$folder/$name/run.sh") \
+  (cd "../$tree" && PYTHONPATH=$PWD JOBS=1 taskset -c "$core" bash "$script") \
     >> "outputs/$name.log" 2>&1
-  log "$name$part ended with status $?"
+  status=$?
+  [ -n "${lock:-}" ] && exec {lock}>&-
+  log "$name$part ended with status $status"
+  return "$status"
+}
+
+shared() {  # shared NAME WORKTREE COMMIT CORE [FOLDER]: `study` beside the other core's process on the same folders
+  # A compare that skipped a run the other core was writing ends with an error (and run.sh with it), so
+  # the study runs again every 5 minutes while a compare of NAME runs elsewhere; the last one to end
+  # finds every run done and writes the tables.
+  local status
+  while true; do
+    SHARE=1 study "$@"
+    status=$?
+    [ "$status" -eq 0 ] && return 0
+    pgrep -f "lerobot-mtdagger compare .*outputs/$1/" > /dev/null || return "$status"
+    sleep 300
+  done
 }
 
 mkdir -p outputs
+SECOND_CORE=$PWD/experiments/pixels-dagger-epochs-dev/second_core.sh  # read as it runs: do not edit meanwhile
 (study paper-regime-pertask-dev study-code-pertask "$PERTASK_COMMIT" 0 &&
   study paper-regime-training-dev study-code-training "$TRAINING_COMMIT" 0 &&
   { SEEDS="2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0
     SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0
-    SEEDS="0 1 2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0; }) &  # tabulates
+    SEEDS="0 1 2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0  # tabulates
+    OMP_NUM_THREADS=1 SCRIPT=$SECOND_CORE shared pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 0
+    OMP_NUM_THREADS=1 SEEDS="0" study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 0
+    OMP_NUM_THREADS=1 SEEDS="2" shared pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 0; }) &
 (study plateau-dagger-training-dev study-code-plateau-dagger "$PLATEAU_COMMIT" 1 &&
   { study plateau-dagger-eval study-code-plateau-eval "$PLATEAU_EVAL_COMMIT" 1
     SEEDS="2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 1
     SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 1
-    OMP_NUM_THREADS=1 study pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 1 docs/results
-    OMP_NUM_THREADS=1 study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 1; }) &
+    OMP_NUM_THREADS=1 shared pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 1 docs/results
+    OMP_NUM_THREADS=1 SEEDS="1" study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 1
+    OMP_NUM_THREADS=1 SEEDS="2" shared pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 1; }) &
 wait
