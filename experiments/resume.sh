@@ -10,13 +10,12 @@
 # studies' run.sh: `pkill -f outputs/resume-running.sh` before copying), then start the new copy; a
 # study still running is waited for, then its core's chain goes on.
 #
-# Running (2026-11-29 03:40): both cores on paper-regime-eval, seed 2 then seed 1 (what is left of
-# it: need_raw and gain), each core its own `compare` on the same folder; compare shares a folder's
-# runs between processes with the same options (each skips the runs another has finished or is
-# writing). A compare that skipped a run the other core was writing ends with an error and no
-# results.csv; core 0's third step tabulates every seed once the runs are done. A study that refuses to
-# start or stops passes the core to the next one.
-# Queued after it (written 2026-11-29 04:50, first used at the next restart): both cores on
+# paper-regime-eval is complete (2026-11-29 06:03; both cores shared its seeds 2 and 1: each core its
+# own `compare` on the same folder, compare skipping the runs another process has finished or is
+# writing; a compare that skipped a run the other core was writing ends with an error and no
+# results.csv, so core 0's third step tabulates every seed): its steps below are skipped at once. A
+# study that refuses to start or stops passes the core to the next one.
+# Next (written 2026-11-29 04:50, first used at the next restart): both cores on
 # pixels-dagger-epochs-dev (it runs from its own commit's docs/results/ layout): run.sh on core 1
 # (epochs, then fixed) and its second_core.sh on core 0 (fixed, then epochs; `shared` retries while the
 # other core's compare runs, so the last to end writes the tables); then pixels-matched-eval (it runs
