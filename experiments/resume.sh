@@ -10,28 +10,25 @@
 # studies' run.sh: `pkill -f outputs/resume-running.sh` before copying), then start the new copy; a
 # study still running is waited for, then its core's chain goes on.
 #
-# paper-regime-eval is complete (2026-11-29 06:03; both cores shared its seeds 2 and 1: each core its
-# own `compare` on the same folder, compare skipping the runs another process has finished or is
-# writing; a compare that skipped a run the other core was writing ends with an error and no
-# results.csv, so core 0's third step tabulates every seed): its steps below are skipped at once. A
-# study that refuses to start or stops passes the core to the next one.
-# Next (written 2026-11-29 04:50, first used at the next restart): both cores on
-# pixels-dagger-epochs-dev (it runs from its own commit's docs/results/ layout): run.sh on core 1
-# (epochs, then fixed) and its second_core.sh on core 0 (fixed, then epochs; `shared` retries while the
-# other core's compare runs, so the last to end writes the tables); then pixels-matched-eval (it runs
-# only if pixels-dagger-epochs-dev's rule says so) with seed 0 on core 0, seed 1 on core 1, and seed 2
-# shared. paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev and
-# plateau-dagger-eval are complete (their runs are skipped at once); drawers-preset-dev stopped (its
-# README).
+# These machines keep no outputs/ between sessions (a new checkout starts without it), so the queue holds
+# only runs still to do, each one short enough to end inside a session, and each saves its records into
+# the study's records/ (commit them): a study run as one long `compare` would restart from nothing at
+# every session. Complete studies are not in the queue (their records and READMEs hold their results):
+# paper-regime-eval, paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev,
+# plateau-dagger-eval; drawers-preset-dev stopped (its README).
+# Queue (2026-11-29): pixels-dagger-epochs-dev's runs not yet in its records (one_run.sh: a run whose
+# records hold phase 5 is skipped), the three fixed runs first (about 1 hour each), then the two epochs
+# runs (about 2.5 hours each): core 0 fixed 100, fixed 101, epochs 101; core 1 fixed 102, epochs 102.
+# With SESSION_END set (a UTC time, e.g. SESSION_END=09:50), a run that would not end before it is not
+# started (its estimate below), so a core does not spend the session's end on a run a stop would lose.
+# Then pixels-matched-eval, which runs nothing until pixels-dagger-epochs-dev's rule has decided (its
+# gate) and reads that study from its committed records and report (DEV below; report.sh writes it).
 set -uo pipefail
 
-PLATEAU_COMMIT=${PLATEAU_COMMIT:-fe972b0}  # the commit that added plateau-dagger-training-dev
-PERTASK_COMMIT=${PERTASK_COMMIT:-b76672e}  # the commit that added paper-regime-pertask-dev
-TRAINING_COMMIT=${TRAINING_COMMIT:-b05f863}  # the commit that added paper-regime-training-dev
-EVAL_COMMIT=${EVAL_COMMIT:-ba3f594}  # the commit that added paper-regime-eval
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
-PLATEAU_EVAL_COMMIT=${PLATEAU_EVAL_COMMIT:-631c388}  # the commit that added plateau-dagger-eval
 PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-91949d1}  # the commit that added pixels-matched-eval
+ONE_RUN=$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh  # read as it runs: do not edit meanwhile
+DEV=$PWD/experiments/pixels-dagger-epochs-dev  # its records/ and, once report.sh has run, report/
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
@@ -44,17 +41,19 @@ worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checko
   ln -sfn ../main/outputs "../$1/outputs"
 }
 
-study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh (or $SCRIPT) there, pinned to CORE
-  # With SEEDS set (a study that splits its seeds over cores) only that seed subset. With SEEDS or SHARE
-  # set, a second process for it on the same core is refused by a lock, and the other core may work on
-  # the same folders (compare shares a folder's runs); otherwise a study that an earlier copy of this
+study() {  # study NAME WORKTREE COMMIT CORE [FOLDER] [-- ARGS]: FOLDER/NAME/run.sh (or $SCRIPT ARGS) there, on CORE
+  # With SEEDS set (a study that splits its runs over cores: a seed subset, or one run) a second process
+  # for that part on the same core is refused by a lock; otherwise a study that an earlier copy of this
   # script runs is waited for. Returns the study's status.
-  local name=$1 tree=$2 commit=$3 core=$4 folder=${5:-experiments} part="" status lock
+  local name=$1 tree=$2 commit=$3 core=$4 folder=experiments part="" status lock
+  shift 4
+  if [ "$#" -gt 0 ] && [ "$1" != "--" ]; then folder=$1; shift; fi
+  [ "${1:-}" = "--" ] && shift
   local script=${SCRIPT:-$folder/$name/run.sh}
   worktree "$tree" "$commit" || { log "cannot make ../$tree"; return 1; }
-  if [ -n "${SEEDS:-}${SHARE:-}" ]; then
-    part="${SEEDS:+ (seeds ${SEEDS})}${SHARE:+ (shared)}"
-    exec {lock}> "outputs/.$name${SEEDS:+-seeds-${SEEDS// /-}}-core$core.lock"
+  if [ -n "${SEEDS:-}" ]; then
+    part=" (${SEEDS})"
+    exec {lock}> "outputs/.$name-${SEEDS// /-}-core$core.lock"
     flock -n "$lock" || { log "$name$part is already running on core $core: stop it first"; exec {lock}>&-; return 1; }
   elif pgrep -f "$name/run.sh" > /dev/null; then  # started by an earlier copy of this script
     log "$name is already running (a second process would share its runs): waiting for it to end"
@@ -63,7 +62,7 @@ study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh (
     return 0
   fi
   log "$name$part on core $core"
-  (cd "../$tree" && PYTHONPATH=$PWD JOBS=1 taskset -c "$core" bash "$script") \
+  (cd "../$tree" && PYTHONPATH=$PWD JOBS=1 taskset -c "$core" bash "$script" "$@") \
     >> "outputs/$name.log" 2>&1
   status=$?
   [ -n "${lock:-}" ] && exec {lock}>&-
@@ -71,35 +70,28 @@ study() {  # study NAME WORKTREE COMMIT CORE [FOLDER]: runs FOLDER/NAME/run.sh (
   return "$status"
 }
 
-shared() {  # shared NAME WORKTREE COMMIT CORE [FOLDER]: `study` beside the other core's process on the same folders
-  # A compare that skipped a run the other core was writing ends with an error (and run.sh with it), so
-  # the study runs again every 5 minutes while a compare of NAME runs elsewhere; the last one to end
-  # finds every run done and writes the tables.
-  local status
-  while true; do
-    SHARE=1 study "$@"
-    status=$?
-    [ "$status" -eq 0 ] && return 0
-    pgrep -f "lerobot-mtdagger compare .*outputs/$1/" > /dev/null || return "$status"
-    sleep 300
-  done
+fits() {  # fits MINUTES: whether a step of about MINUTES ends before SESSION_END (always, unset)
+  [ -z "${SESSION_END:-}" ] && return 0
+  local end now
+  end=$(date -u -d "$SESSION_END" +%s) || return 1
+  now=$(date -u +%s)
+  [ $((now + 60 * $1)) -le "$end" ] || { log "not started: about $1 min would pass SESSION_END $SESSION_END"; return 1; }
 }
 
+dev_run() {  # dev_run CORE ARM SEED MINUTES: one pixels-dagger-epochs-dev run (one_run.sh) on CORE
+  fits "$4" || return 1
+  OMP_NUM_THREADS=1 SCRIPT="$ONE_RUN" SEEDS="$2 $3" study pixels-dagger-epochs-dev study-code-pixels-epochs \
+    "$PIXELS_COMMIT" "$1" -- "$2" "$3"
+}
+
+if [ "${BASH_SOURCE[0]}" != "$0" ]; then return 0; fi  # sourced (its tests): functions only
+
 mkdir -p outputs
-SECOND_CORE=$PWD/experiments/pixels-dagger-epochs-dev/second_core.sh  # read as it runs: do not edit meanwhile
-(study paper-regime-pertask-dev study-code-pertask "$PERTASK_COMMIT" 0 &&
-  study paper-regime-training-dev study-code-training "$TRAINING_COMMIT" 0 &&
-  { SEEDS="2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0
-    SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0
-    SEEDS="0 1 2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 0  # tabulates
-    OMP_NUM_THREADS=1 SCRIPT=$SECOND_CORE shared pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 0
-    OMP_NUM_THREADS=1 SEEDS="0" study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 0
-    OMP_NUM_THREADS=1 SEEDS="2" shared pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 0; }) &
-(study plateau-dagger-training-dev study-code-plateau-dagger "$PLATEAU_COMMIT" 1 &&
-  { study plateau-dagger-eval study-code-plateau-eval "$PLATEAU_EVAL_COMMIT" 1
-    SEEDS="2" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 1
-    SEEDS="1" study paper-regime-eval study-code-paper-eval "$EVAL_COMMIT" 1
-    OMP_NUM_THREADS=1 shared pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" 1 docs/results
-    OMP_NUM_THREADS=1 SEEDS="1" study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 1
-    OMP_NUM_THREADS=1 SEEDS="2" shared pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 1; }) &
+(dev_run 0 fixed 100 75
+  dev_run 0 fixed 101 75
+  dev_run 0 epochs 101 160
+  OMP_NUM_THREADS=1 DEV=$DEV SEEDS="0" study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 0) &
+(dev_run 1 fixed 102 75
+  dev_run 1 epochs 102 160
+  OMP_NUM_THREADS=1 DEV=$DEV SEEDS="1" study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 1) &
 wait

@@ -2,7 +2,7 @@
 # Each arm's report from its saved records, then run.sh's outcomes and rule (table.py) into table.txt.
 # From the repository root, after save_records.sh.
 set -euo pipefail
-STUDY=docs/results/pixels-dagger-epochs-dev
+STUDY=experiments/pixels-dagger-epochs-dev
 for ARM in epochs fixed; do
   .venv/bin/lerobot-mtdagger report --records="[$STUDY/records/$ARM]" --output_dir="$STUDY/report/$ARM"
 done

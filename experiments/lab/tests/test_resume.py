@@ -1,0 +1,79 @@
+"""``experiments/resume.sh``: a step that would pass the session's end is not started; a one-run script
+gets its arguments, from the study's frozen worktree, once per core."""
+
+from __future__ import annotations
+
+import subprocess
+from datetime import datetime, timedelta, timezone
+from pathlib import Path
+
+import pytest
+
+RESUME = Path(__file__).resolve().parents[2] / "resume.sh"
+
+
+def bash(script: str, cwd: Path, **env: str) -> subprocess.CompletedProcess:
+    """``script`` run by bash in ``cwd`` with resume.sh's functions sourced."""
+    return subprocess.run(
+        ["bash", "-c", f"source {RESUME}\n{script}"],
+        cwd=cwd,
+        env={"PATH": "/usr/bin:/bin", "HOME": str(cwd), **env},
+        capture_output=True,
+        text=True,
+    )
+
+
+def in_minutes(minutes: int) -> str:
+    return (datetime.now(timezone.utc) + timedelta(minutes=minutes)).strftime("%H:%M")
+
+
+@pytest.mark.parametrize(("end_in", "step", "starts"), [(90, 60, True), (50, 60, False)])
+def test_a_step_starts_only_if_it_ends_before_session_end(tmp_path, end_in, step, starts):
+    if datetime.now(timezone.utc).hour == 23 and datetime.now(timezone.utc).minute >= 30:
+        pytest.skip("SESSION_END is a time of day: too close to midnight UTC to test here")
+    result = bash(f"fits {step}", tmp_path, SESSION_END=in_minutes(end_in))
+    assert (result.returncode == 0) is starts
+    assert ("would pass SESSION_END" in result.stdout) is not starts
+
+
+def test_without_session_end_every_step_starts(tmp_path):
+    assert bash("fits 100000", tmp_path).returncode == 0
+
+
+@pytest.fixture
+def checkout(tmp_path):
+    """A stand-in ../main with one commit, and a one-run script that logs where and how it ran."""
+    main = tmp_path / "main"
+    main.mkdir()
+    git = ["git", "-c", "user.name=t", "-c", "user.email=t@t", "-C", str(main)]
+    subprocess.run(["git", "init", "-q", str(main)], check=True)
+    (main / "file").write_text("frozen\n")
+    subprocess.run([*git, "add", "file"], check=True)
+    subprocess.run([*git, "commit", "-q", "-m", "c"], check=True)
+    commit = subprocess.run([*git, "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
+    (main / ".venv").mkdir()
+    (main / "outputs").mkdir()
+    script = tmp_path / "one_run.sh"
+    script.write_text('echo "$PWD $* $(cat file)" >> outputs/calls\nsleep "${NAP:-0}"\n')
+    return main, commit, script
+
+
+def test_a_one_run_script_gets_its_arguments_in_the_frozen_worktree(checkout):
+    main, commit, script = checkout
+    result = bash(f'SCRIPT={script} SEEDS="fixed 100" study dev study-code-dev {commit} 0 -- fixed 100', main)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert (main / "outputs" / "calls").read_text().split() == [
+        str(main.parent / "study-code-dev"),
+        "fixed",
+        "100",
+        "frozen",
+    ]
+    assert (main.parent / "study-code-dev" / "outputs").resolve() == main / "outputs"
+
+
+def test_the_same_run_twice_on_one_core_is_refused(checkout):
+    main, commit, script = checkout
+    step = f'SCRIPT={script} SEEDS="fixed 100" study dev study-code-dev {commit} 0 -- fixed 100'
+    result = bash(f"NAP=3 {step} & sleep 1; {step}; echo second=$?; wait", main)
+    assert "already running on core 0" in result.stdout and "second=1" in result.stdout
+    assert len((main / "outputs" / "calls").read_text().splitlines()) == 1
