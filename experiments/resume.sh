@@ -33,12 +33,16 @@ DEV=$PWD/experiments/pixels-dagger-epochs-dev  # its records/ and, once report.s
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
 worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checkout's .venv and outputs/
-  if [ ! -d "../$1" ]; then
-    git worktree prune
-    git worktree add --detach "../$1" "$2" || return 1
-  fi
-  ln -sf ../main/.venv "../$1/.venv"
-  ln -sfn ../main/outputs "../$1/outputs"
+  # One at a time (both cores' chains may ask for the same new worktree at once; git would refuse one).
+  (
+    flock 9
+    if [ ! -d "../$1" ]; then
+      git worktree prune
+      git worktree add --detach "../$1" "$2" || exit 1
+    fi
+    ln -sf ../main/.venv "../$1/.venv"
+    ln -sfn ../main/outputs "../$1/outputs"
+  ) 9> outputs/.worktree.lock
 }
 
 study() {  # study NAME WORKTREE COMMIT CORE [FOLDER] [-- ARGS]: FOLDER/NAME/run.sh (or $SCRIPT ARGS) there, on CORE

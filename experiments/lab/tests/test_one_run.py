@@ -1,4 +1,4 @@
-"""``pixels-dagger-epochs-dev/one_run.sh``: one of run.sh's runs, with run.sh's options, skipped once saved."""
+"""``pixels-dagger-epochs-dev/one_run.sh``: one of run.sh's runs, its options, skipped once saved."""
 
 from __future__ import annotations
 

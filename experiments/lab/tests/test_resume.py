@@ -77,3 +77,15 @@ def test_the_same_run_twice_on_one_core_is_refused(checkout):
     result = bash(f"NAP=3 {step} & sleep 1; {step}; echo second=$?; wait", main)
     assert "already running on core 0" in result.stdout and "second=1" in result.stdout
     assert len((main / "outputs" / "calls").read_text().splitlines()) == 1
+
+
+def test_both_cores_may_ask_for_the_same_new_worktree_at_once(checkout):
+    main, commit, script = checkout
+    steps = [
+        f'SCRIPT={script} SEEDS="fixed {seed}" study dev study-code-dev {commit} {core} -- fixed {seed}'
+        for core, seed in ((0, 100), (1, 102))
+    ]
+    result = bash(f"{steps[0]} & {steps[1]} & wait", main)
+    assert "cannot make" not in result.stdout, result.stdout + result.stderr
+    calls = sorted((main / "outputs" / "calls").read_text().splitlines())
+    assert [call.split()[2] for call in calls] == ["100", "102"]
