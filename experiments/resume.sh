@@ -16,18 +16,21 @@
 # every session. Complete studies are not in the queue (their records and READMEs hold their results):
 # paper-regime-eval, paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev,
 # plateau-dagger-eval; drawers-preset-dev stopped (its README).
-# Queue (2026-11-29): pixels-dagger-epochs-dev's runs not yet in its records (one_run.sh: a run whose
+# Queue (2026-11-29): pixels-dagger-epochs-dev's runs not yet in its records (its one_run.sh: a run whose
 # records hold phase 5 is skipped), the three fixed runs first (about 1 hour each), then the two epochs
 # runs (about 2.5 hours each): core 0 fixed 100, fixed 101, epochs 101; core 1 fixed 102, epochs 102.
+# Once all 6 are in its records, its report.sh (the reports and table that pixels-matched-eval's gate
+# reads, DEV below). Then pixels-matched-eval one run at a time (its one_run.sh: run.sh's gate first, so
+# nothing runs unless the development study's rule proposes it; about 2.5 hours a run), seed 0 on core 0,
+# seed 1 on core 1, seed 2 split.
 # With SESSION_END set (a UTC time, e.g. SESSION_END=09:50), a run that would not end before it is not
 # started (its estimate below), so a core does not spend the session's end on a run a stop would lose.
-# Then pixels-matched-eval, which runs nothing until pixels-dagger-epochs-dev's rule has decided (its
-# gate) and reads that study from its committed records and report (DEV below; report.sh writes it).
 set -uo pipefail
 
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
 PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-91949d1}  # the commit that added pixels-matched-eval
 ONE_RUN=$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh  # read as it runs: do not edit meanwhile
+MATCHED_RUN=$PWD/experiments/pixels-matched-eval/one_run.sh  # read as it runs: do not edit meanwhile
 DEV=$PWD/experiments/pixels-dagger-epochs-dev  # its records/ and, once report.sh has run, report/
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
@@ -88,14 +91,38 @@ dev_run() {  # dev_run CORE ARM SEED MINUTES: one pixels-dagger-epochs-dev run (
     "$PIXELS_COMMIT" "$1" -- "$2" "$3"
 }
 
+dev_report() {  # pixels-dagger-epochs-dev's reports and table (report.sh), once all 6 runs are in its records
+  local arm seed record
+  for arm in epochs fixed; do
+    for seed in 100 101 102; do
+      record=$DEV/records/$arm/uniform-seed$seed/policies/round-005/training.json
+      grep -qs '"eval"' "$record" || { log "pixels-dagger-epochs-dev: $arm seed $seed not in its records yet"; return 1; }
+    done
+  done
+  log "pixels-dagger-epochs-dev: every run done; report.sh"
+  (flock 9 && bash experiments/pixels-dagger-epochs-dev/report.sh) 9> outputs/.dev-report.lock \
+    >> outputs/pixels-dagger-epochs-dev.log 2>&1
+}
+
+matched_run() {  # matched_run CORE METHOD SEED MINUTES: one pixels-matched-eval run (its one_run.sh) on CORE
+  fits "$4" || return 1
+  OMP_NUM_THREADS=1 DEV=$DEV SCRIPT="$MATCHED_RUN" SEEDS="$2 $3" study pixels-matched-eval \
+    study-code-pixels-matched "$PIXELS_EVAL_COMMIT" "$1" -- "$2" "$3"
+}
+
 if [ "${BASH_SOURCE[0]}" != "$0" ]; then return 0; fi  # sourced (its tests): functions only
 
 mkdir -p outputs
 (dev_run 0 fixed 100 75
   dev_run 0 fixed 101 75
   dev_run 0 epochs 101 160
-  OMP_NUM_THREADS=1 DEV=$DEV SEEDS="0" study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 0) &
+  dev_report
+  for method in uniform need gain; do matched_run 0 "$method" 0 160; done
+  matched_run 0 uniform 2 160
+  matched_run 0 need 2 160) &
 (dev_run 1 fixed 102 75
   dev_run 1 epochs 102 160
-  OMP_NUM_THREADS=1 DEV=$DEV SEEDS="1" study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" 1) &
+  dev_report
+  for method in uniform need gain; do matched_run 1 "$method" 1 160; done
+  matched_run 1 gain 2 160) &
 wait

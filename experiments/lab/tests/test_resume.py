@@ -89,3 +89,24 @@ def test_both_cores_may_ask_for_the_same_new_worktree_at_once(checkout):
     assert "cannot make" not in result.stdout, result.stdout + result.stderr
     calls = sorted((main / "outputs" / "calls").read_text().splitlines())
     assert [call.split()[2] for call in calls] == ["100", "102"]
+
+
+def test_the_development_report_waits_for_all_six_runs(tmp_path):
+    main = tmp_path / "main"
+    study = main / "experiments" / "pixels-dagger-epochs-dev"
+    study.mkdir(parents=True)
+    (main / "outputs").mkdir()
+    (study / "report.sh").write_text("touch outputs/reported\n")
+    runs = [(arm, seed) for arm in ("epochs", "fixed") for seed in (100, 101, 102)]
+    for arm, seed in runs[:-1]:
+        last = study / "records" / arm / f"uniform-seed{seed}" / "policies" / "round-005"
+        last.mkdir(parents=True)
+        (last / "training.json").write_text('{"round": 5, "eval": {}}')
+    result = bash("dev_report", main)
+    assert result.returncode == 1 and "fixed seed 102 not in its records yet" in result.stdout
+    assert not (main / "outputs" / "reported").exists()
+    last = study / "records" / "fixed" / "uniform-seed102" / "policies" / "round-005"
+    last.mkdir(parents=True)
+    (last / "training.json").write_text('{"round": 5, "eval": {}}')
+    assert bash("dev_report", main).returncode == 0
+    assert (main / "outputs" / "reported").exists()
