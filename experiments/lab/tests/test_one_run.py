@@ -53,26 +53,36 @@ def one_run(root: Path, study: Path, *args: str) -> subprocess.CompletedProcess:
     )
 
 
-def test_a_run_whose_records_hold_phase_5_is_skipped(study_copy):
-    root, study = study_copy
-    last = study / "records" / "fixed" / "uniform-seed100" / "policies" / "round-005"
-    last.mkdir(parents=True)
-    (last / "training.json").write_text(json.dumps({"round": 5, "eval": {"success": [0.5]}}))
-    result = one_run(root, study, "fixed", "100")
-    assert result.returncode == 0 and "skipped" in result.stdout
-    assert not (root / "cli-calls").exists()
+def write_phase(study: Path, arm: str, seed: int, phase: int, record: dict) -> None:
+    """A phase's training.json in the study's records, as save_records.sh leaves it."""
+    folder = study / "records" / arm / f"uniform-seed{seed}" / "policies" / f"round-{phase:03d}"
+    folder.mkdir(parents=True)
+    (folder / "training.json").write_text(json.dumps({"round": phase, **record}))
 
 
-def test_an_unfinished_run_is_run_on_its_seed_only(study_copy):
+@pytest.mark.parametrize(
+    ("arm", "seed", "phase", "record", "skipped"),
+    [
+        ("fixed", 100, 5, {"eval": {"success": [0.5]}}, True),
+        ("epochs", 101, 3, {"eval": {"success": [0.5]}}, False),  # unfinished
+        ("fixed", 102, 5, {"steps": 1500}, False),  # cut before its last evaluation
+    ],
+)
+def test_only_a_run_whose_records_hold_an_evaluated_phase_5_is_skipped(
+    study_copy, arm, seed, phase, record, skipped
+):
     root, study = study_copy
-    last = study / "records" / "epochs" / "uniform-seed101" / "policies" / "round-003"
-    last.mkdir(parents=True)
-    (last / "training.json").write_text(json.dumps({"round": 3, "eval": {"success": [0.5]}}))
-    result = one_run(root, study, "epochs", "101")
+    write_phase(study, arm, seed, phase, record)
+    result = one_run(root, study, arm, str(seed))
     assert result.returncode == 0, result.stderr
-    call = (root / "cli-calls").read_text()
-    assert "--seeds=[101]" in call and "--training.steps_rule=epochs" in call
-    assert "--output_dir=outputs/pixels-dagger-epochs-dev/epochs" in call
+    assert ("skipped" in result.stdout) is skipped
+    calls = (root / "cli-calls").read_text() if (root / "cli-calls").exists() else ""
+    assert (calls == "") is skipped
+    if not skipped:
+        assert (
+            f"--seeds=[{seed}]" in calls and f"--output_dir=outputs/pixels-dagger-epochs-dev/{arm}" in calls
+        )
+        assert ("--training.steps_rule=epochs" in calls) is (arm == "epochs")
 
 
 def test_an_unknown_arm_is_refused_by_name(study_copy):
@@ -80,13 +90,3 @@ def test_an_unknown_arm_is_refused_by_name(study_copy):
     result = one_run(root, study, "cosine", "100")
     assert result.returncode == 2 and "ARM must be epochs or fixed" in result.stderr
     assert not (root / "cli-calls").exists()
-
-
-def test_a_run_cut_before_its_last_evaluation_is_run_again(study_copy):
-    root, study = study_copy
-    last = study / "records" / "fixed" / "uniform-seed102" / "policies" / "round-005"
-    last.mkdir(parents=True)
-    (last / "training.json").write_text(json.dumps({"round": 5, "steps": 1500}))
-    result = one_run(root, study, "fixed", "102")
-    assert result.returncode == 0, result.stderr
-    assert "--seeds=[102]" in (root / "cli-calls").read_text()
