@@ -17,14 +17,20 @@
 # paper-regime-eval, paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev,
 # plateau-dagger-eval; drawers-preset-dev stopped (its README).
 # Queue (2026-11-29): pixels-dagger-epochs-dev's runs not yet in its records (its one_run.sh: a run whose
-# records hold phase 5 is skipped), the three fixed runs first (about 1 hour each), then the two epochs
-# runs (about 2.5 hours each): core 0 fixed 100, fixed 101, epochs 101; core 1 fixed 102, epochs 102.
-# Once all 6 are in its records, its report.sh (the reports and table that pixels-matched-eval's gate
-# reads, DEV below). Then pixels-matched-eval one run at a time (its one_run.sh: run.sh's gate first, so
-# nothing runs unless the development study's rule proposes it; about 2.5 hours a run), seed 0 on core 0,
-# seed 1 on core 1, seed 2 split.
+# records hold phase 5 is skipped), the fixed runs first, then the two epochs runs: core 0 fixed 100,
+# fixed 101, epochs 101; core 1 fixed 102, epochs 102. Once all 6 are in its records, its report.sh (the
+# reports and table that pixels-matched-eval's gate reads, DEV below). Then pixels-matched-eval one run at
+# a time (its one_run.sh: run.sh's gate first, so nothing runs unless the development study's rule
+# proposes it; each run as long as an epochs run), seed 0 on core 0, seed 1 on core 1, seed 2 split.
 # With SESSION_END set (a UTC time, e.g. SESSION_END=09:50), a run that would not end before it is not
-# started (its estimate below), so a core does not spend the session's end on a run a stop would lose.
+# started, so a core does not spend the session's end on a run a stop would lose. How long a run takes
+# on one core, beside another pixel run, depends on the machine (FIXED_MIN and EPOCHS_MIN below):
+#   - with AVX-512 (the machine of 2026-11-28): an epochs run took 147 min alone (seed 100's records),
+#     a fixed one about 60 (../pixels-eval);
+#   - with AVX2 only (2026-11-29): a fixed phase took about 23 min (1 500 steps 223-230 s, a 20-episode
+#     evaluation 710-750 s, 1.7x and 1.6x the other machine), so a fixed run takes about 2.3 hours and
+#     an epochs run about 4 (estimated: seed 100's phases at those ratios): it cannot end inside a
+#     session, so such a machine runs the fixed runs only.
 set -uo pipefail
 
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
@@ -32,6 +38,8 @@ PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-91949d1}  # the commit that added pixel
 ONE_RUN=$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh  # read as it runs: do not edit meanwhile
 MATCHED_RUN=$PWD/experiments/pixels-matched-eval/one_run.sh  # read as it runs: do not edit meanwhile
 DEV=$PWD/experiments/pixels-dagger-epochs-dev  # its records/ and, once report.sh has run, report/
+if grep -qw avx512f /proc/cpuinfo; then FIXED_MIN=${FIXED_MIN:-75} EPOCHS_MIN=${EPOCHS_MIN:-165}
+else FIXED_MIN=${FIXED_MIN:-145} EPOCHS_MIN=${EPOCHS_MIN:-250}; fi  # minutes a run takes (above)
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
@@ -113,16 +121,16 @@ matched_run() {  # matched_run CORE METHOD SEED MINUTES: one pixels-matched-eval
 if [ "${BASH_SOURCE[0]}" != "$0" ]; then return 0; fi  # sourced (its tests): functions only
 
 mkdir -p outputs
-(dev_run 0 fixed 100 75
-  dev_run 0 fixed 101 75
-  dev_run 0 epochs 101 160
+(dev_run 0 fixed 100 "$FIXED_MIN"
+  dev_run 0 fixed 101 "$FIXED_MIN"
+  dev_run 0 epochs 101 "$EPOCHS_MIN"
   dev_report
-  for method in uniform need gain; do matched_run 0 "$method" 0 160; done
-  matched_run 0 uniform 2 160
-  matched_run 0 need 2 160) &
-(dev_run 1 fixed 102 75
-  dev_run 1 epochs 102 160
+  for method in uniform need gain; do matched_run 0 "$method" 0 "$EPOCHS_MIN"; done
+  matched_run 0 uniform 2 "$EPOCHS_MIN"
+  matched_run 0 need 2 "$EPOCHS_MIN") &
+(dev_run 1 fixed 102 "$FIXED_MIN"
+  dev_run 1 epochs 102 "$EPOCHS_MIN"
   dev_report
-  for method in uniform need gain; do matched_run 1 "$method" 1 160; done
-  matched_run 1 gain 2 160) &
+  for method in uniform need gain; do matched_run 1 "$method" 1 "$EPOCHS_MIN"; done
+  matched_run 1 gain 2 "$EPOCHS_MIN") &
 wait
