@@ -17,8 +17,9 @@
 # paper-regime-eval, paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev,
 # plateau-dagger-eval; drawers-preset-dev stopped (its README).
 # Queue (2026-11-29): pixels-dagger-epochs-dev's runs not yet in its records (its one_run.sh: a run whose
-# records hold phase 5 is skipped), the fixed runs first, then the two epochs runs: core 0 fixed 100,
-# fixed 101, epochs 101; core 1 fixed 102, epochs 102. Once all 6 are in its records, its report.sh (the
+# records hold phase 5 is skipped), the two epochs runs first (they fit a session only if they start
+# with it), then the fixed runs: core 0 epochs 101, fixed 100, fixed 101; core 1 epochs 102, fixed 102
+# (the session of 2026-11-29 ran fixed 101 and 102). Once all 6 are in its records, its report.sh (the
 # reports and table that pixels-matched-eval's gate reads, DEV below). Then pixels-matched-eval one run at
 # a time (its one_run.sh: run.sh's gate first, so nothing runs unless the development study's rule
 # proposes it; each run as long as an epochs run), seed 0 on core 0, seed 1 on core 1, seed 2 split.
@@ -121,15 +122,15 @@ matched_run() {  # matched_run CORE METHOD SEED MINUTES: one pixels-matched-eval
 if [ "${BASH_SOURCE[0]}" != "$0" ]; then return 0; fi  # sourced (its tests): functions only
 
 mkdir -p outputs
-(dev_run 0 fixed 100 "$FIXED_MIN"
+(dev_run 0 epochs 101 "$EPOCHS_MIN"
+  dev_run 0 fixed 100 "$FIXED_MIN"
   dev_run 0 fixed 101 "$FIXED_MIN"
-  dev_run 0 epochs 101 "$EPOCHS_MIN"
   dev_report
   for method in uniform need gain; do matched_run 0 "$method" 0 "$EPOCHS_MIN"; done
   matched_run 0 uniform 2 "$EPOCHS_MIN"
   matched_run 0 need 2 "$EPOCHS_MIN") &
-(dev_run 1 fixed 102 "$FIXED_MIN"
-  dev_run 1 epochs 102 "$EPOCHS_MIN"
+(dev_run 1 epochs 102 "$EPOCHS_MIN"
+  dev_run 1 fixed 102 "$FIXED_MIN"
   dev_report
   for method in uniform need gain; do matched_run 1 "$method" 1 "$EPOCHS_MIN"; done
   matched_run 1 gain 2 "$EPOCHS_MIN") &
