@@ -6,6 +6,7 @@ import io
 import json
 import os
 import subprocess
+import sys
 import tarfile
 from pathlib import Path
 
@@ -23,7 +24,7 @@ def one_run(tmp_path: Path, dev: Path, *args: str) -> tuple[subprocess.Completed
     environment = {
         **os.environ,
         "CLI": str(cli),
-        "PY": str(Path(os.sys.executable)),
+        "PY": sys.executable,
         "OUT": str(tmp_path / "out"),
         "DEV": str(dev),
         "DEV_BC": str(tmp_path / "bc" / "results.csv"),
