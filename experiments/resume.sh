@@ -7,8 +7,8 @@
 #   mkdir -p outputs && cp experiments/resume.sh outputs/resume-running.sh
 #   nohup bash outputs/resume-running.sh >> outputs/resume.log 2>&1 &
 # To change the queue while studies run: stop the earlier copy's chains (its bash processes, not the
-# studies' run.sh: `pkill -f outputs/resume-running.sh` before copying), then start the new copy; a
-# study still running is waited for, then its core's chain goes on.
+# runs: `pkill -f outputs/resume-running.sh` before copying), then start the new copy; a run still
+# going on a core is refused there by its lock, and that core's chain goes on to its next run.
 #
 # These machines keep no outputs/ between sessions (a new checkout starts without it), so the queue holds
 # only runs still to do, each one short enough to end inside a session, and each saves its records into
@@ -57,31 +57,20 @@ worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checko
   ) 9> outputs/.worktree.lock
 }
 
-study() {  # study NAME WORKTREE COMMIT CORE [FOLDER] [-- ARGS]: FOLDER/NAME/run.sh (or $SCRIPT ARGS) there, on CORE
-  # With SEEDS set (a study that splits its runs over cores: a seed subset, or one run) a second process
-  # for that part on the same core is refused by a lock; otherwise a study that an earlier copy of this
-  # script runs is waited for. Returns the study's status.
-  local name=$1 tree=$2 commit=$3 core=$4 folder=experiments part="" status lock
-  shift 4
-  if [ "$#" -gt 0 ] && [ "$1" != "--" ]; then folder=$1; shift; fi
-  [ "${1:-}" = "--" ] && shift
-  local script=${SCRIPT:-$folder/$name/run.sh}
+study() {  # study NAME WORKTREE COMMIT CORE SCRIPT [ARGS]: SCRIPT ARGS in ../WORKTREE (at COMMIT), on CORE
+  # A second process for the same NAME and ARGS on the same core is refused by a lock. Returns the
+  # script's status.
+  local name=$1 tree=$2 commit=$3 core=$4 script=$5 part status lock
+  shift 5
+  part=" ($*)"
   worktree "$tree" "$commit" || { log "cannot make ../$tree"; return 1; }
-  if [ -n "${SEEDS:-}" ]; then
-    part=" (${SEEDS})"
-    exec {lock}> "outputs/.$name-${SEEDS// /-}-core$core.lock"
-    flock -n "$lock" || { log "$name$part is already running on core $core: stop it first"; exec {lock}>&-; return 1; }
-  elif pgrep -f "$name/run.sh" > /dev/null; then  # started by an earlier copy of this script
-    log "$name is already running (a second process would share its runs): waiting for it to end"
-    while pgrep -f "$name/run.sh" > /dev/null; do sleep 60; done
-    log "$name ended (run by the earlier process)"
-    return 0
-  fi
+  exec {lock}> "outputs/.$name-${*// /-}-core$core.lock"
+  flock -n "$lock" || { log "$name$part is already running on core $core: stop it first"; exec {lock}>&-; return 1; }
   log "$name$part on core $core"
   (cd "../$tree" && PYTHONPATH=$PWD JOBS=1 taskset -c "$core" bash "$script" "$@") \
     >> "outputs/$name.log" 2>&1
   status=$?
-  [ -n "${lock:-}" ] && exec {lock}>&-
+  exec {lock}>&-
   log "$name$part ended with status $status"
   return "$status"
 }
@@ -94,10 +83,9 @@ fits() {  # fits MINUTES: whether a step of about MINUTES ends before SESSION_EN
   [ $((now + 60 * $1)) -le "$end" ] || { log "not started: about $1 min would pass SESSION_END $SESSION_END"; return 1; }
 }
 
-dev_run() {  # dev_run CORE ARM SEED MINUTES: one pixels-dagger-epochs-dev run (one_run.sh) on CORE
+dev_run() {  # dev_run CORE ARM SEED MINUTES: one pixels-dagger-epochs-dev run (its one_run.sh) on CORE
   fits "$4" || return 1
-  OMP_NUM_THREADS=1 SCRIPT="$ONE_RUN" SEEDS="$2 $3" study pixels-dagger-epochs-dev study-code-pixels-epochs \
-    "$PIXELS_COMMIT" "$1" -- "$2" "$3"
+  OMP_NUM_THREADS=1 study pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" "$1" "$ONE_RUN" "$2" "$3"
 }
 
 dev_report() {  # pixels-dagger-epochs-dev's reports and table (report.sh), once all 6 runs are in its records
@@ -115,8 +103,8 @@ dev_report() {  # pixels-dagger-epochs-dev's reports and table (report.sh), once
 
 matched_run() {  # matched_run CORE METHOD SEED MINUTES: one pixels-matched-eval run (its one_run.sh) on CORE
   fits "$4" || return 1
-  OMP_NUM_THREADS=1 DEV=$DEV SCRIPT="$MATCHED_RUN" SEEDS="$2 $3" study pixels-matched-eval \
-    study-code-pixels-matched "$PIXELS_EVAL_COMMIT" "$1" -- "$2" "$3"
+  OMP_NUM_THREADS=1 DEV=$DEV study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" "$1" \
+    "$MATCHED_RUN" "$2" "$3"
 }
 
 if [ "${BASH_SOURCE[0]}" != "$0" ]; then return 0; fi  # sourced (its tests): functions only

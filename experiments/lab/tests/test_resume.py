@@ -60,7 +60,7 @@ def checkout(tmp_path):
 
 def test_a_one_run_script_gets_its_arguments_in_the_frozen_worktree(checkout):
     main, commit, script = checkout
-    result = bash(f'SCRIPT={script} SEEDS="fixed 100" study dev study-code-dev {commit} 0 -- fixed 100', main)
+    result = bash(f"study dev study-code-dev {commit} 0 {script} fixed 100", main)
     assert result.returncode == 0, result.stdout + result.stderr
     assert (main / "outputs" / "calls").read_text().split() == [
         str(main.parent / "study-code-dev"),
@@ -73,7 +73,7 @@ def test_a_one_run_script_gets_its_arguments_in_the_frozen_worktree(checkout):
 
 def test_the_same_run_twice_on_one_core_is_refused(checkout):
     main, commit, script = checkout
-    step = f'SCRIPT={script} SEEDS="fixed 100" study dev study-code-dev {commit} 0 -- fixed 100'
+    step = f"study dev study-code-dev {commit} 0 {script} fixed 100"
     result = bash(f"NAP=3 {step} & sleep 1; {step}; echo second=$?; wait", main)
     assert "already running on core 0" in result.stdout and "second=1" in result.stdout
     assert len((main / "outputs" / "calls").read_text().splitlines()) == 1
@@ -82,7 +82,7 @@ def test_the_same_run_twice_on_one_core_is_refused(checkout):
 def test_both_cores_may_ask_for_the_same_new_worktree_at_once(checkout):
     main, commit, script = checkout
     steps = [
-        f'SCRIPT={script} SEEDS="fixed {seed}" study dev study-code-dev {commit} {core} -- fixed {seed}'
+        f"study dev study-code-dev {commit} {core} {script} fixed {seed}"
         for core, seed in ((0, 100), (1, 102))
     ]
     result = bash(f"{steps[0]} & {steps[1]} & wait", main)
