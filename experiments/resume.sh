@@ -10,35 +10,37 @@
 # runs: `pkill -f outputs/resume-running.sh` before copying), then start the new copy; a run still
 # going on a core is refused there by its lock, and that core's chain goes on to its next run.
 #
-# These machines keep no outputs/ between sessions (a new checkout starts without it), so the queue holds
-# only runs still to do, each one short enough to end inside a session, and each saves its records into
-# the study's records/ (commit them): a study run as one long `compare` would restart from nothing at
-# every session. Complete studies are not in the queue (their records and READMEs hold their results):
-# paper-regime-eval, paper-regime-pertask-dev, paper-regime-training-dev, plateau-dagger-training-dev,
-# plateau-dagger-eval; drawers-preset-dev stopped (its README).
+# A machine may or may not keep outputs/ between sessions: the session of 2026-11-29 06:55 came as a new
+# checkout without it (two cut runs lost), the one of 10:45 found outputs/, .venv and the worktrees as
+# the one before left them. So the queue holds only runs still to do, each saves its records into the
+# study's records/ (commit them) when it ends, and `compare` resumes a cut run from its last committed
+# phase when outputs/ is still there. Complete studies are not in the queue (their records and READMEs
+# hold their results): paper-regime-eval, paper-regime-pertask-dev, paper-regime-training-dev,
+# plateau-dagger-training-dev, plateau-dagger-eval; drawers-preset-dev stopped (its README).
 # Queue (2026-11-29): pixels-dagger-epochs-dev's runs not yet in its records (its one_run.sh: a run whose
-# records hold phase 5 is skipped), the two epochs runs first (they fit a session only if they start
-# with it), then the fixed runs: core 0 epochs 101, fixed 100, fixed 101; core 1 epochs 102, fixed 102
-# (the session of 2026-11-29 ran fixed 101 and 102). Once all 6 are in its records, its report.sh (the
-# reports and table that pixels-matched-eval's gate reads, DEV below). Then pixels-matched-eval one run at
-# a time (its one_run.sh: run.sh's gate first, so nothing runs unless the development study's rule
-# proposes it; each run as long as an epochs run), seed 0 on core 0, seed 1 on core 1, seed 2 split.
-# With SESSION_END set (a UTC time, e.g. SESSION_END=09:50), a run that would not end before it is not
-# started, so a core does not spend the session's end on a run a stop would lose. How long a run takes
-# on one core, beside another pixel run, depends on the machine (FIXED_MIN and EPOCHS_MIN below):
+# records hold phase 5 is skipped): core 0 epochs 101, fixed 100, fixed 101; core 1 epochs 102, fixed
+# 102. Once all 6 are in its records, its report.sh (the reports and table that pixels-matched-eval's
+# gate reads, DEV below). Then pixels-matched-eval one run at a time (its one_run.sh: run.sh's gate
+# first, so nothing runs unless the development study's rule proposes it; each run as long as an epochs
+# run), seed 0 on core 0, seed 1 on core 1, seed 2 split.
+# With SESSION_END set (a UTC time, e.g. SESSION_END=09:50), a run that would not end before it is put
+# off: the chain runs the ones that fit first, then the ones it put off, in order (a stop cuts them;
+# `compare` resumes them if outputs/ is kept, and nothing else would use the core meanwhile). A run is
+# refused while another chain runs it (a lock per run, whatever the core). How long a run takes on one
+# core, beside another pixel run, depends on the machine (FIXED_MIN and EPOCHS_MIN below, for a run
+# from its start):
 #   - with AVX-512 (the machine of 2026-11-28): an epochs run took 147 min alone (seed 100's records),
 #     a fixed one about 60 (../pixels-eval);
 #   - with AVX2 only (2026-11-29): a fixed phase took about 23 min (1 500 steps 223-230 s, a 20-episode
 #     evaluation 710-750 s, 1.7x and 1.6x the other machine), so a fixed run takes about 2.3 hours and
-#     an epochs run about 4 (estimated: seed 100's phases at those ratios): it cannot end inside a
-#     session, so such a machine runs the fixed runs only.
+#     an epochs run about 4 (estimated: seed 100's phases at those ratios): longer than a session.
 set -uo pipefail
 
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
 PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-91949d1}  # the commit that added pixels-matched-eval
-ONE_RUN=$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh  # read as it runs: do not edit meanwhile
-MATCHED_RUN=$PWD/experiments/pixels-matched-eval/one_run.sh  # read as it runs: do not edit meanwhile
-DEV=$PWD/experiments/pixels-dagger-epochs-dev  # its records/ and, once report.sh has run, report/
+ONE_RUN=${ONE_RUN:-$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh}  # read as it runs: do not edit meanwhile
+MATCHED_RUN=${MATCHED_RUN:-$PWD/experiments/pixels-matched-eval/one_run.sh}  # read as it runs: do not edit meanwhile
+DEV=${DEV:-$PWD/experiments/pixels-dagger-epochs-dev}  # its records/ and, once report.sh has run, report/
 if grep -qw avx512f /proc/cpuinfo; then FIXED_MIN=${FIXED_MIN:-75} EPOCHS_MIN=${EPOCHS_MIN:-165}
 else FIXED_MIN=${FIXED_MIN:-145} EPOCHS_MIN=${EPOCHS_MIN:-250}; fi  # minutes a run takes (above)
 
@@ -58,14 +60,14 @@ worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checko
 }
 
 study() {  # study NAME WORKTREE COMMIT CORE SCRIPT [ARGS]: SCRIPT ARGS in ../WORKTREE (at COMMIT), on CORE
-  # A second process for the same NAME and ARGS on the same core is refused by a lock. Returns the
-  # script's status.
+  # A second process for the same NAME and ARGS, on any core, is refused by a lock. Returns the script's
+  # status.
   local name=$1 tree=$2 commit=$3 core=$4 script=$5 part status lock
   shift 5
   part=" ($*)"
   worktree "$tree" "$commit" || { log "cannot make ../$tree"; return 1; }
-  exec {lock}> "outputs/.$name-${*// /-}-core$core.lock"
-  flock -n "$lock" || { log "$name$part is already running on core $core: stop it first"; exec {lock}>&-; return 1; }
+  exec {lock}> "outputs/.$name-${*// /-}.lock"
+  flock -n "$lock" || { log "$name$part is already running: stop it first"; exec {lock}>&-; return 1; }
   log "$name$part on core $core"
   (cd "../$tree" && PYTHONPATH=$PWD JOBS=1 taskset -c "$core" bash "$script" "$@") \
     >> "outputs/$name.log" 2>&1
@@ -80,11 +82,33 @@ fits() {  # fits MINUTES: whether a step of about MINUTES ends before SESSION_EN
   local end now
   end=$(date -u -d "$SESSION_END" +%s) || return 1
   now=$(date -u +%s)
-  [ $((now + 60 * $1)) -le "$end" ] || { log "not started: about $1 min would pass SESSION_END $SESSION_END"; return 1; }
+  [ $((now + 60 * $1)) -le "$end" ] || { log "put off: about $1 min would pass SESSION_END $SESSION_END"; return 1; }
 }
 
-dev_run() {  # dev_run CORE ARM SEED MINUTES: one pixels-dagger-epochs-dev run (its one_run.sh) on CORE
-  fits "$4" || return 1
+PUT_OFF=()  # the steps this chain put off (each chain is a subshell with its own), run by run_put_off
+
+later_if_long() {  # later_if_long MINUTES STEP [ARGS]: false, and STEP ARGS kept for later, if it does not fit
+  fits "$1" && return 0
+  shift
+  PUT_OFF+=("$*")
+  return 1
+}
+
+run_put_off() {  # the steps this chain put off, in their order, now that nothing that fits is left
+  local step
+  for step in "${PUT_OFF[@]}"; do
+    log "starting the step put off: $step (a stop cuts it; compare resumes it if outputs/ is kept)"
+    $step  # split into the function and its arguments (no argument holds a space)
+  done
+  PUT_OFF=()
+}
+
+dev_run() {  # dev_run CORE ARM SEED MINUTES: dev_start, or put off if a run of MINUTES would not fit
+  later_if_long "$4" dev_start "$1" "$2" "$3" || return 1
+  dev_start "$1" "$2" "$3"
+}
+
+dev_start() {  # dev_start CORE ARM SEED: one pixels-dagger-epochs-dev run (its one_run.sh) on CORE
   OMP_NUM_THREADS=1 study pixels-dagger-epochs-dev study-code-pixels-epochs "$PIXELS_COMMIT" "$1" "$ONE_RUN" "$2" "$3"
 }
 
@@ -101,8 +125,12 @@ dev_report() {  # pixels-dagger-epochs-dev's reports and table (report.sh), once
     >> outputs/pixels-dagger-epochs-dev.log 2>&1
 }
 
-matched_run() {  # matched_run CORE METHOD SEED MINUTES: one pixels-matched-eval run (its one_run.sh) on CORE
-  fits "$4" || return 1
+matched_run() {  # matched_run CORE METHOD SEED MINUTES: matched_start, or put off if it would not fit
+  later_if_long "$4" matched_start "$1" "$2" "$3" || return 1
+  matched_start "$1" "$2" "$3"
+}
+
+matched_start() {  # matched_start CORE METHOD SEED: one pixels-matched-eval run (its one_run.sh) on CORE
   OMP_NUM_THREADS=1 DEV=$DEV study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" "$1" \
     "$MATCHED_RUN" "$2" "$3"
 }
@@ -113,13 +141,15 @@ mkdir -p outputs
 (dev_run 0 epochs 101 "$EPOCHS_MIN"
   dev_run 0 fixed 100 "$FIXED_MIN"
   dev_run 0 fixed 101 "$FIXED_MIN"
-  dev_report
+  dev_report || PUT_OFF+=(dev_report)
   for method in uniform need gain; do matched_run 0 "$method" 0 "$EPOCHS_MIN"; done
   matched_run 0 uniform 2 "$EPOCHS_MIN"
-  matched_run 0 need 2 "$EPOCHS_MIN") &
+  matched_run 0 need 2 "$EPOCHS_MIN"
+  run_put_off) &
 (dev_run 1 epochs 102 "$EPOCHS_MIN"
   dev_run 1 fixed 102 "$FIXED_MIN"
-  dev_report
+  dev_report || PUT_OFF+=(dev_report)
   for method in uniform need gain; do matched_run 1 "$method" 1 "$EPOCHS_MIN"; done
-  matched_run 1 gain 2 "$EPOCHS_MIN") &
+  matched_run 1 gain 2 "$EPOCHS_MIN"
+  run_put_off) &
 wait

@@ -1,5 +1,6 @@
-"""``experiments/resume.sh``: a step that would pass the session's end is not started; a one-run script
-gets its arguments, from the study's frozen worktree, once per core."""
+"""``experiments/resume.sh``: a step that would pass the session's end is put off until the steps that
+fit have run; a one-run script gets its arguments, from the study's frozen worktree, and runs once
+whatever the core."""
 
 from __future__ import annotations
 
@@ -71,12 +72,27 @@ def test_a_one_run_script_gets_its_arguments_in_the_frozen_worktree(checkout):
     assert (main.parent / "study-code-dev" / "outputs").resolve() == main / "outputs"
 
 
-def test_the_same_run_twice_on_one_core_is_refused(checkout):
+@pytest.mark.parametrize("second_core", [0, 1])
+def test_the_same_run_twice_is_refused_on_either_core(checkout, second_core):
     main, commit, script = checkout
-    step = f"study dev study-code-dev {commit} 0 {script} fixed 100"
-    result = bash(f"NAP=3 {step} & sleep 1; {step}; echo second=$?; wait", main)
-    assert "already running on core 0" in result.stdout and "second=1" in result.stdout
+    first = f"study dev study-code-dev {commit} 0 {script} fixed 100"
+    second = f"study dev study-code-dev {commit} {second_core} {script} fixed 100"
+    result = bash(f"NAP=3 {first} & sleep 1; {second}; echo second=$?; wait", main)
+    assert "already running" in result.stdout and "second=1" in result.stdout
     assert len((main / "outputs" / "calls").read_text().splitlines()) == 1
+
+
+def test_a_run_that_would_pass_session_end_starts_after_those_that_fit(checkout):
+    if datetime.now(timezone.utc).hour == 22 and datetime.now(timezone.utc).minute >= 50:
+        pytest.skip("SESSION_END is a time of day: too close to midnight UTC to test here")
+    main, commit, script = checkout
+    chain = f"ONE_RUN={script}\ndev_run 0 epochs 101 250; dev_run 0 fixed 100 30; run_put_off"
+    result = bash(chain, main, SESSION_END=in_minutes(60), PIXELS_COMMIT=commit)
+    assert result.returncode == 0, result.stdout + result.stderr
+    calls = (main / "outputs" / "calls").read_text().splitlines()
+    assert [call.split()[1:3] for call in calls] == [["fixed", "100"], ["epochs", "101"]]
+    assert "put off: about 250 min would pass SESSION_END" in result.stdout
+    assert "starting the step put off: dev_start 0 epochs 101" in result.stdout
 
 
 def test_both_cores_may_ask_for_the_same_new_worktree_at_once(checkout):
@@ -110,3 +126,44 @@ def test_the_development_report_waits_for_all_six_runs(tmp_path):
     (last / "training.json").write_text('{"round": 5, "eval": {}}')
     assert bash("dev_report", main).returncode == 0
     assert (main / "outputs" / "reported").exists()
+
+
+def test_the_queue_runs_what_fits_first_then_what_it_put_off_on_each_core(checkout, tmp_path):
+    if datetime.now(timezone.utc).hour == 22 and datetime.now(timezone.utc).minute >= 50:
+        pytest.skip("SESSION_END is a time of day: too close to midnight UTC to test here")
+    main, commit, script = checkout
+    script.write_text('echo "$(grep Cpus_allowed_list /proc/self/status | cut -f2) $*" >> outputs/calls\n')
+    result = subprocess.run(
+        ["bash", str(RESUME)],
+        cwd=main,
+        env={
+            "PATH": "/usr/bin:/bin",
+            "HOME": str(main),
+            "SESSION_END": in_minutes(60),
+            "FIXED_MIN": "30",
+            "EPOCHS_MIN": "500",
+            "PIXELS_COMMIT": commit,
+            "PIXELS_EVAL_COMMIT": commit,
+            "ONE_RUN": str(script),
+            "MATCHED_RUN": str(script),
+            "DEV": str(tmp_path / "no-records-yet"),
+        },
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    calls = (main / "outputs" / "calls").read_text().splitlines()
+    by_core = {core: [call.split(maxsplit=1)[1] for call in calls if call.startswith(core)] for core in "01"}
+    assert by_core["0"] == [
+        "fixed 100",
+        "fixed 101",
+        "epochs 101",
+        "uniform 0",
+        "need 0",
+        "gain 0",
+        "uniform 2",
+        "need 2",
+    ]
+    assert by_core["1"] == ["fixed 102", "epochs 102", "uniform 1", "need 1", "gain 1", "gain 2"]
+    assert result.stdout.count("not in its records yet") == 4  # each core's report: when due, and again
