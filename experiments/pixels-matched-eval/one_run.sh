@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # One run of this study: run.sh's gate, then run.sh's compare for METHOD (uniform, need or gain) on SEED
 # only (the same options, checked by experiments/lab/tests/test_pixels_matched_one_run.py), then the
-# study's records saved (save_records.sh, which keeps the runs an earlier session archived). These
-# machines keep no outputs/ between sessions and a seed's compare of three epochs runs (about 7.5 hours)
-# outlasts a session, so the queue gives one run at a time (about 2.5 hours); a run whose archived
-# records hold its phase 5 with its evaluation is skipped.
+# study's records saved (save_records.sh, which keeps the runs an earlier session archived). A machine
+# may not keep outputs/ between sessions, and a seed's compare of three epochs runs (about 7.5 hours on
+# an AVX-512 machine) outlasts a session, so the queue gives one run at a time (about 2.5 hours there,
+# 4 on an AVX2 one; compare resumes a cut run if outputs/ is kept); a run whose archived records hold
+# its phase 5 with its evaluation is skipped.
 # The gate is run.sh's own (run with no seed: it decides, or reads decision.txt, and runs nothing):
 # nothing runs unless its decision.txt says `run:`. Give the development study's committed records and
 # report as DEV (run.sh's option), as experiments/resume.sh does.
