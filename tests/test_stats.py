@@ -6,7 +6,14 @@ import math
 
 import pytest
 
-from lerobot_mtdagger.studies.stats import correlation, demos_to_reach, mean_interval, paired_difference
+from lerobot_mtdagger.studies.stats import (
+    Interval,
+    correlation,
+    demos_to_reach,
+    format_difference,
+    mean_interval,
+    paired_difference,
+)
 
 
 def test_mean_interval_of_1_2_3():
@@ -22,6 +29,19 @@ def test_one_seed_has_a_mean_and_no_interval():
     interval = mean_interval([0.7])
     assert interval.mean == 0.7 and interval.n == 1
     assert math.isnan(interval.low) and math.isnan(interval.high) and not interval.excludes_zero()
+
+
+@pytest.mark.parametrize(
+    ("interval", "text"),
+    [
+        (Interval(0.012, -0.004, 0.028, 3), "+0.012 [-0.004, +0.028]"),
+        (Interval(0.05, 0.01, 0.09, 3), "+0.050 [+0.010, +0.090] *"),
+        (Interval(-0.05, -0.09, -0.01, 3), "-0.050 [-0.090, -0.010] *"),
+        (Interval(0.7, math.nan, math.nan, 1), "+0.700 (one seed, no interval)"),
+    ],
+)
+def test_a_difference_is_marked_only_where_its_interval_excludes_zero(interval, text):
+    assert format_difference(interval) == text
 
 
 def test_paired_difference_of_four_seeds():

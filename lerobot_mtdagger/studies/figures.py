@@ -31,6 +31,7 @@ from lerobot_mtdagger.studies.stats import (
     Interval,
     correlation,
     demos_to_reach,
+    format_difference,
     mean_interval,
     paired_difference,
 )
@@ -370,14 +371,6 @@ def demos_ratio(
         if a is not None and b is not None:
             ratios.append(a / b)
     return (float(np.mean(ratios)) if ratios else None), len(ratios), len(seeds)
-
-
-def format_difference(interval: Interval) -> str:
-    """``+0.012 [-0.004, +0.028]``, with `` *`` when the interval excludes 0 (one seed: no interval)."""
-    if math.isnan(interval.low):
-        return f"{interval.mean:+.3f} (one seed, no interval)"
-    mark = " *" if interval.excludes_zero() else ""
-    return f"{interval.mean:+.3f} [{interval.low:+.3f}, {interval.high:+.3f}]{mark}"
 
 
 def comparison_pairs(rows: Sequence[Row]) -> list[tuple[str, str]]:

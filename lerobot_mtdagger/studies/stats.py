@@ -43,6 +43,14 @@ class Interval:
         return bool(self.n > 1 and (self.low > 0.0 or self.high < 0.0))
 
 
+def format_difference(interval: Interval) -> str:
+    """``+0.012 [-0.004, +0.028]``, with `` *`` when the interval excludes 0 (one seed: no interval)."""
+    if math.isnan(interval.low):
+        return f"{interval.mean:+.3f} (one seed, no interval)"
+    mark = " *" if interval.excludes_zero() else ""
+    return f"{interval.mean:+.3f} [{interval.low:+.3f}, {interval.high:+.3f}]{mark}"
+
+
 def mean_interval(values: Sequence[float], confidence: float = CONFIDENCE) -> Interval:
     """Mean of ``values`` with a Student-t interval (``mean +- t * s / sqrt(n)``).
 
