@@ -46,6 +46,14 @@ from lerobot.datasets.utils import update_chunk_file_indices
 
 from lerobot_mtdagger.datasets.config_layout import flatten
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
+from lerobot_mtdagger.datasets.layout import (
+    CONFIG_FILE,
+    LOCK_FILE,
+    POLICIES_DIR,
+    ROUNDS_DIR,
+    STAGING_DIR,
+    TRAINING_FILE,
+)
 from lerobot_mtdagger.datasets.ledger import Ledger
 from lerobot_mtdagger.datasets.migrations import migrate_run_config, resume_hint
 from lerobot_mtdagger.datasets.records import (
@@ -62,15 +70,8 @@ from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 logger = logging.getLogger(__name__)
 
-ROUNDS_DIR = "rounds"
-POLICIES_DIR = "policies"
-STAGING_DIR = ".staging"
-TRAINING_FILE = "training.json"
-CONFIG_FILE = "config.json"
 EXPERT_CHECK_FILE = "expert_check.json"
 """The measurement that chose an experiment's tasks (``--expert.min_success``, ``runner/expert_check.py``)."""
-LOCK_FILE = ".lock"
-"""The writer lock of an experiment folder (an OS lock held while a run writes; it holds the pid)."""
 
 
 STATS_FILE = "meta/stats.json"

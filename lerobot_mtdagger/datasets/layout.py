@@ -1,0 +1,15 @@
+"""Names of an experiment folder's files and folders (the layout: ``lerobot_mtdagger.datasets.rounds``).
+
+In a module that imports nothing, so that readers of saved records (``studies.saved_records`` and the
+studies' table scripts) need not import LeRobot and torch, as ``rounds`` does, to know a file's name.
+"""
+
+from __future__ import annotations
+
+ROUNDS_DIR = "rounds"
+POLICIES_DIR = "policies"
+STAGING_DIR = ".staging"
+TRAINING_FILE = "training.json"
+CONFIG_FILE = "config.json"
+LOCK_FILE = ".lock"
+"""The writer lock of an experiment folder (an OS lock held while a run writes; it holds the pid)."""
