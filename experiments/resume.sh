@@ -113,10 +113,17 @@ dev_start() {  # dev_start CORE ARM SEED: one pixels-dagger-epochs-dev run (its 
 }
 
 dev_report() {  # pixels-dagger-epochs-dev's reports and table (report.sh), once all 6 runs are in its records
-  local arm seed record
+  # A run that another chain is running is waited for (its lock), so that the chain that ends first
+  # goes on to pixels-matched-eval, whose gate reads the report, instead of finding it missing.
+  local arm seed record lock
   for arm in epochs fixed; do
     for seed in 100 101 102; do
       record=$DEV/records/$arm/uniform-seed$seed/policies/round-005/training.json
+      lock=outputs/.pixels-dagger-epochs-dev-$arm-$seed.lock
+      if ! grep -qs '"eval"' "$record" && [ -f "$lock" ] && ! flock -n "$lock" true; then
+        log "pixels-dagger-epochs-dev: waiting for $arm seed $seed, which another chain is running"
+        flock "$lock" true
+      fi
       grep -qs '"eval"' "$record" || { log "pixels-dagger-epochs-dev: $arm seed $seed not in its records yet"; return 1; }
     done
   done

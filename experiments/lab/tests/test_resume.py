@@ -167,3 +167,28 @@ def test_the_queue_runs_what_fits_first_then_what_it_put_off_on_each_core(checko
     ]
     assert by_core["1"] == ["fixed 102", "epochs 102", "uniform 1", "need 1", "gain 1", "gain 2"]
     assert result.stdout.count("not in its records yet") == 4  # each core's report: when due, and again
+
+
+def test_the_development_report_waits_for_a_run_another_chain_is_running(tmp_path):
+    main = tmp_path / "main"
+    study = main / "experiments" / "pixels-dagger-epochs-dev"
+    study.mkdir(parents=True)
+    (main / "outputs").mkdir()
+    (study / "report.sh").write_text("touch outputs/reported\n")
+    for arm in ("epochs", "fixed"):
+        for seed in (100, 101, 102):
+            if (arm, seed) == ("epochs", 102):
+                continue
+            last = study / "records" / arm / f"uniform-seed{seed}" / "policies" / "round-005"
+            last.mkdir(parents=True)
+            (last / "training.json").write_text('{"round": 5, "eval": {}}')
+    last = study / "records" / "epochs" / "uniform-seed102" / "policies" / "round-005"
+    (tmp_path / "record.json").write_text('{"round": 5, "eval": {}}')
+    running = f"mkdir -p {last} && sleep 2 && cp {tmp_path / 'record.json'} {last}/training.json"
+    chain = (
+        f"flock outputs/.pixels-dagger-epochs-dev-epochs-102.lock bash -c '{running}' & sleep 0.5; dev_report"
+    )
+    result = bash(chain, main)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "waiting for epochs seed 102, which another chain is running" in result.stdout
+    assert (main / "outputs" / "reported").exists()
