@@ -107,21 +107,28 @@ def test_both_cores_may_ask_for_the_same_new_worktree_at_once(checkout):
     assert [call.split()[2] for call in calls] == ["100", "102"]
 
 
-def test_the_development_report_waits_for_all_six_runs(tmp_path):
+def development_study(tmp_path: Path, missing: tuple[str, int]) -> tuple[Path, Path]:
+    """A stand-in ../main whose development study holds every run's phase 5 but ``missing``'s, and a
+    report.sh that notes it ran; ../main and the record ``missing``'s run would write."""
     main = tmp_path / "main"
     study = main / "experiments" / "pixels-dagger-epochs-dev"
     study.mkdir(parents=True)
     (main / "outputs").mkdir()
     (study / "report.sh").write_text("touch outputs/reported\n")
-    runs = [(arm, seed) for arm in ("epochs", "fixed") for seed in (100, 101, 102)]
-    for arm, seed in runs[:-1]:
-        last = study / "records" / arm / f"uniform-seed{seed}" / "policies" / "round-005"
-        last.mkdir(parents=True)
-        (last / "training.json").write_text('{"round": 5, "eval": {}}')
+    for arm in ("epochs", "fixed"):
+        for seed in (100, 101, 102):
+            last = study / "records" / arm / f"uniform-seed{seed}" / "policies" / "round-005"
+            if (arm, seed) != missing:
+                last.mkdir(parents=True)
+                (last / "training.json").write_text('{"round": 5, "eval": {}}')
+    return main, study / "records" / missing[0] / f"uniform-seed{missing[1]}" / "policies" / "round-005"
+
+
+def test_the_development_report_waits_for_all_six_runs(tmp_path):
+    main, last = development_study(tmp_path, ("fixed", 102))
     result = bash("dev_report", main)
     assert result.returncode == 1 and "fixed seed 102 not in its records yet" in result.stdout
     assert not (main / "outputs" / "reported").exists()
-    last = study / "records" / "fixed" / "uniform-seed102" / "policies" / "round-005"
     last.mkdir(parents=True)
     (last / "training.json").write_text('{"round": 5, "eval": {}}')
     assert bash("dev_report", main).returncode == 0
@@ -170,19 +177,7 @@ def test_the_queue_runs_what_fits_first_then_what_it_put_off_on_each_core(checko
 
 
 def test_the_development_report_waits_for_a_run_another_chain_is_running(tmp_path):
-    main = tmp_path / "main"
-    study = main / "experiments" / "pixels-dagger-epochs-dev"
-    study.mkdir(parents=True)
-    (main / "outputs").mkdir()
-    (study / "report.sh").write_text("touch outputs/reported\n")
-    for arm in ("epochs", "fixed"):
-        for seed in (100, 101, 102):
-            if (arm, seed) == ("epochs", 102):
-                continue
-            last = study / "records" / arm / f"uniform-seed{seed}" / "policies" / "round-005"
-            last.mkdir(parents=True)
-            (last / "training.json").write_text('{"round": 5, "eval": {}}')
-    last = study / "records" / "epochs" / "uniform-seed102" / "policies" / "round-005"
+    main, last = development_study(tmp_path, ("epochs", 102))
     (tmp_path / "record.json").write_text('{"round": 5, "eval": {}}')
     running = f"mkdir -p {last} && sleep 2 && cp {tmp_path / 'record.json'} {last}/training.json"
     chain = (
