@@ -8,7 +8,7 @@
 #   nohup bash outputs/resume-running.sh >> outputs/resume.log 2>&1 &
 # To change the queue while studies run: stop the earlier copy's chains (its bash processes, not the
 # runs: `pkill -f outputs/resume-running.sh` before copying), then start the new copy; a run still
-# going on a core is refused there by its lock, and that core's chain goes on to its next run.
+# going is refused by its lock (on either core), and that chain goes on to its next run.
 #
 # A machine may or may not keep outputs/ between sessions: the session of 2026-11-29 06:55 came as a new
 # checkout without it (two cut runs lost), the one of 10:45 found outputs/, .venv and the worktrees as
