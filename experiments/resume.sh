@@ -59,6 +59,12 @@ worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checko
   ) 9> outputs/.worktree.lock
 }
 
+run_lock() {  # run_lock NAME [ARGS]: the lock file of one run (study holds it while the run goes)
+  local name=$1 IFS=-
+  shift
+  echo "outputs/.$name-$*.lock"  # outputs/.NAME-ARG1-ARG2.lock
+}
+
 study() {  # study NAME WORKTREE COMMIT CORE SCRIPT [ARGS]: SCRIPT ARGS in ../WORKTREE (at COMMIT), on CORE
   # A second process for the same NAME and ARGS, on any core, is refused by a lock. Returns the script's
   # status.
@@ -66,7 +72,7 @@ study() {  # study NAME WORKTREE COMMIT CORE SCRIPT [ARGS]: SCRIPT ARGS in ../WO
   shift 5
   part=" ($*)"
   worktree "$tree" "$commit" || { log "cannot make ../$tree"; return 1; }
-  exec {lock}> "outputs/.$name-${*// /-}.lock"
+  exec {lock}> "$(run_lock "$name" "$@")"
   flock -n "$lock" || { log "$name$part is already running: stop it first"; exec {lock}>&-; return 1; }
   log "$name$part on core $core"
   (cd "../$tree" && PYTHONPATH=$PWD JOBS=1 taskset -c "$core" bash "$script" "$@") \
@@ -119,7 +125,7 @@ dev_report() {  # pixels-dagger-epochs-dev's reports and table (report.sh), once
   for arm in epochs fixed; do
     for seed in 100 101 102; do
       record=$DEV/records/$arm/uniform-seed$seed/policies/round-005/training.json
-      lock=outputs/.pixels-dagger-epochs-dev-$arm-$seed.lock
+      lock=$(run_lock pixels-dagger-epochs-dev "$arm" "$seed")
       if ! grep -qs '"eval"' "$record" && [ -f "$lock" ] && ! flock -n "$lock" true; then
         log "pixels-dagger-epochs-dev: waiting for $arm seed $seed, which another chain is running"
         flock "$lock" true

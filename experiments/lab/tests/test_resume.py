@@ -179,9 +179,15 @@ def test_the_queue_runs_what_fits_first_then_what_it_put_off_on_each_core(checko
 def test_the_development_report_waits_for_a_run_another_chain_is_running(tmp_path):
     main, last = development_study(tmp_path, ("epochs", 102))
     (tmp_path / "record.json").write_text('{"round": 5, "eval": {}}')
-    running = f"mkdir -p {last} && sleep 2 && cp {tmp_path / 'record.json'} {last}/training.json"
+    started = (
+        tmp_path / "started"
+    )  # the stand-in run holds the lock (a loaded machine may be slow to start it)
+    running = (
+        f"touch {started} && mkdir -p {last} && sleep 2 && cp {tmp_path / 'record.json'} {last}/training.json"
+    )
     chain = (
-        f"flock outputs/.pixels-dagger-epochs-dev-epochs-102.lock bash -c '{running}' & sleep 0.5; dev_report"
+        f"flock outputs/.pixels-dagger-epochs-dev-epochs-102.lock bash -c '{running}' & "
+        f"until [ -f {started} ]; do sleep 0.1; done; dev_report"
     )
     result = bash(chain, main)
     assert result.returncode == 0, result.stdout + result.stderr
