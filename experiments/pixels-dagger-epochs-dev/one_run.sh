@@ -2,8 +2,9 @@
 # One run of this study: run.sh's compare for ARM (epochs or fixed) with the same options (checked by
 # experiments/lab/tests/test_one_run.py), on SEED only; then its records are saved into this folder's
 # records/ (save_records.sh). A run whose records already hold its last phase (5) with its evaluation
-# is skipped: these machines keep no outputs/ between sessions, so the queue names the runs still to
-# do, each short enough to end within a session (fixed about 1 hour, epochs about 2.5 hours on a core).
+# is skipped, so the queue names the runs still to do. A machine may or may not keep outputs/ between
+# sessions; where it does, `compare` resumes a run a stop cut from its last committed phase. On one core
+# beside another pixel run: fixed about 1-2 hours, epochs about 2.5 (AVX-512) to 4 (AVX2) hours.
 # From the study's frozen worktree, as experiments/resume.sh starts it:
 #   (cd ../study-code-pixels-epochs && OMP_NUM_THREADS=1 PYTHONPATH=$PWD taskset -c 0 \
 #     bash ../main/experiments/pixels-dagger-epochs-dev/one_run.sh fixed 100)
