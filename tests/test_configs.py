@@ -319,3 +319,23 @@ def test_the_migrations_are_one_ordered_list_of_known_options():
     # A migration's rewrite leaves today's layout as it is.
     grouped = parse("--suite.name=toy").to_dict()
     assert migrate_run_config(grouped) == grouped and migrate_run_config(grouped) is not grouped
+
+
+def test_options_parsed_in_many_threads_at_once_leave_stderr_as_it_was():
+    """``compare``'s pool parses each run's options in its own thread; a parse swaps ``sys.stderr``."""
+    import sys
+    import threading
+
+    before = sys.stderr
+    options = ["--suite.name=toy", "--scheduler.type=need", "--output_dir=/tmp/unused"]
+
+    def parse_many() -> None:
+        for _ in range(30):
+            parsing.parse_options(RunConfig, options, "lerobot-mtdagger run")
+
+    threads = [threading.Thread(target=parse_many) for _ in range(6)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert sys.stderr is before

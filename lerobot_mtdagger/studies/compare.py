@@ -23,6 +23,9 @@ A run started by ``compare`` ends itself within a second of ``compare`` ending (
 ``compare`` that is killed leaves no run writing on into its folder.
 Asked again with more ``--dagger.rounds``, it extends the finished DAgger runs by the new rounds and adds BC
 at the new budgets; the rounds already made are kept as they are.
+The DAgger methods of a seed make the same round 0 and phase 0 (the scheduler acts from round 1), so a
+run that starts after another of its seed has committed them copies them and begins at round 1
+(``studies/round_zero.py``; ``--share_round0=false`` to make each its own).
 """
 
 from __future__ import annotations
@@ -74,6 +77,9 @@ class CompareConfig:
             its env workers).
         ray_gpus_per_run: GPUs each run holds with ``launcher=ray`` (0: none; pass
             ``--policy.device=cuda`` for the runs to use them).
+        share_round0: A DAgger run starts from the round 0 and phase 0 of a run of the same seed that
+            made them, where one has by the time it starts (``studies/round_zero.py``: the scheduler
+            acts from round 1, so they are the same to the bit); false: every run makes its own.
     """
 
     HELP_FOOTER: ClassVar[str] = (
@@ -91,6 +97,7 @@ class CompareConfig:
     ray_address: str | None = None
     ray_cpus_per_run: int = 1
     ray_gpus_per_run: float = 0.0
+    share_round0: bool = True
 
     def __post_init__(self) -> None:
         if self.launcher not in LAUNCHERS:
@@ -311,9 +318,10 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
             compare_config.ray_cpus_per_run,
             compare_config.ray_gpus_per_run,
             compare_config.ray_address,
+            compare_config.share_round0,
         )
     else:
-        pool = RunPool(runs_dir, parallel, threads, workers)
+        pool = RunPool(runs_dir, parallel, threads, workers, compare_config.share_round0)
     folders = pool.run_all(jobs)
     rows = results_rows(folders)
     write_results(rows, compare_config.output_dir, task_names, configs=check_comparable(folders))

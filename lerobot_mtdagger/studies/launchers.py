@@ -111,18 +111,33 @@ def job_command(
     from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
 
     resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []
-    command = [
-        sys.executable,
-        "-m",
-        "lerobot_mtdagger.cli",
-        "run",
+    arguments = run_arguments(job, folder, workers)
+    command = [sys.executable, "-m", "lerobot_mtdagger.cli", "run", *arguments, *resume]
+    return command, {"OMP_NUM_THREADS": str(threads), "MKL_NUM_THREADS": str(threads)}
+
+
+def run_arguments(job: Job, folder: Path, workers: int | None) -> list[str]:
+    """The ``lerobot-mtdagger run`` options of one job in ``folder`` (``--resume`` aside)."""
+    return [
         *job.args,
         f"--output_dir={folder}",
         *([] if workers is None else [f"--rollout.workers={workers}"]),
         "--progress=false",
-        *resume,
     ]
-    return command, {"OMP_NUM_THREADS": str(threads), "MKL_NUM_THREADS": str(threads)}
+
+
+def start_from_shared_round_zero(job: Job, folder: Path, workers: int | None) -> None:
+    """Copies into a job not started yet the round 0 and phase 0 of a run beside it that made the same.
+
+    ``studies/round_zero.py``: DAgger runs of one seed whose options differ only in the scheduler. The
+    job then starts as a resume, at round 1.
+
+    Raises:
+        UserError: On bad run options, or if another process started writing ``folder`` meanwhile.
+    """
+    from lerobot_mtdagger.studies.round_zero import share_round_zero  # LeRobot: loaded only when needed
+
+    share_round_zero(folder, run_arguments(job, folder, workers))
 
 
 class RunPool:
@@ -132,7 +147,9 @@ class RunPool:
     thread) starts no further run and ends the running ones, which the next ``compare`` resumes.
     """
 
-    def __init__(self, runs_dir: Path, parallel: int, threads: int, workers: int | None) -> None:
+    def __init__(
+        self, runs_dir: Path, parallel: int, threads: int, workers: int | None, share_round0: bool = True
+    ) -> None:
         """Prepares the pool; nothing runs before ``run_all``.
 
         Args:
@@ -140,11 +157,14 @@ class RunPool:
             parallel: Runs at once.
             threads: Torch threads per run.
             workers: Env worker processes per run (None: the run options choose).
+            share_round0: Start a DAgger run from the round 0 of a run beside it that made the same
+                one, where there is one when it starts (``start_from_shared_round_zero``).
         """
         self.runs_dir = runs_dir
         self.parallel = parallel
         self.threads = threads
         self.workers = workers
+        self.share_round0 = share_round0
         self._lock = threading.Lock()
         self._live: set[subprocess.Popen] = set()
         self._stopping = False
@@ -184,6 +204,8 @@ class RunPool:
             logger.info("%s: finished, skipped", job.name)
             return folder
         check_not_held(folder, job.name)
+        if self.share_round0 and not self._stopping:
+            start_from_shared_round_zero(job, folder, self.workers)
         command, variables = job_command(job, folder, self.threads, self.workers)
         env = {**os.environ, **variables, PARENT_PID_ENV: str(os.getpid())}
         log_path = self.runs_dir / f"{job.name}.log"
@@ -238,7 +260,9 @@ class RayRunPool:
     running runs end and are resumed by the next ``compare``).
     """
 
-    def __init__(self, runs_dir: Path, cpus: int, gpus: float, address: str | None) -> None:
+    def __init__(
+        self, runs_dir: Path, cpus: int, gpus: float, address: str | None, share_round0: bool = True
+    ) -> None:
         """Joins (or starts) the Ray cluster; nothing runs before ``run_all``.
 
         Args:
@@ -246,11 +270,15 @@ class RayRunPool:
             cpus: CPUs per run (its torch threads and, from 2, its env workers).
             gpus: GPUs per run (0: none; a fraction shares one).
             address: The Ray cluster (None: a local Ray on this machine).
+            share_round0: Start a DAgger run from the round 0 of a run beside it that made the same
+                one (``start_from_shared_round_zero``): with every task submitted at once, only a run
+                that had committed its phase 0 before this ``compare`` can be that run.
 
         Raises:
             UserError: If Ray is missing or there is no cluster at ``address``.
         """
         self.runs_dir = runs_dir
+        self.share_round0 = share_round0
         self.cpus = cpus
         self.gpus = gpus
         self.ray = connect(address)
@@ -276,6 +304,8 @@ class RayRunPool:
             except RunHeldError as error:
                 held.append(error)
                 continue
+            if self.share_round0:
+                start_from_shared_round_zero(job, folder, workers)
             command, variables = job_command(job, folder, self.cpus, workers)
             log_path = str(self.runs_dir / f"{job.name}.log")
             submitted[task.remote(command, variables, log_path)] = job

@@ -16,6 +16,7 @@ import contextlib
 import functools
 import inspect
 import io
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TypeVar
@@ -27,6 +28,10 @@ from draccus.wrappers import docstring as draccus_docstring
 from lerobot_mtdagger.utils.errors import UserError
 
 T = TypeVar("T")
+
+PARSING = threading.Lock()
+"""One parse at a time in a process: a parse swaps ``sys.stderr`` (and a config may narrow its parser),
+which two threads parsing at once (``compare``'s pool) would leave swapped."""
 
 
 @functools.cache
@@ -137,6 +142,7 @@ def parse_options(config_class: type[T], options: Sequence[str], prog: str) -> T
     narrowing = getattr(config_class, "parsing_context", None)
     try:
         with (
+            PARSING,
             contextlib.redirect_stderr(argparse_output),
             narrowing(options) if narrowing is not None else contextlib.nullcontext(),
         ):

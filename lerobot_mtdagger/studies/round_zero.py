@@ -1,0 +1,184 @@
+"""Round 0 shared between the DAgger methods of one seed: ``compare`` copies it instead of redoing it.
+
+In a DAgger run (``runner/dagger.py``), round 0 (``initial_demos`` expert demonstrations per task) and
+phase 0 (the first policy, trained on them and evaluated) come before the scheduler acts: it first
+allocates round 1. Every random draw derives from the seed and the round, so two DAgger runs whose
+options differ only in the scheduler (``--scheduler.type`` and its hyperparameters), in
+``--dagger.rounds`` (no round depends on how many follow it) or in options that never change a result
+make the same round 0 and phase 0, to the bit. ``compare`` runs the first method of a seed in full;
+before it starts another method of that seed, it copies the committed round 0 and phase 0 of a run that
+has them into the new run's folder, and the new run resumes at round 1. On MT10 pixels that is about
+a sixth of a run's time for each method but the first (``docs/benchmarks.md``).
+
+The copy is a run of its own, as if it had made its round 0 itself: its ``config.json`` and its round-0
+record (method, config, scheduler hyperparameters) are its own, the record's notes name the run it was
+copied from, and its ledger lists its own records. The round's data, the policy and the phase's
+training record (losses, evaluation and timings: the seconds the source spent making them) are the
+source's files, hard-linked where the file system allows (committed files are never changed), else
+copied. ``--share_round0=false`` makes every run make its own.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import os
+import shutil
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from lerobot_mtdagger.datasets.layout import CONFIG_FILE, STAGING_DIR
+from lerobot_mtdagger.datasets.records import RECORD_KEY
+from lerobot_mtdagger.datasets.rounds import (
+    EXPERT_CHECK_FILE,
+    INFO_FILE,
+    RECORD_FILE,
+    RESULT_NEUTRAL_OPTIONS,
+    ExperimentDir,
+    fill_added_options,
+    result_options,
+    round_name,
+    write_json_atomic,
+)
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.utils.errors import UserError
+
+logger = logging.getLogger(__name__)
+
+ROUND_ZERO_NEUTRAL_OPTIONS: tuple[str, ...] = (*RESULT_NEUTRAL_OPTIONS, "dagger.rounds")
+"""Options (dotted paths) that cannot change a DAgger run's round 0 or phase 0, besides ``scheduler.*``."""
+
+SCHEDULER_PREFIX = "scheduler."
+
+
+def round_zero_differences(source: Mapping[str, Any], target: Mapping[str, Any]) -> list[str]:
+    """The options by which two run configs (``RunConfig.to_dict``) would make different round-0s.
+
+    Empty when both are DAgger runs whose options differ only in the scheduler, ``dagger.rounds`` and
+    options that never change a result (an option one config predates counts as its default).
+    ``["mode"]`` when either is a BC run: BC's round 0 holds the whole budget.
+    """
+    if source.get("mode") != "dagger" or target.get("mode") != "dagger":
+        return ["mode"]
+    theirs, ours = (
+        {
+            key: value
+            for key, value in result_options(config, ROUND_ZERO_NEUTRAL_OPTIONS).items()
+            if not key.startswith(SCHEDULER_PREFIX)
+        }
+        for config in (source, target)
+    )
+    fill_added_options(theirs, ours, RunConfig.option_defaults())
+    return sorted(key for key in theirs.keys() | ours.keys() if theirs.get(key) != ours.get(key))
+
+
+def round_zero_source(runs_dir: Path, config: RunConfig, exclude: Path) -> Path | None:
+    """A run under ``runs_dir`` (not ``exclude``) whose committed round 0 and phase 0 ``config`` would make.
+
+    The first such folder by name; None if there is none. Folders that are not experiments are passed
+    over, as are runs that have not committed phase 0 yet.
+    """
+    target = config.to_dict()
+    for folder in sorted(path for path in Path(runs_dir).iterdir() if path.is_dir() and path != exclude):
+        experiment = ExperimentDir(folder)
+        if not (folder / CONFIG_FILE).is_file():
+            continue
+        try:
+            stored = experiment.read_config()
+            made = 0 in experiment.committed_phases() and 0 in experiment.committed_rounds()
+        except UserError as error:  # a foreign or damaged folder: not a source
+            logger.debug("%s is not a round-0 source: %s", folder, error)
+            continue
+        if made and not round_zero_differences(stored, target):
+            return folder
+    return None
+
+
+def link_or_copy(source: str, destination: str) -> None:
+    """Hard-links ``source`` at ``destination``, or copies it where the file system cannot link."""
+    try:
+        os.link(source, destination)
+    except OSError:
+        shutil.copy2(source, destination)
+
+
+def copy_round_zero(source: Path, target: Path, config: RunConfig) -> None:
+    """Makes ``target`` a new experiment of ``config`` holding ``source``'s round 0 and phase 0.
+
+    Each is staged and committed by an atomic rename, as a run commits them: a copy cut off half-way
+    leaves a run that resumes by making what is missing itself.
+
+    Raises:
+        UserError: If ``target`` exists and is not empty, or another process is writing it.
+    """
+    origin, experiment = ExperimentDir(source), ExperimentDir(target)
+    check = source / EXPERT_CHECK_FILE
+    extra = {EXPERT_CHECK_FILE: json.loads(check.read_text())} if check.is_file() else None
+    experiment.initialise(config.to_dict(), extra)
+    with experiment.writer_lock():
+        staged_round = experiment.rounds / STAGING_DIR / round_name(0)
+        shutil.copytree(origin.round_root(0), staged_round, copy_function=link_or_copy)
+        write_round_zero_record(staged_round, own_round_zero_record(origin, config, source.name))
+        os.replace(staged_round, experiment.round_root(0))
+        staged_policy = experiment.policies / STAGING_DIR / round_name(0)
+        shutil.copytree(origin.policy_root(0), staged_policy, copy_function=link_or_copy)
+        os.replace(staged_policy, experiment.policy_root(0))
+        experiment.update_ledger()
+
+
+def own_round_zero_record(origin: ExperimentDir, config: RunConfig, source_name: str) -> dict[str, Any]:
+    """``origin``'s round-0 record as the run of ``config`` would have written it, naming its source."""
+    record = origin.read_round_record(0)
+    note = (
+        f"round 0 and phase 0 copied from the run {source_name} (the same seed and options but the "
+        "scheduler, which acts from round 1; its timings are that run's)"
+    )
+    own = dataclasses.replace(
+        record,
+        method=config.method,
+        config=config.to_dict(),
+        temperature=config.scheduler.temperature,
+        n_min=config.scheduler.min_episodes,
+        notes=[*record.notes, note],
+    )
+    return own.to_dict()
+
+
+def write_round_zero_record(round_root: Path, record: dict[str, Any]) -> None:
+    """Writes a round's record and its mirror in ``meta/info.json`` (new files: links stay intact)."""
+    info_path = round_root / INFO_FILE
+    info = json.loads(info_path.read_text())
+    info[RECORD_KEY] = record
+    write_json_atomic(round_root / RECORD_FILE, record)
+    write_json_atomic(info_path, info)
+
+
+def share_round_zero(folder: Path, run_args: Sequence[str]) -> Path | None:
+    """Gives a run not started yet the round 0 and phase 0 of a run beside it that made the same ones.
+
+    Args:
+        folder: The run's folder (its siblings are the other runs of the compare).
+        run_args: The run's ``lerobot-mtdagger run`` options, ``--output_dir`` included.
+
+    Returns:
+        The run it was copied from, or None (a run already started, a BC run, or no such run yet:
+        it makes its own).
+
+    Raises:
+        UserError: On bad run options, or if another process started writing ``folder`` meanwhile.
+    """
+    if ExperimentDir(folder).exists():
+        return None
+    from lerobot_mtdagger.utils.parsing import parse_options
+
+    config = parse_options(RunConfig, run_args, "lerobot-mtdagger run")
+    if config.is_bc or not Path(folder).parent.is_dir():
+        return None
+    source = round_zero_source(Path(folder).parent, config, exclude=Path(folder))
+    if source is None:
+        return None
+    copy_round_zero(source, Path(folder), config)
+    logger.info("%s: round 0 and phase 0 copied from %s (the same by construction)", folder.name, source.name)
+    return source
