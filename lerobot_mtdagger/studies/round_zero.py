@@ -7,8 +7,8 @@ options differ only in the scheduler (``--scheduler.type`` and its hyperparamete
 ``--dagger.rounds`` (no round depends on how many follow it) or in options that never change a result
 make the same round 0 and phase 0, to the bit. ``compare`` runs the first method of a seed in full;
 before it starts another method of that seed, it copies the committed round 0 and phase 0 of a run that
-has them into the new run's folder, and the new run resumes at round 1. On MT10 pixels that is about
-a sixth of a run's time for each method but the first (``docs/benchmarks.md``).
+has them into the new run's folder, and the new run resumes at round 1 (on MT10 pixels, phase 0 was
+7-30% of a run's time: ``docs/benchmarks.md``).
 
 The copy is a run of its own, as if it had made its round 0 itself: its ``config.json`` and its round-0
 record (method, config, scheduler hyperparameters) are its own, the record's notes name the run it was
