@@ -92,8 +92,10 @@ def test_verify_accepts_a_run_with_a_copied_round_zero(runs):
     assert main(["verify", f"--experiment_dir={both / 'need-seed0'}"]) == 0
 
 
-def test_share_round0_false_makes_every_run_its_own(tmp_path):
-    runs = compare(tmp_path / "own", "[uniform,gain]", "--share_round0=false")
+def test_share_round0_false_makes_every_run_its_own(runs, tmp_path):
+    both, _ = runs
+    shutil.copytree(both / "uniform-seed0", tmp_path / "own" / "runs" / "uniform-seed0")  # a source there
+    runs = compare(tmp_path / "own", "[gain]", "--share_round0=false")
     gain = ExperimentDir(runs / "gain-seed0")
     assert not any("copied" in note for note in gain.read_round_record(0).notes)
     theirs, ours = round_zero_files(runs / "uniform-seed0"), round_zero_files(gain.root)
