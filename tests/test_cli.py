@@ -132,7 +132,7 @@ COMMAND_OPTIONS = {
         "--policy.type",
         "--expert.noise",
     ],
-    "compare": ["--methods", "--seeds", "--bc_budgets", "--jobs", "--cores", "--launcher"],
+    "compare": ["--methods", "--seeds", "--bc_budgets", "--jobs", "--cores", "--launcher", "--share_round0"],
     "eval": ["--policy_path", "--suite.name", "--episodes", "--output"],
     "shift": ["--policy_path", "--episodes"],
     "verify": ["--experiment_dir"],

@@ -77,9 +77,10 @@ class CompareConfig:
             its env workers).
         ray_gpus_per_run: GPUs each run holds with ``launcher=ray`` (0: none; pass
             ``--policy.device=cuda`` for the runs to use them).
-        share_round0: A DAgger run starts from the round 0 and phase 0 of a run of the same seed that
-            made them, where one has by the time it starts (``studies/round_zero.py``: the scheduler
-            acts from round 1, so they are the same to the bit); false: every run makes its own.
+        share_round0: A DAgger run copies the round 0 and phase 0 that a run of its seed with the same
+            options but the scheduler committed before it started, and begins at round 1
+            (``studies/round_zero.py``: the scheduler acts from round 1, so they are the same to the
+            bit); false: every run makes its own.
     """
 
     HELP_FOOTER: ClassVar[str] = (
