@@ -29,9 +29,10 @@ from lerobot_mtdagger.utils.errors import UserError
 
 T = TypeVar("T")
 
-PARSING = threading.Lock()
+PARSING = threading.RLock()
 """One parse at a time in a process: a parse swaps ``sys.stderr`` (and a config may narrow its parser),
-which two threads parsing at once (``compare``'s pool) would leave swapped."""
+which two threads parsing at once (``compare``'s pool) would leave swapped. Reentrant: a parse within a
+parse, in the same thread, restores in order."""
 
 
 @functools.cache
