@@ -101,3 +101,17 @@ TINY_ROUND = [
     "--progress=false",
 ]
 """One DAgger round of a tiny ``mtdagger`` policy, in-process envs (add the suite and ``--output_dir``)."""
+
+
+TOY_COMPARE = [
+    "--suite.name=toy",
+    "--dagger.rounds=2",
+    "--dagger.initial_demos=1",
+    "--dagger.budget_per_task=2",
+    "--training.steps_per_round=20",
+    "--rollout.eval_episodes=2",
+    "--policy.batch_size=32",
+    "--policy.state_hidden_dims=[32]",
+    "--policy.head_hidden_dims=[32]",
+]
+"""Run options of a small ``compare`` on the toy suite: two DAgger rounds of a tiny ``mtdagger`` policy."""

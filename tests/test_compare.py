@@ -34,19 +34,9 @@ from lerobot_mtdagger.studies.compare import (
 from lerobot_mtdagger.studies.figures import hardest_tasks, seed_reach
 from lerobot_mtdagger.studies.launchers import Job, RunPool, is_finished
 from lerobot_mtdagger.utils.errors import UserError
-from tests.helpers import child_pids, is_running
+from tests.helpers import TOY_COMPARE, child_pids, is_running
 
-TINY = [
-    "--suite.name=toy",
-    "--dagger.rounds=2",
-    "--dagger.initial_demos=1",
-    "--dagger.budget_per_task=2",
-    "--training.steps_per_round=20",
-    "--rollout.eval_episodes=2",
-    "--policy.batch_size=32",
-    "--policy.state_hidden_dims=[32]",
-    "--policy.head_hidden_dims=[32]",
-]
+TINY = TOY_COMPARE
 FIGURES = [
     "success_vs_demos.png",
     "success_vs_frames.png",

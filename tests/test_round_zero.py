@@ -15,18 +15,9 @@ from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.studies.round_zero import round_zero_differences, round_zero_source
 from lerobot_mtdagger.utils.parsing import parse_options
+from tests.helpers import TOY_COMPARE
 
-TINY = [
-    "--suite.name=toy",
-    "--dagger.rounds=2",
-    "--dagger.initial_demos=1",
-    "--dagger.budget_per_task=2",
-    "--training.steps_per_round=20",
-    "--rollout.eval_episodes=2",
-    "--policy.batch_size=32",
-    "--policy.state_hidden_dims=[32]",
-    "--policy.head_hidden_dims=[32]",
-]
+TINY = TOY_COMPARE
 COPIED_NOTE = "copied from the run uniform-seed0"
 
 
