@@ -37,7 +37,7 @@
 set -uo pipefail
 
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
-PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-a71f863}  # pixels-matched-eval's code: its README, "Round 0 shared"
+PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-897c0d6}  # pixels-matched-eval's code: its README, "Round 0 shared"
 ONE_RUN=${ONE_RUN:-$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh}  # read as it runs: do not edit meanwhile
 MATCHED_RUN=${MATCHED_RUN:-$PWD/experiments/pixels-matched-eval/one_run.sh}  # read as it runs: do not edit meanwhile
 DEV=${DEV:-$PWD/experiments/pixels-dagger-epochs-dev}  # its records/ and, once report.sh has run, report/
