@@ -124,7 +124,8 @@ def test_a_run_without_phase_zero_or_with_other_options_or_foreign_is_no_source(
     cut = tmp_path / "cut"
     shutil.copytree(both / "uniform-seed0", cut / "uniform-seed0")
     shutil.rmtree(cut / "uniform-seed0" / "policies")  # round 0 committed, phase 0 not
-    (cut / "foreign").mkdir()
+    (cut / "foreign" / "policies" / "round-000").mkdir(parents=True)  # a phase 0, as far as names go
+    (cut / "foreign" / "policies" / "round-000" / "training.json").write_text("{}")
     (cut / "foreign" / "config.json").write_text("not json")
     assert round_zero_source(cut, config, exclude=cut / "gain") is None
     other = parse_options(RunConfig, [*TINY, "--policy.lr=0.001", target], "run")

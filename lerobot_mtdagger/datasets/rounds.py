@@ -128,6 +128,18 @@ def write_json_atomic(path: Path, payload: Any) -> None:
     os.replace(tmp, path)
 
 
+def write_record_files(root: Path, record: dict[str, Any]) -> None:
+    """Writes a dataset's record (``meta/mtdagger.json``) and its mirror in ``meta/info.json``.
+
+    Each file is written anew (``write_json_atomic``), so a hard link to the former file is left intact.
+    """
+    info_path = root / INFO_FILE
+    info = json.loads(info_path.read_text())
+    info[RECORD_KEY] = record
+    write_json_atomic(root / RECORD_FILE, record)
+    write_json_atomic(info_path, info)
+
+
 def read_committed_json(path: Path, fix: str) -> Any:
     """Reads a JSON file of a committed round or phase.
 
@@ -542,14 +554,9 @@ class ExperimentDir:
         dataset.finalize()
         staging = Path(dataset.root)
         sort_stats_file(staging)
-        info_path = staging / INFO_FILE
-        info = json.loads(info_path.read_text())
         files = folder_digests(staging, exclude=RECORD_FILES)
-        info[RECORD_KEY] = dataclasses.replace(
-            record, format_version=FORMAT_VERSION, committed=True, files=files
-        ).to_dict()
-        write_json_atomic(staging / RECORD_FILE, info[RECORD_KEY])
-        write_json_atomic(info_path, info)
+        committed = dataclasses.replace(record, format_version=FORMAT_VERSION, committed=True, files=files)
+        write_record_files(staging, committed.to_dict())
         os.replace(staging, final)
         self.update_ledger()
         return final
@@ -800,14 +807,11 @@ def merge_rounds(
             roots=[experiment.round_root(k) for k in rounds],
             aggr_root=staging,
         )
-    info_path = staging / INFO_FILE
-    info = json.loads(info_path.read_text())
-    info[RECORD_KEY] = {
+    merged = {
         "format_version": FORMAT_VERSION,
         "merged_rounds": list(rounds),
         "rounds": [record.to_dict() for record in records],
     }
-    write_json_atomic(staging / RECORD_FILE, info[RECORD_KEY])
-    write_json_atomic(info_path, info)
+    write_record_files(staging, merged)
     os.replace(staging, output)
     return output

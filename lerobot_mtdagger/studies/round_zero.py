@@ -30,17 +30,14 @@ from pathlib import Path
 from typing import Any
 
 from lerobot_mtdagger.datasets.layout import CONFIG_FILE, STAGING_DIR
-from lerobot_mtdagger.datasets.records import RECORD_KEY
 from lerobot_mtdagger.datasets.rounds import (
     EXPERT_CHECK_FILE,
-    INFO_FILE,
-    RECORD_FILE,
     RESULT_NEUTRAL_OPTIONS,
     ExperimentDir,
     fill_added_options,
     result_options,
     round_name,
-    write_json_atomic,
+    write_record_files,
 )
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.utils.errors import UserError
@@ -83,16 +80,14 @@ def round_zero_source(runs_dir: Path, config: RunConfig, exclude: Path) -> Path 
     target = config.to_dict()
     for folder in sorted(path for path in Path(runs_dir).iterdir() if path.is_dir() and path != exclude):
         experiment = ExperimentDir(folder)
-        if not (folder / CONFIG_FILE).is_file():
+        if not (folder / CONFIG_FILE).is_file() or 0 not in experiment.committed_phases():
             continue
         try:
-            stored = experiment.read_config()
-            made = 0 in experiment.committed_phases() and 0 in experiment.committed_rounds()
+            if not round_zero_differences(experiment.read_config(), target):
+                experiment.read_round_record(0)  # committed and readable
+                return folder
         except UserError as error:  # a foreign or damaged folder: not a source
             logger.debug("%s is not a round-0 source: %s", folder, error)
-            continue
-        if made and not round_zero_differences(stored, target):
-            return folder
     return None
 
 
@@ -120,7 +115,7 @@ def copy_round_zero(source: Path, target: Path, config: RunConfig) -> None:
     with experiment.writer_lock():
         staged_round = experiment.rounds / STAGING_DIR / round_name(0)
         shutil.copytree(origin.round_root(0), staged_round, copy_function=link_or_copy)
-        write_round_zero_record(staged_round, own_round_zero_record(origin, config, source.name))
+        write_record_files(staged_round, own_round_zero_record(origin, config, source.name))
         os.replace(staged_round, experiment.round_root(0))
         staged_policy = experiment.policies / STAGING_DIR / round_name(0)
         shutil.copytree(origin.policy_root(0), staged_policy, copy_function=link_or_copy)
@@ -146,15 +141,6 @@ def own_round_zero_record(origin: ExperimentDir, config: RunConfig, source_name:
     return own.to_dict()
 
 
-def write_round_zero_record(round_root: Path, record: dict[str, Any]) -> None:
-    """Writes a round's record and its mirror in ``meta/info.json`` (new files: links stay intact)."""
-    info_path = round_root / INFO_FILE
-    info = json.loads(info_path.read_text())
-    info[RECORD_KEY] = record
-    write_json_atomic(round_root / RECORD_FILE, record)
-    write_json_atomic(info_path, info)
-
-
 def share_round_zero(folder: Path, run_args: Sequence[str]) -> Path | None:
     """Gives a run not started yet the round 0 and phase 0 of a run beside it that made the same ones.
 
@@ -174,11 +160,9 @@ def share_round_zero(folder: Path, run_args: Sequence[str]) -> Path | None:
     from lerobot_mtdagger.utils.parsing import parse_options
 
     config = parse_options(RunConfig, run_args, "lerobot-mtdagger run")
-    if config.is_bc or not Path(folder).parent.is_dir():
-        return None
-    source = round_zero_source(Path(folder).parent, config, exclude=Path(folder))
+    source = None if config.is_bc else round_zero_source(folder.parent, config, exclude=folder)
     if source is None:
         return None
-    copy_round_zero(source, Path(folder), config)
+    copy_round_zero(source, folder, config)
     logger.info("%s: round 0 and phase 0 copied from %s (the same by construction)", folder.name, source.name)
     return source
