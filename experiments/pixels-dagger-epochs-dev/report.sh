@@ -6,4 +6,5 @@ STUDY=experiments/pixels-dagger-epochs-dev
 for ARM in epochs fixed; do
   .venv/bin/lerobot-mtdagger report --records="[$STUDY/records/$ARM]" --output_dir="$STUDY/report/$ARM"
 done
-.venv/bin/python "$STUDY/table.py" > "$STUDY/table.txt"
+# table.py imports experiments/lab
+PYTHONPATH=experiments .venv/bin/python "$STUDY/table.py" > "$STUDY/table.txt"
