@@ -18,11 +18,11 @@
 # hold their results): paper-regime-eval, paper-regime-pertask-dev, paper-regime-training-dev,
 # plateau-dagger-training-dev, plateau-dagger-eval; drawers-preset-dev stopped (its README).
 # Queue (2026-11-29): pixels-dagger-epochs-dev's runs not yet in its records (its one_run.sh: a run whose
-# records hold phase 5 is skipped): core 0 epochs 101, fixed 100, fixed 101; core 1 epochs 102, fixed
-# 102. Once all 6 are in its records, its report.sh (the reports and table that pixels-matched-eval's
-# gate reads, DEV below). Then pixels-matched-eval one run at a time (its one_run.sh: run.sh's gate
-# first, so nothing runs unless the development study's rule proposes it; each run as long as an epochs
-# run), seed 0 on core 0, seed 1 on core 1, seed 2 split.
+# records hold phase 5 is skipped; all 6 are in since 2026-11-29 19:55). Once all 6 are in its records,
+# its report.sh (the reports and table that pixels-matched-eval's gate reads, DEV below). Then
+# pixels-matched-eval one run at a time (its one_run.sh: run.sh's gate first; it runs because its
+# gate-deviation.md says why, though the development rule proposed no rerun; each run as long as an
+# epochs run), seed 0 on core 0, seed 1 on core 1, seed 2 split.
 # With SESSION_END set (a UTC time, e.g. SESSION_END=09:50), a run that would not end before it is put
 # off: the chain runs the ones that fit first, then the ones it put off, in order (a stop cuts them;
 # `compare` resumes them if outputs/ is kept, and nothing else would use the core meanwhile). A run is

@@ -7,7 +7,9 @@
 # 4 on an AVX2 one; compare resumes a cut run if outputs/ is kept); a run whose archived records hold
 # its phase 5 with its evaluation is skipped.
 # The gate is run.sh's own (run with no seed: it decides, or reads decision.txt, and runs nothing):
-# nothing runs unless its decision.txt says `run:`. Give the development study's committed records and
+# nothing runs unless its decision.txt says `run:`, or says the switch with the rerun not proposed while
+# gate-deviation.md (OVERRIDE) exists: that file says why the study runs then (decided after the
+# development study's result, before any run of this study). Give the development study's committed records and
 # report as DEV (run.sh's option), as experiments/resume.sh does.
 # From the study's frozen worktree, as experiments/resume.sh starts it:
 #   (cd ../study-code-pixels-matched && OMP_NUM_THREADS=1 PYTHONPATH=$PWD DEV=../main/experiments/pixels-dagger-epochs-dev \
@@ -22,6 +24,7 @@ PY=${PY:-.venv/bin/python}
 OUT=${OUT:-outputs/pixels-matched-eval}
 RECORDS=${RECORDS:-$HERE/records}
 SAVE=${SAVE:-bash experiments/pixels-matched-eval/save_records.sh}
+OVERRIDE=${OVERRIDE:-$HERE/gate-deviation.md}  # why the study runs though the gate proposes no rerun
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 case "$METHOD" in
   uniform | need | gain) ;;
@@ -37,6 +40,9 @@ SEEDS=" " bash experiments/pixels-matched-eval/run.sh  # the gate only (no seed 
 gate=$(PYTHONPATH=experiments:${PYTHONPATH:-} "$PY" experiments/pixels-matched-eval/table.py --gate "$OUT/decision.txt")
 case "$gate" in
   run:*) ;;
+  "not run:"*"a pixels-eval rerun is not proposed"*)  # the switch, the rerun not proposed: the deviation
+    [ -f "$OVERRIDE" ] || { log "$RUN not run: $gate"; exit 0; }
+    log "$RUN runs despite the gate's answer ($gate), as $OVERRIDE says why" ;;
   *) log "$RUN not run: $gate"; exit 0 ;;
 esac
 log "$RUN with 10 passes per phase"

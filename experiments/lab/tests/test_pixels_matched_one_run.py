@@ -14,8 +14,14 @@ import pytest
 from test_pixels_matched_eval import ROOT, STUDY, compare_call, write_dev
 
 
-def one_run(tmp_path: Path, dev: Path, *args: str) -> tuple[subprocess.CompletedProcess, list[str]]:
-    """one_run.sh with a stand-in CLI and save step that note their calls; the result and the calls."""
+def one_run(
+    tmp_path: Path, dev: Path, *args: str, override: Path | None = None
+) -> tuple[subprocess.CompletedProcess, list[str]]:
+    """one_run.sh with a stand-in CLI and save step that note their calls; the result and the calls.
+
+    ``override`` is the deviation file it reads (default: one that does not exist, so that the
+    committed ``gate-deviation.md`` does not act on the stand-in gates).
+    """
     calls = tmp_path / "calls.txt"
     calls.unlink(missing_ok=True)
     cli = tmp_path / "cli.sh"
@@ -30,6 +36,7 @@ def one_run(tmp_path: Path, dev: Path, *args: str) -> tuple[subprocess.Completed
         "DEV_BC": str(tmp_path / "bc" / "results.csv"),
         "RECORDS": str(tmp_path / "records"),
         "SAVE": f"touch {tmp_path / 'saved'}",
+        "OVERRIDE": str(override or tmp_path / "no-deviation.md"),
     }
     result = subprocess.run(
         ["bash", str(STUDY / "one_run.sh"), *args], capture_output=True, text=True, cwd=ROOT, env=environment
@@ -50,6 +57,35 @@ def test_a_negative_gate_runs_nothing(tmp_path):
     assert result.returncode == 0, result.stderr
     assert calls == [] and not (tmp_path / "saved").exists()
     assert "gain-seed0 not run: not run: matched training did not help" in result.stdout
+
+
+def test_the_deviation_runs_only_the_switch_whose_rerun_was_not_proposed(tmp_path):
+    deviation = tmp_path / "gate-deviation.md"
+    deviation.write_text("why\n")
+    dev = write_dev(tmp_path, 0.7, 0.6)  # +0.100 over fixed, -0.100 to BC: the switch, no rerun proposed
+    result, calls = one_run(tmp_path, dev, "need", "1")
+    assert result.returncode == 0 and calls == [], result.stderr
+    assert "need-seed1 not run: not run: matched training did not help" in result.stdout
+    result, calls = one_run(tmp_path, dev, "need", "1", override=deviation)
+    assert result.returncode == 0, result.stderr
+    assert calls == [compare_call(1, tmp_path / "out").replace("[uniform,need,gain]", "[need]")]
+    assert "runs despite the gate's answer" in result.stdout and str(deviation) in result.stdout
+    assert "a pixels-eval rerun is not proposed" in (tmp_path / "out" / "decision.txt").read_text()
+
+
+def test_the_deviation_does_not_run_a_preset_that_stays_fixed(tmp_path):
+    deviation = tmp_path / "gate-deviation.md"
+    deviation.write_text("why\n")
+    result, calls = one_run(tmp_path, write_dev(tmp_path, 0.7, 0.7), "gain", "0", override=deviation)
+    assert result.returncode == 0 and calls == [], result.stderr
+    assert "gain-seed0 not run: not run: matched training did not help" in result.stdout
+
+
+def test_the_deviation_does_not_run_before_a_final_decision(tmp_path):
+    deviation = tmp_path / "gate-deviation.md"
+    deviation.write_text("why\n")
+    result, calls = one_run(tmp_path, tmp_path / "no-runs-yet", "uniform", "2", override=deviation)
+    assert result.returncode == 1 and calls == []
 
 
 def test_no_decision_yet_refuses(tmp_path):
