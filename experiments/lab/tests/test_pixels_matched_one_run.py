@@ -59,9 +59,15 @@ def test_a_negative_gate_runs_nothing(tmp_path):
     assert "gain-seed0 not run: not run: matched training did not help" in result.stdout
 
 
-def test_the_deviation_runs_only_the_switch_whose_rerun_was_not_proposed(tmp_path):
-    deviation = tmp_path / "gate-deviation.md"
-    deviation.write_text("why\n")
+@pytest.fixture
+def deviation(tmp_path: Path) -> Path:
+    """A stand-in for gate-deviation.md (one_run.sh reads only that it exists)."""
+    path = tmp_path / "gate-deviation.md"
+    path.write_text("why\n")
+    return path
+
+
+def test_the_deviation_runs_only_the_switch_whose_rerun_was_not_proposed(tmp_path, deviation):
     dev = write_dev(tmp_path, 0.7, 0.6)  # +0.100 over fixed, -0.100 to BC: the switch, no rerun proposed
     result, calls = one_run(tmp_path, dev, "need", "1")
     assert result.returncode == 0 and calls == [], result.stderr
@@ -73,17 +79,13 @@ def test_the_deviation_runs_only_the_switch_whose_rerun_was_not_proposed(tmp_pat
     assert "a pixels-eval rerun is not proposed" in (tmp_path / "out" / "decision.txt").read_text()
 
 
-def test_the_deviation_does_not_run_a_preset_that_stays_fixed(tmp_path):
-    deviation = tmp_path / "gate-deviation.md"
-    deviation.write_text("why\n")
+def test_the_deviation_does_not_run_a_preset_that_stays_fixed(tmp_path, deviation):
     result, calls = one_run(tmp_path, write_dev(tmp_path, 0.7, 0.7), "gain", "0", override=deviation)
     assert result.returncode == 0 and calls == [], result.stderr
     assert "gain-seed0 not run: not run: matched training did not help" in result.stdout
 
 
-def test_the_deviation_does_not_run_before_a_final_decision(tmp_path):
-    deviation = tmp_path / "gate-deviation.md"
-    deviation.write_text("why\n")
+def test_the_deviation_does_not_run_before_a_final_decision(tmp_path, deviation):
     result, calls = one_run(tmp_path, tmp_path / "no-runs-yet", "uniform", "2", override=deviation)
     assert result.returncode == 1 and calls == []
 
