@@ -46,6 +46,8 @@ def another_value(path: str, value):
         return "rgb" if value != "rgb" else "state"
     if path == "training.sampling":
         return "balanced" if value != "balanced" else "uniform"
+    if path == "training.steps_rule":
+        return "epochs" if value != "epochs" else "fixed"
     if isinstance(value, float):
         return value * 3
     return value + 2
@@ -81,7 +83,7 @@ def test_a_command_line_value_wins_over_the_preset(index):
 
 @pytest.mark.parametrize("preset", list(PRESETS))
 def test_every_preset_option_set_at_once_wins(preset):
-    wanted = {path: another_value(path, value) for path, value in PRESETS[preset].items()}
+    wanted = {path: another_value(path, value) for path, value in preset_values(preset).items()}
     config = parse(f"--preset={preset}", *(f"--{path}={value}" for path, value in wanted.items()))
     assert {path: value_of(config, path) for path in PRESET_FIELDS} == wanted
 

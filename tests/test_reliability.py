@@ -586,6 +586,7 @@ def test_a_pixel_run_made_before_balanced_sampling_is_told_to_add_uniform(finish
     message = str(info.value)
     assert "training.sampling: 'uniform' -> 'balanced'" in message, message
     assert "used --training.sampling=uniform: add it" in message and "-paper" not in message, message
+    uniform = TrainingConfig(sampling="uniform")  # a new one: a RunConfig fills the one it is given
     bc_before = RunConfig(preset="metaworld-pixels", mode="bc", training=uniform, output_dir=older_root)
     (older_root / "config.json").write_text(json.dumps(bc_before.to_dict()))
     experiment.check_resumable(bc_before.to_dict())
@@ -596,3 +597,45 @@ def test_a_pixel_run_made_before_balanced_sampling_is_told_to_add_uniform(finish
     (older_root / "config.json").write_text(json.dumps(paper_values | {"preset": "metaworld-pixels"}))
     with pytest.raises(UserError, match=r"resume it with that preset\)"):
         experiment.check_resumable(today)
+
+
+def test_a_pixel_run_made_before_ten_passes_is_told_to_add_fixed_steps(finished, tmp_path):
+    """``metaworld-pixels``' DAgger phases make 10 passes since 2026-11-29; its BC keeps fixed steps."""
+    older_root = tmp_path / "older-pixels"
+    shutil.copytree(finished, older_root)
+    fixed = {"steps_rule": "fixed", "epochs": 100.0}
+    before = RunConfig(preset="metaworld-pixels", training=TrainingConfig(**fixed), output_dir=older_root)
+    (older_root / "config.json").write_text(json.dumps(before.to_dict()))
+    experiment = ExperimentDir(older_root)
+    experiment.check_resumable(before.to_dict())
+    today = RunConfig(preset="metaworld-pixels", output_dir=older_root).to_dict()
+    assert today["training"]["steps_rule"] == "epochs" and today["training"]["epochs"] == 10.0
+    with pytest.raises(UserError) as info:
+        experiment.check_resumable(today)
+    message = str(info.value)
+    assert "training.steps_rule: 'fixed' -> 'epochs'" in message, message
+    named = "used --training.epochs=100.0 --training.steps_rule=fixed: add it"
+    assert f"before 2026-11-29 with --preset=metaworld-pixels {named}" in message, message
+    bc = RunConfig(preset="metaworld-pixels", mode="bc", output_dir=older_root)
+    assert (bc.training.steps_rule, bc.training.epochs) == ("fixed", 100.0)
+    (older_root / "config.json").write_text(json.dumps(bc.to_dict()))
+    experiment.check_resumable(bc.to_dict())  # BC's training did not change
+    oldest = TrainingConfig(sampling="uniform", **fixed)
+    (older_root / "config.json").write_text(
+        json.dumps(RunConfig(preset="metaworld-pixels", training=oldest, output_dir=older_root).to_dict())
+    )
+    with pytest.raises(UserError) as info:
+        experiment.check_resumable(today)
+    message = str(info.value)
+    assert "before 2026-11-27 with --preset=metaworld-pixels used --" in message, message
+    for option in ("--training.sampling=uniform", "--training.steps_rule=fixed", "--training.epochs=100.0"):
+        assert option in message, message
+
+
+def test_the_pixels_preset_trains_dagger_ten_passes_and_bc_its_fixed_steps():
+    dagger = RunConfig(preset="metaworld-pixels")
+    assert dagger.phase_steps(6400) == 1000 and dagger.phase_steps(6401) == 1001  # 10 passes, batch 64
+    bc = RunConfig(preset="metaworld-pixels", mode="bc")
+    assert bc.phase_steps(6400) == bc.phase_steps(55_000) == 1500 * (5 + 1)
+    stated = RunConfig(preset="metaworld-pixels", training=TrainingConfig(steps_rule="fixed"))
+    assert stated.phase_steps(55_000) == 1500

@@ -253,6 +253,13 @@ def short(name: str) -> str:
     return re.sub(r"-v\d+$", "", name)
 
 
+def preset_bc_values() -> dict[str, Any]:
+    """What today's preset fills in a BC run (a value keyed by run mode: its ``bc`` value)."""
+    return {
+        key: value["bc"] if isinstance(value, Mapping) else value for key, value in PRESETS[PRESET].items()
+    }
+
+
 def run_defaults() -> dict[str, Any]:
     """Every option of a run at its default value (an option added since pixels-eval ran keeps it)."""
     return flatten(dataclasses.asdict(RunConfig()))
@@ -272,7 +279,8 @@ def bc_reuse_check(earlier: Runs, study: Runs) -> list[str]:
     """Why pixels-eval's BC can stand as this study's BC, checked on the stored configs; problems named.
 
     BC's training is unchanged when every BC run of pixels-eval stored the same options, sampled
-    ``balanced`` with the fixed steps rule, today's preset still fills the values they stored, and
+    ``balanced`` with the fixed steps rule, today's preset still fills the values they stored in a BC
+    run (its DAgger phases make 10 passes since the development study; its BC keeps fixed steps), and
     every run of this study stored them too but for the matched training (options added since
     pixels-eval ran at their defaults).
 
@@ -295,8 +303,8 @@ def bc_reuse_check(earlier: Runs, study: Runs) -> list[str]:
         if reference.get(key) != value
     ]
     problems += [
-        f"today's {PRESET} preset fills {key}={value!r}, BC's runs stored {reference.get(key)!r}"
-        for key, value in PRESETS[PRESET].items()
+        f"today's {PRESET} preset fills {key}={value!r} for BC, BC's runs stored {reference.get(key)!r}"
+        for key, value in preset_bc_values().items()
         if key not in FROM_COMMAND_LINE and reference.get(key) != value
     ]
     defaults = run_defaults()

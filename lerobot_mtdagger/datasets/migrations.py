@@ -94,8 +94,13 @@ RESCALED_PRESETS: dict[str, str] = {
 """Presets whose values were scaled to a 2-core CPU -> the preset that keeps the former values. A
 stored config holds the values themselves, so only resuming is affected."""
 
-BALANCED_PIXELS_VALUES: dict[str, Any] = {"training.sampling": "uniform"}
-"""What ``metaworld-pixels`` runs sampled before the preset chose ``balanced``."""
+PIXELS_FORMER_VALUES: tuple[tuple[str, dict[str, Any]], ...] = (
+    ("2026-11-27", {"training.sampling": "uniform"}),
+    ("2026-11-29", {"training.steps_rule": "fixed", "training.epochs": 100.0}),
+)
+"""``metaworld-pixels``' later values, by the date they changed -> what runs made before had: the
+preset samples ``balanced`` since 2026-11-27 (DAgger runs since 2026-11-26), and its DAgger phases
+make 10 passes (``epochs``) since 2026-11-29."""
 
 
 def is_flat(config: Mapping[str, Any]) -> bool:
@@ -143,16 +148,22 @@ def rescaled_preset_hint(
     )
 
 
-def balanced_pixels_hint(
+def pixels_preset_hint(
     stored_config: Mapping[str, Any], differing: Sequence[str], stored: Mapping[str, Any]
 ) -> str:
-    """Names ``--training.sampling=uniform`` for a ``metaworld-pixels`` run made before balanced."""
+    """Names the options that keep a ``metaworld-pixels`` run made before the preset changed them.
+
+    The date named is that of the earliest change among the differing options (a run that sampled
+    uniform was made before 2026-11-27, and so before 2026-11-29 too).
+    """
     if stored_config.get("preset") != "metaworld-pixels" or not differing:
         return ""
-    if not set(differing) <= set(BALANCED_PIXELS_VALUES):
+    former = {key: value for _, values in PIXELS_FORMER_VALUES for key, value in values.items()}
+    if not set(differing) <= set(former):
         return ""
-    options = " ".join(f"--{key}={BALANCED_PIXELS_VALUES[key]}" for key in differing)
-    return f" (a run made before 2026-11-27 with --preset=metaworld-pixels used {options}: add it)"
+    since = min(date for date, values in PIXELS_FORMER_VALUES if set(values) & set(differing))
+    options = " ".join(f"--{key}={former[key]}" for key in differing)
+    return f" (a run made before {since} with --preset=metaworld-pixels used {options}: add it)"
 
 
 MIGRATIONS: tuple[Migration, ...] = (
@@ -185,7 +196,17 @@ MIGRATIONS: tuple[Migration, ...] = (
         name="balanced-pixels",
         since="2026-11-27",
         summary="metaworld-pixels samples balanced (DAgger runs, then BC runs); before: uniform.",
-        resume_hint=balanced_pixels_hint,
+        resume_hint=pixels_preset_hint,
+    ),
+    Migration(
+        name="pixels-epochs",
+        since="2026-11-29",
+        summary=(
+            "Presets fill --training.steps_rule and --training.epochs; metaworld-pixels' DAgger phases "
+            "make 10 passes (epochs) where they took fixed steps; runs stored without them: fixed, 100."
+        ),
+        former_values={"training.steps_rule": "fixed", "training.epochs": 100.0},
+        resume_hint=pixels_preset_hint,
     ),
 )
 """Every change to what stored runs hold or mean, oldest first."""

@@ -121,7 +121,7 @@ class RunConfig:
             if not hasattr(owner, name):  # policy.lr: a LeRobot student's is its optimizer_lr
                 continue
             if getattr(owner, name) is None:
-                setattr(owner, name, value)
+                setattr(owner, name, value[self.mode] if isinstance(value, Mapping) else value)
         if self.output_dir is None:
             self.output_dir = Path("outputs") / "mtdagger" / f"{self.preset}-{self.method}-seed{self.seed}"
         self.suite.fill_defaults()

@@ -295,8 +295,10 @@ class TrainingConfig:
             over the phase's training frames, at least one step) or ``plateau`` (until the loss on
             held-out episodes stops improving, at most ``plateau_max_steps``; the weights of its
             minimum are kept). ``plateau`` holds ``heldout_fraction`` of each task's episodes out of
-            training, BC's and DAgger's alike.
-        epochs: Passes over the training frames per phase when ``steps_rule=epochs``.
+            training, BC's and DAgger's alike. None: from the preset (``fixed`` except
+            ``metaworld-pixels``: ``epochs``).
+        epochs: Passes over the training frames per phase when ``steps_rule=epochs``; None: from the
+            preset (100 except ``metaworld-pixels``: 10).
         plateau_every: Steps between two held-out loss measurements when ``steps_rule=plateau``.
         plateau_patience: Measurements without a new minimum that end a ``plateau`` phase.
         plateau_max_steps: Most steps of a ``plateau`` phase.
@@ -318,8 +320,8 @@ class TrainingConfig:
 
     steps_per_round: int | None = None
     warm_start: bool = True
-    steps_rule: str = "fixed"
-    epochs: float = 100.0
+    steps_rule: str | None = None
+    epochs: float | None = None
     plateau_every: int = 200
     plateau_patience: int = 5
     plateau_max_steps: int = 20_000
