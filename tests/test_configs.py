@@ -315,7 +315,12 @@ def test_the_migrations_are_one_ordered_list_of_known_options():
     assert len({m.name for m in MIGRATIONS}) == len(MIGRATIONS)
     today = flatten(parse("--suite.name=toy").to_dict())
     former = former_option_values()
-    assert former == {"suite.placement": "narrow", "training.sampling": "uniform"}
+    assert former == {
+        "suite.placement": "narrow",
+        "training.sampling": "uniform",
+        "training.steps_rule": "fixed",
+        "training.epochs": 100.0,
+    }
     assert set(former) <= set(today)
     assert {path: RunConfig.option_defaults()[path] for path in former} == former
     # A migration's rewrite leaves today's layout as it is.
