@@ -22,7 +22,9 @@
 # its report.sh (the reports and table that pixels-matched-eval's gate reads, DEV below). Then
 # pixels-matched-eval one run at a time (its one_run.sh: run.sh's gate first; it runs because its
 # gate-deviation.md says why, though the development rule proposed no rerun; each run as long as an
-# epochs run), seed 0 on core 0, seed 1 on core 1, seed 2 split.
+# epochs run), seed 0 on core 0, seed 1 on core 1, seed 2 split. Nine runs on two cores leave one core
+# idle for the last run: when every other run of the study is in its records, that run gets both cores
+# (2 torch threads, as pixels-dagger-epochs-dev's seed 102 had; threads change floating-point sums only).
 # With SESSION_END set (a UTC time, e.g. SESSION_END=09:50), a run that would not end before it is put
 # off: the chain runs the ones that fit first, then the ones it put off, in order (a stop cuts them;
 # `compare` resumes them if outputs/ is kept, and nothing else would use the core meanwhile). A run is
@@ -41,6 +43,7 @@ PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-897c0d6}  # pixels-matched-eval's code:
 ONE_RUN=${ONE_RUN:-$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh}  # read as it runs: do not edit meanwhile
 MATCHED_RUN=${MATCHED_RUN:-$PWD/experiments/pixels-matched-eval/one_run.sh}  # read as it runs: do not edit meanwhile
 DEV=${DEV:-$PWD/experiments/pixels-dagger-epochs-dev}  # its records/ and, once report.sh has run, report/
+MATCHED_RECORDS=${MATCHED_RECORDS:-$PWD/experiments/pixels-matched-eval/records}  # seed*/runs-records.tar.gz
 if grep -qw avx512f /proc/cpuinfo; then FIXED_MIN=${FIXED_MIN:-75} EPOCHS_MIN=${EPOCHS_MIN:-165}
 else FIXED_MIN=${FIXED_MIN:-145} EPOCHS_MIN=${EPOCHS_MIN:-250}; fi  # minutes a run takes (above)
 
@@ -84,10 +87,12 @@ study() {  # study NAME WORKTREE COMMIT CORE SCRIPT [ARGS]: SCRIPT ARGS in ../WO
 }
 
 fits() {  # fits MINUTES: whether a step of about MINUTES ends before SESSION_END (always, unset)
+  # SESSION_END is a time of day: more than 12 hours before now, it is tomorrow's (a session past midnight).
   [ -z "${SESSION_END:-}" ] && return 0
   local end now
   end=$(date -u -d "$SESSION_END" +%s) || return 1
   now=$(date -u +%s)
+  [ "$end" -lt $((now - 43200)) ] && end=$((end + 86400))
   [ $((now + 60 * $1)) -le "$end" ] || { log "put off: about $1 min would pass SESSION_END $SESSION_END"; return 1; }
 }
 
@@ -143,9 +148,31 @@ matched_run() {  # matched_run CORE METHOD SEED MINUTES: matched_start, or put o
   matched_start "$1" "$2" "$3"
 }
 
+matched_done() {  # matched_done METHOD SEED: whether the study's archived records hold the run's phase 5
+  local archive=$MATCHED_RECORDS/seed$2/runs-records.tar.gz
+  [ -f "$archive" ] && tar xzOf "$archive" "./$1-seed$2/policies/round-005/training.json" 2> /dev/null \
+    | grep -q '"eval"'
+}
+
+matched_others_done() {  # matched_others_done METHOD SEED: every other run of the study is in its records
+  local method seed
+  for seed in 0 1 2; do
+    for method in uniform need gain; do
+      [ "$method $seed" = "$1 $2" ] && continue
+      matched_done "$method" "$seed" || return 1
+    done
+  done
+}
+
 matched_start() {  # matched_start CORE METHOD SEED: one pixels-matched-eval run (its one_run.sh) on CORE
-  OMP_NUM_THREADS=1 DEV=$DEV study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" "$1" \
-    "$MATCHED_RUN" "$2" "$3"
+  # The study's last run (every other one in its records, so the other core has nothing left) gets both.
+  local cores=$1 threads=1
+  if matched_others_done "$2" "$3"; then
+    cores=0,1 threads=2
+    log "pixels-matched-eval ($2 $3): every other run is in the records, so both cores and 2 threads"
+  fi
+  OMP_NUM_THREADS=$threads DEV=$DEV study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" \
+    "$cores" "$MATCHED_RUN" "$2" "$3"
 }
 
 if [ "${BASH_SOURCE[0]}" != "$0" ]; then return 0; fi  # sourced (its tests): functions only

@@ -4,6 +4,7 @@ whatever the core."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
@@ -24,17 +25,30 @@ def bash(script: str, cwd: Path, **env: str) -> subprocess.CompletedProcess:
     )
 
 
-def in_minutes(minutes: int) -> str:
-    return (datetime.now(timezone.utc) + timedelta(minutes=minutes)).strftime("%H:%M")
+def in_minutes(minutes: int, now: datetime | None = None) -> str:
+    """The time of day (UTC, ``HH:MM``) ``minutes`` from ``now`` (default: this moment)."""
+    return ((now or datetime.now(timezone.utc)) + timedelta(minutes=minutes)).strftime("%H:%M")
 
 
 @pytest.mark.parametrize(("end_in", "step", "starts"), [(90, 60, True), (50, 60, False)])
 def test_a_step_starts_only_if_it_ends_before_session_end(tmp_path, end_in, step, starts):
-    if datetime.now(timezone.utc).hour == 23 and datetime.now(timezone.utc).minute >= 30:
-        pytest.skip("SESSION_END is a time of day: too close to midnight UTC to test here")
     result = bash(f"fits {step}", tmp_path, SESSION_END=in_minutes(end_in))
     assert (result.returncode == 0) is starts
     assert ("would pass SESSION_END" in result.stdout) is not starts
+
+
+@pytest.mark.parametrize(("end_in", "step", "starts"), [(90, 60, True), (50, 60, False)])
+def test_a_session_end_past_midnight_is_tomorrows(tmp_path, end_in, step, starts):
+    """At 23:30 UTC, a SESSION_END of 01:00 is 90 minutes away, not 22.5 hours ago."""
+    fake_now = "23:30"
+    date_at = tmp_path / "bin" / "date"  # `date` as at 23:30 today, for `now`; others answered by date
+    date_at.parent.mkdir()
+    now_line = f'[ "$*" = "-u +%s" ] && exec /usr/bin/date -u -d {fake_now} +%s'
+    date_at.write_text(f'#!/bin/bash\n{now_line}\nexec /usr/bin/date "$@"\n')
+    date_at.chmod(0o755)
+    end = in_minutes(end_in, datetime.now(timezone.utc).replace(hour=23, minute=30))
+    result = bash(f"fits {step}", tmp_path, SESSION_END=end, PATH=f"{date_at.parent}:/usr/bin:/bin")
+    assert (result.returncode == 0) is starts, result.stdout + result.stderr
 
 
 def test_without_session_end_every_step_starts(tmp_path):
@@ -83,8 +97,6 @@ def test_the_same_run_twice_is_refused_on_either_core(checkout, second_core):
 
 
 def test_a_run_that_would_pass_session_end_starts_after_those_that_fit(checkout):
-    if datetime.now(timezone.utc).hour == 22 and datetime.now(timezone.utc).minute >= 50:
-        pytest.skip("SESSION_END is a time of day: too close to midnight UTC to test here")
     main, commit, script = checkout
     chain = f"ONE_RUN={script}\ndev_run 0 epochs 101 250; dev_run 0 fixed 100 30; run_put_off"
     result = bash(chain, main, SESSION_END=in_minutes(60), PIXELS_COMMIT=commit)
@@ -136,8 +148,6 @@ def test_the_development_report_waits_for_all_six_runs(tmp_path):
 
 
 def test_the_queue_runs_what_fits_first_then_what_it_put_off_on_each_core(checkout, tmp_path):
-    if datetime.now(timezone.utc).hour == 22 and datetime.now(timezone.utc).minute >= 50:
-        pytest.skip("SESSION_END is a time of day: too close to midnight UTC to test here")
     main, commit, script = checkout
     script.write_text('echo "$(grep Cpus_allowed_list /proc/self/status | cut -f2) $*" >> outputs/calls\n')
     result = subprocess.run(
@@ -193,3 +203,40 @@ def test_the_development_report_waits_for_a_run_another_chain_is_running(tmp_pat
     assert result.returncode == 0, result.stdout + result.stderr
     assert "waiting for epochs seed 102, which another chain is running" in result.stdout
     assert (main / "outputs" / "reported").exists()
+
+
+def matched_records(root: Path, missing: set[tuple[str, int]]) -> Path:
+    """Stand-in pixels-matched-eval records: each seed's archive holds every run's phase 5 but
+    ``missing``'s."""
+    for seed in (0, 1, 2):
+        runs = root / "unpacked" / f"seed{seed}"
+        for method in ("uniform", "need", "gain"):
+            if (method, seed) not in missing:
+                last = runs / f"{method}-seed{seed}" / "policies" / "round-005"
+                last.mkdir(parents=True)
+                (last / "training.json").write_text('{"round": 5, "eval": {}}')
+        (root / f"seed{seed}").mkdir(parents=True)
+        runs.mkdir(parents=True, exist_ok=True)
+        archive = root / f"seed{seed}" / "runs-records.tar.gz"
+        subprocess.run(["tar", "czf", str(archive), "-C", str(runs), "."], check=True)
+    return root
+
+
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="needs two cores to pin a run to both")
+@pytest.mark.parametrize(
+    ("missing", "cores", "threads"),
+    [({("need", 2)}, "0-1", "2"), ({("need", 2), ("gain", 2)}, "0", "1")],
+)
+def test_the_studys_last_run_gets_both_cores_and_no_other_does(checkout, tmp_path, missing, cores, threads):
+    main, commit, script = checkout
+    script.write_text(
+        'echo "$(grep Cpus_allowed_list /proc/self/status | cut -f2) $OMP_NUM_THREADS $*" >> outputs/calls\n'
+    )
+    records = matched_records(tmp_path / "records", missing)
+    step = (
+        f"MATCHED_RUN={script} MATCHED_RECORDS={records} PIXELS_EVAL_COMMIT={commit}\nmatched_start 0 need 2"
+    )
+    result = bash(step, main)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert (main / "outputs" / "calls").read_text().split() == [cores, threads, "need", "2"]
+    assert ("both cores and 2 threads" in result.stdout) is (cores == "0-1")
