@@ -44,6 +44,7 @@ ONE_RUN=${ONE_RUN:-$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh}  # read
 MATCHED_RUN=${MATCHED_RUN:-$PWD/experiments/pixels-matched-eval/one_run.sh}  # read as it runs: do not edit meanwhile
 DEV=${DEV:-$PWD/experiments/pixels-dagger-epochs-dev}  # its records/ and, once report.sh has run, report/
 MATCHED_RECORDS=${MATCHED_RECORDS:-$PWD/experiments/pixels-matched-eval/records}  # seed*/runs-records.tar.gz
+MATCHED_DONE=${MATCHED_DONE:-$PWD/experiments/pixels-matched-eval/run_done.sh}  # whether one run is done
 if grep -qw avx512f /proc/cpuinfo; then FIXED_MIN=${FIXED_MIN:-75} EPOCHS_MIN=${EPOCHS_MIN:-165}
 else FIXED_MIN=${FIXED_MIN:-145} EPOCHS_MIN=${EPOCHS_MIN:-250}; fi  # minutes a run takes (above)
 
@@ -148,18 +149,12 @@ matched_run() {  # matched_run CORE METHOD SEED MINUTES: matched_start, or put o
   matched_start "$1" "$2" "$3"
 }
 
-matched_done() {  # matched_done METHOD SEED: whether the study's archived records hold the run's phase 5
-  local archive=$MATCHED_RECORDS/seed$2/runs-records.tar.gz
-  [ -f "$archive" ] && tar xzOf "$archive" "./$1-seed$2/policies/round-005/training.json" 2> /dev/null \
-    | grep -q '"eval"'
-}
-
 matched_others_done() {  # matched_others_done METHOD SEED: every other run of the study is in its records
   local method seed
   for seed in 0 1 2; do
     for method in uniform need gain; do
       [ "$method $seed" = "$1 $2" ] && continue
-      matched_done "$method" "$seed" || return 1
+      bash "$MATCHED_DONE" "$method" "$seed" "$MATCHED_RECORDS" || return 1
     done
   done
 }

@@ -31,8 +31,7 @@ case "$METHOD" in
   *) echo "METHOD must be uniform, need or gain, got '$METHOD'" >&2; exit 2 ;;
 esac
 RUN=$METHOD-seed$SEED
-ARCHIVE=$RECORDS/seed$SEED/runs-records.tar.gz
-if [ -f "$ARCHIVE" ] && tar xzOf "$ARCHIVE" "./$RUN/policies/round-005/training.json" 2> /dev/null | grep -q '"eval"'; then
+if bash "$HERE/run_done.sh" "$METHOD" "$SEED" "$RECORDS"; then
   log "$RUN: done (its archived records hold phase 5), skipped"
   exit 0
 fi

@@ -37,7 +37,7 @@ from lerobot_mtdagger.datasets.config_layout import flatten
 from lerobot_mtdagger.datasets.records import PhaseRecord
 from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.presets import PRESETS
+from lerobot_mtdagger.runner.presets import preset_values
 from lerobot_mtdagger.studies.saved_records import ARCHIVE_NAME, saved_records_runs
 from lerobot_mtdagger.studies.stats import Interval, paired_difference
 
@@ -253,13 +253,6 @@ def short(name: str) -> str:
     return re.sub(r"-v\d+$", "", name)
 
 
-def preset_bc_values() -> dict[str, Any]:
-    """What today's preset fills in a BC run (a value keyed by run mode: its ``bc`` value)."""
-    return {
-        key: value["bc"] if isinstance(value, Mapping) else value for key, value in PRESETS[PRESET].items()
-    }
-
-
 def run_defaults() -> dict[str, Any]:
     """Every option of a run at its default value (an option added since pixels-eval ran keeps it)."""
     return flatten(dataclasses.asdict(RunConfig()))
@@ -304,7 +297,7 @@ def bc_reuse_check(earlier: Runs, study: Runs) -> list[str]:
     ]
     problems += [
         f"today's {PRESET} preset fills {key}={value!r} for BC, BC's runs stored {reference.get(key)!r}"
-        for key, value in preset_bc_values().items()
+        for key, value in preset_values(PRESET, "bc").items()
         if key not in FROM_COMMAND_LINE and reference.get(key) != value
     ]
     defaults = run_defaults()

@@ -26,7 +26,7 @@ from lerobot_mtdagger.runner.option_groups import (
     TrainingConfig,
     check_device,
 )
-from lerobot_mtdagger.runner.presets import PRESETS
+from lerobot_mtdagger.runner.presets import PRESETS, preset_values
 from lerobot_mtdagger.runner.student import Student, student_names, student_of_options
 from lerobot_mtdagger.runner.student_options import (
     PolicyOptions,
@@ -116,12 +116,12 @@ class RunConfig:
             raise ValueError(f"Unknown preset {self.preset!r}; presets: {list(PRESETS)}.")
         if self.mode not in RUN_MODES:
             raise ValueError(f"Unknown mode {self.mode!r}; choose one of {list(RUN_MODES)}.")
-        for path, value in PRESETS[self.preset].items():
+        for path, value in preset_values(self.preset, self.mode).items():
             owner, name = self._field_owner(path)
             if not hasattr(owner, name):  # policy.lr: a LeRobot student's is its optimizer_lr
                 continue
             if getattr(owner, name) is None:
-                setattr(owner, name, value[self.mode] if isinstance(value, Mapping) else value)
+                setattr(owner, name, value)
         if self.output_dir is None:
             self.output_dir = Path("outputs") / "mtdagger" / f"{self.preset}-{self.method}-seed{self.seed}"
         self.suite.fill_defaults()

@@ -158,3 +158,12 @@ line or in Python always wins. A value that is a mapping is keyed by ``RunConfig
 
 PRESET_FIELDS: tuple[str, ...] = tuple(PRESETS["small"])
 """The options every preset fills."""
+
+
+def preset_values(preset: str, mode: str) -> dict[str, Any]:
+    """What ``preset`` fills in a run of ``mode`` (``dagger`` or ``bc``), by option path.
+
+    A value keyed by run mode (``PIXELS_STEPS_RULE``) gives that mode's.
+    """
+    values = PRESETS[preset].items()
+    return {path: value[mode] if isinstance(value, dict) else value for path, value in values}

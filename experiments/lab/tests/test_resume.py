@@ -233,9 +233,9 @@ def test_the_studys_last_run_gets_both_cores_and_no_other_does(checkout, tmp_pat
         'echo "$(grep Cpus_allowed_list /proc/self/status | cut -f2) $OMP_NUM_THREADS $*" >> outputs/calls\n'
     )
     records = matched_records(tmp_path / "records", missing)
-    step = (
-        f"MATCHED_RUN={script} MATCHED_RECORDS={records} PIXELS_EVAL_COMMIT={commit}\nmatched_start 0 need 2"
-    )
+    done = RESUME.parent / "pixels-matched-eval" / "run_done.sh"
+    options = f"MATCHED_RUN={script} MATCHED_RECORDS={records} MATCHED_DONE={done}"
+    step = f"{options} PIXELS_EVAL_COMMIT={commit}\nmatched_start 0 need 2"
     result = bash(step, main)
     assert result.returncode == 0, result.stdout + result.stderr
     assert (main / "outputs" / "calls").read_text().split() == [cores, threads, "need", "2"]
