@@ -25,7 +25,7 @@ context.free()'
 
 check nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv
 check "$PYTHON" -c "$gl_renderer"
-check "$PYTHON" -m pytest -q -m gpu -p no:cacheprovider tests/test_gpu.py
+check "$PYTHON" -m pytest -q -m gpu -n 0 -p no:cacheprovider tests/test_gpu.py  # one process: one GPU
 check "$PYTHON" benchmarks/bench_policy.py --device=cuda --batch-size 256 --steps 20 --rounds 3 --precisions fp32,tf32,bf16
 check "$PYTHON" benchmarks/bench_policy.py --device=cuda --batch-size 1024 --steps 10 --rounds 2
 check "$PYTHON" benchmarks/bench_policy.py --device=cpu --batch-size 256 --steps 5 --rounds 1
