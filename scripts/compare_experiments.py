@@ -28,9 +28,8 @@ from pathlib import Path
 import pyarrow.parquet as pq
 from safetensors.numpy import load_file
 
-from lerobot_mtdagger.datasets.config_layout import flatten
+from lerobot_mtdagger.datasets.config_layout import RESULT_NEUTRAL_OPTIONS, flatten
 from lerobot_mtdagger.datasets.migrations import migrate_run_config
-from lerobot_mtdagger.datasets.rounds import RESULT_NEUTRAL_OPTIONS
 
 PROVENANCE_FIELDS = {"timings", "environment"}
 """``training.json`` fields that say how and where a phase ran, not what it gave."""

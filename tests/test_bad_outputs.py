@@ -117,6 +117,19 @@ def test_compare_experiments_ignores_what_never_changes_a_result(tmp_path):
     assert "config.dagger.beta" in compare().stdout
 
 
+def test_compare_experiments_starts_without_torch_or_lerobot():
+    """Comparing two folders' records needs neither (importing them takes several seconds a call)."""
+    script = Path(__file__).resolve().parents[1] / "scripts" / "compare_experiments.py"
+    load = (
+        "import importlib.util, sys; "
+        f"spec = importlib.util.spec_from_file_location('compare_experiments', {str(script)!r}); "
+        "spec.loader.exec_module(importlib.util.module_from_spec(spec)); "
+        "print(sorted({m.split('.')[0] for m in sys.modules} & {'torch', 'lerobot'}))"
+    )
+    loaded = subprocess.run([sys.executable, "-c", load], capture_output=True, text=True, check=True)
+    assert loaded.stdout.strip() == "[]"
+
+
 def test_a_refused_run_prints_no_experiment_header(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["run", *TOY, f"--output_dir={out}"]) == 0

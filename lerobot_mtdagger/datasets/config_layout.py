@@ -10,7 +10,7 @@ Hub card) sees one layout.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from lerobot_mtdagger.datasets.migrations import is_flat, migrate_run_config
@@ -36,3 +36,21 @@ def option(config: Mapping[str, Any], path: str, default: Any = None) -> Any:
             return default
         node = node[part]
     return node
+
+
+RESULT_NEUTRAL_OPTIONS: tuple[str, ...] = (
+    "preset",  # a config stores every option the preset filled, resolved: those are compared
+    "resume",
+    "progress",
+    "output_dir",
+    "rollout.workers",
+    "rollout.worker_backend",
+    "rollout.ray_address",
+    "policy.device",
+)
+"""Options (dotted paths) that never change a result, free to differ on resume."""
+
+
+def result_options(config: Mapping[str, Any], ignore: Sequence[str]) -> dict[str, Any]:
+    """A run config's leaves by dotted path, without the options in ``ignore`` (compared on resume)."""
+    return {key: value for key, value in flatten(migrate_run_config(config)).items() if key not in ignore}

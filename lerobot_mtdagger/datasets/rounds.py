@@ -44,7 +44,7 @@ import pyarrow.parquet as pq
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import update_chunk_file_indices
 
-from lerobot_mtdagger.datasets.config_layout import flatten
+from lerobot_mtdagger.datasets.config_layout import RESULT_NEUTRAL_OPTIONS, result_options
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.datasets.layout import (
     CONFIG_FILE,
@@ -150,24 +150,6 @@ def read_committed_json(path: Path, fix: str) -> Any:
         return json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as error:
         raise CorruptExperimentError(f"{path} is unreadable ({error}); {fix}.") from None
-
-
-RESULT_NEUTRAL_OPTIONS: tuple[str, ...] = (
-    "preset",  # a config stores every option the preset filled, resolved: those are compared
-    "resume",
-    "progress",
-    "output_dir",
-    "rollout.workers",
-    "rollout.worker_backend",
-    "rollout.ray_address",
-    "policy.device",
-)
-"""Options (dotted paths) that never change a result, free to differ on resume."""
-
-
-def result_options(config: Mapping[str, Any], ignore: Sequence[str]) -> dict[str, Any]:
-    """A run config's leaves by dotted path, without the options in ``ignore`` (compared on resume)."""
-    return {key: value for key, value in flatten(migrate_run_config(config)).items() if key not in ignore}
 
 
 def fill_added_options(stored: dict[str, Any], given: Mapping[str, Any], added: Mapping[str, Any]) -> None:

@@ -29,13 +29,12 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from lerobot_mtdagger.datasets.config_layout import RESULT_NEUTRAL_OPTIONS, result_options
 from lerobot_mtdagger.datasets.layout import CONFIG_FILE, STAGING_DIR
 from lerobot_mtdagger.datasets.rounds import (
     EXPERT_CHECK_FILE,
-    RESULT_NEUTRAL_OPTIONS,
     ExperimentDir,
     fill_added_options,
-    result_options,
     round_name,
     write_record_files,
 )
