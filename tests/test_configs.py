@@ -271,7 +271,7 @@ def test_a_flat_config_migrates_into_the_groups():
     today = flatten(parse("--suite.name=toy").to_dict())
     added = set(today) - set(leaves)
     expected = {"suite.episode_length", "suite.module", "rollout.worker_backend", "rollout.ray_address"}
-    expected |= {"training.lr_schedule", "training.seed"}
+    expected |= {"training.lr_schedule", "training.seed", "training.progress_every_s"}
     expected |= {"expert.noise", "expert.noise_correlation", "expert.noise_seed", "expert.labels"}
     expected |= {"expert.path", "expert.type", "expert.min_success", "expert.success_episodes"}
     expected |= {"expert.noise_by_task"}

@@ -9,6 +9,8 @@ from __future__ import annotations
 ROUNDS_DIR = "rounds"
 POLICIES_DIR = "policies"
 STAGING_DIR = ".staging"
+PROGRESS_DIR = ".progress"
+"""Under ``policies/``: the saved progress of phases being trained (``runner.phase_progress``)."""
 TRAINING_FILE = "training.json"
 CONFIG_FILE = "config.json"
 LOCK_FILE = ".lock"

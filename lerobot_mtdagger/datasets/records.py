@@ -276,6 +276,9 @@ class PhaseRecord:
             environment: elsewhere the arithmetic differs in the last bits and grows over the steps.
         passes_per_task: Per task, the frames the phase's steps drew over its training frames (how
             many passes over each task's data it made); None in phases written before it was recorded.
+        resumed_after_steps: The steps after which a cut phase was resumed from its saved progress
+            (``runner.phase_progress``), in order; empty: trained in one go; None in phases written
+            before progress was saved. Its ``steps_s`` and ``train_s`` count every process's steps.
     """
 
     round: int
@@ -298,6 +301,7 @@ class PhaseRecord:
     heldout_eval: dict[str, Any] | None = None
     environment: dict[str, Any] | None = None
     passes_per_task: list[float | None] | None = None
+    resumed_after_steps: list[int] | None = None
 
     @property
     def eval_mean(self) -> float | None:

@@ -15,6 +15,8 @@ Layout of an experiment directory::
             round-000/               policy trained on rounds 0..0 (LeRobot pretrained model +
                                      processors) and training.json (per-task losses, gain, eval)
             .staging/round-001/      a training phase being written
+            .progress/round-001.pt   its progress, saved every few minutes: kept on resume, which
+                                     goes on from it (runner.phase_progress); deleted at commit
 
 A round or training phase is committed by an atomic rename of its finished staging folder; anything
 cut off half-way stays in ``.staging`` and is discarded, so a committed round is immutable and
@@ -50,6 +52,7 @@ from lerobot_mtdagger.datasets.layout import (
     CONFIG_FILE,
     LOCK_FILE,
     POLICIES_DIR,
+    PROGRESS_DIR,
     ROUNDS_DIR,
     STAGING_DIR,
     TRAINING_FILE,
@@ -404,12 +407,17 @@ class ExperimentDir:
         return digest_mismatches(self.policy_root(record.round), record.files, exclude=(TRAINING_FILE,))
 
     def clear_staging(self) -> None:
-        """Deletes everything that was being written when a run was cut off."""
+        """Deletes everything that was being written when a run was cut off.
+
+        A phase's saved progress is kept (the phase goes on from it), but for phases committed since.
+        """
         for parent in (self.rounds, self.policies):
             staging = parent / STAGING_DIR
             if staging.exists():
                 logger.info("Discarding unfinished work in %s", staging)
                 shutil.rmtree(staging)
+        for round_index in self.committed_phases():
+            self.phase_progress_path(round_index).unlink(missing_ok=True)
 
     # ---------------------------------------------------------------------------------------------
     # Rounds
@@ -559,6 +567,10 @@ class ExperimentDir:
             int(p.name.split("-")[1]) for p in self.policies.glob("round-*") if (p / TRAINING_FILE).exists()
         )
 
+    def phase_progress_path(self, round_index: int) -> Path:
+        """The saved progress of a phase being trained (``runner.phase_progress``)."""
+        return self.policies / PROGRESS_DIR / f"{round_name(round_index)}.pt"
+
     def staging_policy_root(self, round_index: int) -> Path:
         """An empty staging folder for a training phase."""
         staging = self.policies / STAGING_DIR / round_name(round_index)
@@ -576,6 +588,7 @@ class ExperimentDir:
             raise FileExistsError(f"Training phase {round_index} is already committed at {final}.")
         os.replace(staging, final)
         self.update_ledger()
+        self.phase_progress_path(round_index).unlink(missing_ok=True)
         return final
 
     # ---------------------------------------------------------------------------------------------

@@ -31,7 +31,8 @@ Normalisation statistics come from round 0's training frames and stay fixed (``n
 a warm-started policy sees its inputs as before; held-out episodes (``gain_split=heldout`` or
 ``steps_rule=plateau``) are chosen once per episode and stay held out.
 
-Resuming: committed rounds and phases are immutable; a run restarts at the first uncommitted step.
+Resuming: committed rounds and phases are immutable; a run restarts at the first uncommitted step (a
+training phase from its saved progress, where it has some: ``runner.phase_progress``).
 Every random choice derives from the seed and the round, and the scheduler's state after each round
 is stored in the round's record, so a resumed run makes the same allocations as an uninterrupted one.
 """
@@ -277,7 +278,8 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     data = ctx.rounds.load(roots, list(policy_cfg.input_features))
     previous = ctx.experiment.policy_root(round_index - 1) if round_index > 0 else None
     loaded = time.perf_counter()
-    trained = train_on_rounds(ctx.config, policy_cfg, data, round_index, previous, ctx.show_progress)
+    saved = ctx.experiment.phase_progress_path(round_index)
+    trained = train_on_rounds(ctx.config, policy_cfg, data, round_index, previous, ctx.show_progress, saved)
     trained_at = time.perf_counter()
     staging = ctx.experiment.staging_policy_root(round_index)
     trained.save(staging)

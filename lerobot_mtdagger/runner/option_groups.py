@@ -316,6 +316,10 @@ class TrainingConfig:
             differ from the run's ``--seed`` (which keeps every other draw: the episodes collected,
             evaluated and held out). A BC run repeated with other training seeds trains on the very
             same data: the spread between trainings, apart from the data's. None: ``--seed``.
+        progress_every_s: Seconds of training between two saves of a phase's progress
+            (``policies/.progress``), from which a phase cut off part-way resumes with
+            ``--resume=true`` and ends as it would have (``runner.phase_progress``); 0: never saved,
+            a cut phase starts over. Changes no result.
     """
 
     steps_per_round: int | None = None
@@ -331,11 +335,17 @@ class TrainingConfig:
     gain_split: str = "train"
     heldout_fraction: float = 0.2
     seed: int | None = None
+    progress_every_s: float = 600.0
 
     def check(self) -> None:
         """Refuses impossible values (one line naming the option)."""
         positive = ("steps_per_round", "epochs", "plateau_every", "plateau_patience", "plateau_max_steps")
         _require_positive(self, "training", positive)
+        if self.progress_every_s < 0:
+            raise ValueError(
+                f"training.progress_every_s must be >= 0 (0: never save a phase's progress), got "
+                f"{self.progress_every_s}."
+            )
         if self.seed is not None and self.seed < 0:
             raise ValueError(
                 f"training.seed must be >= 0 (or left unset: the run's --seed), got {self.seed}."

@@ -24,6 +24,7 @@ import torch
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE
 from lerobot_mtdagger.runner.normalise import NormalisedData
+from lerobot_mtdagger.runner.phase_progress import PhaseProgress, loop_state, restore_loop
 from lerobot_mtdagger.runner.plateau import PlateauStop, PlateauTracker
 from lerobot_mtdagger.runner.student import Student, student_of_policy
 from lerobot_mtdagger.runner.task_loss import per_task_loss, performance_gain
@@ -57,6 +58,9 @@ class PhaseResult:
         task_loss_s: Seconds spent measuring the per-task loss before and after them.
         passes_per_task: Per task, the frames its steps drew divided by its training frames: how
             many times over its data the phase went (None where a task had no training frame).
+        resumed_after_steps: The steps after which the phase was resumed from its saved progress,
+            in order (empty: trained in one go). ``steps_s`` counts every process's steps.
+        earlier_steps_s: Of ``steps_s``, the seconds of the processes before the last resume.
     """
 
     loss_start: list[float | None]
@@ -70,6 +74,8 @@ class PhaseResult:
     steps_s: float = field(default=0.0, compare=False)  # timings: equal phases differ in them
     task_loss_s: float = field(default=0.0, compare=False)
     passes_per_task: list[float | None] | None = None
+    resumed_after_steps: list[int] = field(default_factory=list)
+    earlier_steps_s: float = field(default=0.0, compare=False)
 
 
 def make_optimizer(policy: MTDAggerPolicy, lr: float) -> torch.optim.AdamW:
@@ -179,6 +185,8 @@ class StepOptions:
             minimum (None: train all ``steps``).
         log_interval: Steps between two reads of the loss.
         task_dropout: A LeRobot student's task dropout (``mtdagger``'s is in its config).
+        progress: Where the phase's progress is saved every few minutes and resumed from
+            (``phase_progress.PhaseProgress``; None: never saved, a cut phase starts over).
     """
 
     steps: int
@@ -190,6 +198,7 @@ class StepOptions:
     plateau: PlateauStop | None = None
     log_interval: int = LOG_INTERVAL
     task_dropout: float = 0.0
+    progress: PhaseProgress | None = None
 
 
 def train_phase(
@@ -245,9 +254,11 @@ def train_phase(
         steps=done,
         best_step=None if loop.tracker is None else loop.tracker.best_step,
         heldout_loss=None if loop.tracker is None else loop.tracker.curve,
-        steps_s=trained - measured,
+        steps_s=trained - measured + loop.earlier_steps_s,
         task_loss_s=(measured - started) + (time.perf_counter() - trained),
         passes_per_task=loop.draws.passes(),
+        resumed_after_steps=loop.resumed_after_steps,
+        earlier_steps_s=loop.earlier_steps_s,
     )
 
 
@@ -264,25 +275,37 @@ class StepLoop:
     ) -> None:
         """Builds the sampler, the optimiser (over ``options.steps``) and the plateau tracker."""
         self.ops, self.data, self.options = ops, data, options
-        generator = torch.Generator().manual_seed(options.seed)
-        self.draw = batch_sampler(train_index, data.data.task_index, options.sampling, generator)
+        self.generator = torch.Generator().manual_seed(options.seed)
+        self.draw = batch_sampler(train_index, data.data.task_index, options.sampling, self.generator)
         self.optimizer, self.scheduler, self.clip_norm = ops.optimizer(options.steps)
         self.parameters = [p for p in ops.policy.parameters() if p.requires_grad]
         self.size = min(options.batch_size, len(train_index))
         self.tracker = None if options.plateau is None else PlateauTracker(options.plateau, ops, data)
         self.losses = _LossWindow(on_step)
         self.draws = DrawCounter(data.data.task_index, train_index, len(data.task_names))
+        # Progress is saved part-way only without a plateau stop (its curve and best weights are not).
+        self.progress = options.progress if self.tracker is None else None
+        self.earlier_steps_s = 0.0  # seconds earlier processes spent in the steps of a resumed phase
+        self.resumed_after_steps: list[int] = []
 
     def run(self) -> int:
-        """Takes the steps (until the cap or a plateau, whose best weights it restores); the steps taken."""
+        """Takes the steps (until the cap or a plateau, whose best weights it restores); the steps taken.
+
+        Resumes from the phase's saved progress where there is some, and saves it every
+        ``progress.every_s`` seconds at the start of an interval.
+        """
         steps, log_interval = self.options.steps, self.options.log_interval
         stopped = self.tracker is not None and self.tracker.measure(0)
         self.ops.policy.train()
         picks = torch.empty(0, dtype=torch.long)
-        done = 0
+        done = restore_loop(self, self.progress.load()) if self.progress is not None else 0
+        started = time.perf_counter()
         while done < steps and not stopped:
             offset = done % log_interval
             if offset == 0:
+                if done > 0 and self.progress is not None and self.progress.due():
+                    steps_s = self.earlier_steps_s + time.perf_counter() - started
+                    self.progress.save(done, loop_state(self), steps_s)
                 # One interval's batch indices at once, drawn on the CPU (device independent).
                 drawn = self.draw((min(log_interval, steps - done), self.size))
                 self.draws.start_interval(drawn)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +25,7 @@ from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdag
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
+from lerobot_mtdagger.runner.phase_progress import PhaseProgress, phase_key
 from lerobot_mtdagger.runner.plateau import plateau_stop
 from lerobot_mtdagger.runner.provenance import training_environment
 from lerobot_mtdagger.runner.round_data import TrainingData, load_round
@@ -159,6 +160,7 @@ class TrainedPhase:
             heldout_loss=result.heldout_loss,
             environment=training_environment(next(self.policy.parameters()).device),
             passes_per_task=result.passes_per_task,
+            resumed_after_steps=result.resumed_after_steps,
         )
 
 
@@ -169,6 +171,7 @@ def train_on_rounds(
     round_index: int,
     previous: Path | None,
     show_progress: bool = False,
+    progress_path: Path | None = None,
 ) -> TrainedPhase:
     """Algorithm 1's "Train Policy" for round ``round_index`` of a run: trains a student on D(k).
 
@@ -183,6 +186,8 @@ def train_on_rounds(
         round_index: k.
         previous: The folder of round k-1's policy (None in round 0).
         show_progress: Show a progress bar over the steps.
+        progress_path: Where the phase's progress is saved every ``training.progress_every_s``
+            seconds and resumed from (``phase_progress``; None: never saved).
     """
     start = time.perf_counter()
     image_keys = list(policy_cfg.image_features)
@@ -212,6 +217,11 @@ def train_on_rounds(
         plateau=plateau_stop(config, split),
         task_dropout=getattr(policy_cfg, "task_dropout", 0.0),
     )
+    if progress_path is not None:
+        key = phase_key(round_index, policy_cfg.type, options, split.train)
+        options = replace(
+            options, progress=PhaseProgress(progress_path, key, config.training.progress_every_s)
+        )
     loss_previous = (
         None if runner is None else student.previous_losses(runner, normalised, split.loss, options)
     )
@@ -236,7 +246,7 @@ def train_on_rounds(
         loss_previous=loss_previous,
         frames=len(data),
         prepare_s=prepared - start,
-        train_s=time.perf_counter() - prepared,
+        train_s=time.perf_counter() - prepared + result.earlier_steps_s,
     )
 
 

@@ -1,0 +1,174 @@
+"""A training phase's progress, saved every few minutes so that a cut phase resumes where it was.
+
+A phase of a pixel run trains for hours on a CPU, and a run cut off during one (a stop, ``kill -9``)
+used to take it again from its first step. Every ``every_s`` seconds of training, at the start of a
+log interval, ``StepLoop`` saves what the remaining steps depend on: the weights, the optimiser's and
+the scheduler's state, the batch sampler's generator, the global (and CUDA) random state and the
+random generators of the training seam (a LeRobot student's task dropout), the steps taken, the
+frames drawn per task and the last step losses. A resumed run loads them and takes the remaining
+steps, so its phase equals the uninterrupted one (on the same device and threads, as any resume).
+
+The file sits beside the committed phases (``policies/.progress/round-XXX.pt``), written atomically;
+unlike ``.staging`` it is kept when a run resumes, and it is deleted once its phase commits. Its key
+(the round, the policy type, the steps, seed, batch, learning rate and sampling, and a fingerprint of
+the training frames) must match the phase's; a file that does not match, or cannot be read, is
+discarded with a warning and the phase starts over. A ``plateau`` phase is never saved part-way (its
+held-out curve and best weights would have to be too): it starts over.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import pickle
+import time
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import torch
+
+logger = logging.getLogger(__name__)
+
+FORMAT = 1
+"""Version of the saved progress; a file of another version is discarded."""
+
+
+@dataclass
+class SavedProgress:
+    """What a phase's remaining steps need, as loaded (``PhaseProgress.load``).
+
+    Attributes:
+        done: Steps taken.
+        state: The rest, for ``StepLoop.restore``.
+        steps_s: Seconds the earlier processes spent in these steps.
+    """
+
+    done: int
+    state: dict[str, Any]
+    steps_s: float
+
+
+class PhaseProgress:
+    """Saves and loads one training phase's progress at ``path``.
+
+    Args:
+        path: The progress file (``ExperimentDir.phase_progress_path``).
+        key: What identifies the phase (``phase_key``); a saved file of another key is discarded.
+        every_s: Seconds of training between two saves (0: never save).
+    """
+
+    def __init__(self, path: Path, key: dict[str, Any], every_s: float) -> None:
+        """Starts the clock of the first save now."""
+        self.path = Path(path)
+        self.key = key
+        self.every_s = every_s
+        self.last_save = time.perf_counter()
+
+    def due(self) -> bool:
+        """Whether ``every_s`` seconds have passed since the last save (or the start)."""
+        return self.every_s > 0 and time.perf_counter() - self.last_save >= self.every_s
+
+    def save(self, done: int, state: dict[str, Any], steps_s: float) -> None:
+        """Writes the progress after ``done`` steps (a temporary file, then an atomic rename)."""
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        partial = self.path.with_name(self.path.name + ".partial")
+        torch.save({"format": FORMAT, "key": self.key, "done": done, "steps_s": steps_s, **state}, partial)
+        os.replace(partial, self.path)
+        self.last_save = time.perf_counter()
+        logger.info("Saved the phase's progress after %d steps to %s", done, self.path)
+
+    def load(self) -> SavedProgress | None:
+        """The saved progress of this phase, or None.
+
+        None where there is no file, and where it is of another phase or unreadable: it is then
+        discarded, with a warning, and the phase starts over.
+        """
+        if not self.path.exists():
+            return None
+        try:
+            saved = torch.load(self.path, map_location="cpu", weights_only=True)
+        except (OSError, RuntimeError, EOFError, pickle.UnpicklingError, zipfile.BadZipFile) as error:
+            return self._discard(f"it cannot be read ({error})")
+        if not isinstance(saved, dict) or saved.get("format") != FORMAT:
+            return self._discard(f"it is not progress of format {FORMAT}")
+        if saved.get("key") != self.key:
+            return self._discard(f"it belongs to another phase ({saved.get('key')}, this one: {self.key})")
+        done, steps_s = saved.pop("done"), saved.pop("steps_s")
+        for name in ("format", "key"):
+            saved.pop(name)
+        logger.info("Resuming the phase after %d steps from %s", done, self.path)
+        return SavedProgress(done=int(done), state=saved, steps_s=float(steps_s))
+
+    def discard(self) -> None:
+        """Deletes the saved progress (the phase is committed, or the file is of no use)."""
+        self.path.unlink(missing_ok=True)
+        self.path.with_name(self.path.name + ".partial").unlink(missing_ok=True)
+
+    def _discard(self, why: str) -> None:
+        logger.warning("Discarding %s: %s; the phase starts over.", self.path, why)
+        self.discard()
+
+
+def phase_key(round_index: int, policy_type: str, options: Any, train_index: torch.Tensor) -> dict[str, Any]:
+    """What a saved progress must match to be resumed: the phase, its options and its training frames.
+
+    Args:
+        round_index: The phase's round.
+        policy_type: The student's policy type.
+        options: The phase's ``StepOptions``.
+        train_index: Its training frames (a fingerprint: their number and sums).
+    """
+    index = train_index.cpu().long()
+    return {
+        "round": round_index,
+        "policy_type": policy_type,
+        "steps": options.steps,
+        "batch_size": options.batch_size,
+        "lr": float(options.lr),
+        "seed": options.seed,
+        "sampling": options.sampling,
+        "lr_schedule": options.lr_schedule,
+        "frames": [len(index), int(index.sum()), int((index * index).sum())],
+    }
+
+
+def loop_state(loop: Any) -> dict[str, Any]:
+    """What a ``steps.StepLoop``'s remaining steps depend on, at the start of an interval."""
+    ops = loop.ops
+    seam_rngs = {name: g for name, g in vars(ops).items() if isinstance(g, torch.Generator)}
+    return {
+        "policy": ops.policy.state_dict(),
+        "optimizer": loop.optimizer.state_dict(),
+        "scheduler": None if loop.scheduler is None else loop.scheduler.state_dict(),
+        "sampler": loop.generator.get_state(),
+        "torch_rng": torch.get_rng_state(),
+        "cuda_rng": torch.cuda.get_rng_state_all() if loop.data.device.type == "cuda" else None,
+        "seam_rngs": {name: generator.get_state() for name, generator in seam_rngs.items()},
+        "drawn": loop.draws.drawn.clone(),
+        "tail": loop.losses.tail.clone(),
+        "resumed_after_steps": list(loop.resumed_after_steps),
+    }
+
+
+def restore_loop(loop: Any, saved: SavedProgress | None) -> int:
+    """Gives a ``steps.StepLoop`` a saved progress (``loop_state``); the steps it had taken (0: none)."""
+    if saved is None:
+        return 0
+    state = saved.state
+    loop.ops.policy.load_state_dict(state["policy"])
+    loop.optimizer.load_state_dict(state["optimizer"])
+    if loop.scheduler is not None:
+        loop.scheduler.load_state_dict(state["scheduler"])
+    loop.generator.set_state(state["sampler"])
+    torch.set_rng_state(state["torch_rng"])
+    if state["cuda_rng"] is not None:
+        torch.cuda.set_rng_state_all(state["cuda_rng"])
+    for name, generator_state in state["seam_rngs"].items():
+        getattr(loop.ops, name).set_state(generator_state)
+    loop.draws.drawn = state["drawn"]
+    loop.losses.tail = state["tail"]
+    loop.earlier_steps_s = saved.steps_s
+    loop.resumed_after_steps = [*state["resumed_after_steps"], saved.done]
+    return saved.done
