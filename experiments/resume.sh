@@ -39,7 +39,8 @@
 set -uo pipefail
 
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
-PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-897c0d6}  # pixels-matched-eval's code: its README, "Round 0 shared"
+PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-3340fca}  # pixels-matched-eval's code: its README, "Round 0 shared"
+MATCHED_TREE=${MATCHED_TREE:-study-code-pixels-matched-progress}  # its worktree ("Phases resume mid-way")
 ONE_RUN=${ONE_RUN:-$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh}  # read as it runs: do not edit meanwhile
 MATCHED_RUN=${MATCHED_RUN:-$PWD/experiments/pixels-matched-eval/one_run.sh}  # read as it runs: do not edit meanwhile
 DEV=${DEV:-$PWD/experiments/pixels-dagger-epochs-dev}  # its records/ and, once report.sh has run, report/
@@ -52,11 +53,18 @@ log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
 worktree() {  # worktree NAME COMMIT: ../NAME frozen at COMMIT, with this checkout's .venv and outputs/
   # One at a time (both cores' chains may ask for the same new worktree at once; git would refuse one).
+  # A ../NAME at another commit is refused: a study's code changes only under a new worktree name.
   (
     flock 9
     if [ ! -d "../$1" ]; then
       git worktree prune
       git worktree add --detach "../$1" "$2" || exit 1
+    fi
+    local at
+    at=$(git -C "../$1" rev-parse HEAD)
+    if [ "$at" != "$(git rev-parse "$2^{commit}")" ]; then
+      log "../$1 is at ${at:0:7}, not $2: remove it (git worktree remove ../$1) or freeze $2 under another name"
+      exit 1
     fi
     ln -sf ../main/.venv "../$1/.venv"
     ln -sfn ../main/outputs "../$1/outputs"
@@ -166,7 +174,7 @@ matched_start() {  # matched_start CORE METHOD SEED: one pixels-matched-eval run
     cores=0,1 threads=2
     log "pixels-matched-eval ($2 $3): every other run is in the records, so both cores and 2 threads"
   fi
-  OMP_NUM_THREADS=$threads DEV=$DEV study pixels-matched-eval study-code-pixels-matched "$PIXELS_EVAL_COMMIT" \
+  OMP_NUM_THREADS=$threads DEV=$DEV study pixels-matched-eval "$MATCHED_TREE" "$PIXELS_EVAL_COMMIT" \
     "$cores" "$MATCHED_RUN" "$2" "$3"
 }
 

@@ -12,7 +12,7 @@
 # development study's result, before any run of this study). Give the development study's committed records and
 # report as DEV (run.sh's option), as experiments/resume.sh does.
 # From the study's frozen worktree, as experiments/resume.sh starts it:
-#   (cd ../study-code-pixels-matched && OMP_NUM_THREADS=1 PYTHONPATH=$PWD DEV=../main/experiments/pixels-dagger-epochs-dev \
+#   (cd ../study-code-pixels-matched-progress && OMP_NUM_THREADS=1 PYTHONPATH=$PWD DEV=../main/experiments/pixels-dagger-epochs-dev \
 #     taskset -c 0 bash ../main/experiments/pixels-matched-eval/one_run.sh need 0)
 set -euo pipefail
 METHOD=$1

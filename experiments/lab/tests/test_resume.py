@@ -86,6 +86,18 @@ def test_a_one_run_script_gets_its_arguments_in_the_frozen_worktree(checkout):
     assert (main.parent / "study-code-dev" / "outputs").resolve() == main / "outputs"
 
 
+def test_a_worktree_frozen_at_another_commit_is_refused(checkout):
+    """A study's code changes only under a new worktree name: an old one is never run as a new commit."""
+    main, commit, script = checkout
+    assert bash(f"worktree study-code-dev {commit}", main).returncode == 0
+    git = ["git", "-c", "user.name=t", "-c", "user.email=t@t", "-C", str(main)]
+    (main / "file").write_text("changed\n")
+    subprocess.run([*git, "commit", "-q", "-am", "d"], check=True)
+    result = bash(f"study dev study-code-dev HEAD 0 {script} fixed 100", main)
+    assert result.returncode == 1 and f"../study-code-dev is at {commit[:7]}, not HEAD" in result.stdout
+    assert not (main / "outputs" / "calls").exists()
+
+
 @pytest.mark.parametrize("second_core", [0, 1])
 def test_the_same_run_twice_is_refused_on_either_core(checkout, second_core):
     main, commit, script = checkout
