@@ -7,6 +7,7 @@ per-episode action queues and the per-task loss on their own; bad options refuse
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -358,6 +359,49 @@ def test_the_per_task_loss_of_a_lerobot_student_is_reproducible(act_run):
     again, _ = ops.task_losses(index, 3)
     assert first == again and sum(counts) == len(data)
     assert all(loss is not None and loss > 0 for loss in first)
+
+
+class CutError(Exception):
+    """Stands for the end of a process part-way through a phase."""
+
+
+def act_phase(act_run: Path, progress: Path | None = None, cut_after: int | None = None):
+    """65 steps of the trained ACT student on its run's frames, with task dropout (the seam's generator)."""
+    from lerobot_mtdagger.runner.normalise import NormalisedData
+    from lerobot_mtdagger.runner.phase_progress import PhaseProgress
+    from lerobot_mtdagger.runner.steps import StepOptions, train_phase
+    from lerobot_mtdagger.runner.train import RoundCache
+
+    experiment = ExperimentDir(act_run)
+    runner = PolicyRunner.from_pretrained(experiment.policy_root(2))
+    data = RoundCache().load([experiment.round_root(k) for k in range(3)], runner.input_keys)
+    normalised = NormalisedData(data, runner.preprocessor, [], ["toy-left", "toy-right", "toy-up-windy"])
+    options = StepOptions(steps=65, batch_size=16, lr=1e-3, seed=0, log_interval=10, task_dropout=0.5)
+    if progress is not None:
+        options = dataclasses.replace(options, progress=PhaseProgress(progress, {"round": 2}, 1e-9))
+
+    def on_step(done: int, _loss: float) -> None:
+        if cut_after is not None and done >= cut_after:
+            raise CutError
+
+    torch.manual_seed(0)
+    index = torch.arange(len(data))
+    result = train_phase(runner.policy, normalised, index, index[::5], options, on_step)
+    return runner.policy.state_dict(), result
+
+
+def test_a_lerobot_students_phase_cut_part_way_resumes_to_the_uninterrupted_phase(act_run, tmp_path):
+    """ACT draws from the global random state (dropout, its VAE) and the seam's own (task dropout)."""
+    reference_weights, reference = act_phase(act_run)
+    progress = tmp_path / "round-002.pt"
+    with pytest.raises(CutError):
+        act_phase(act_run, progress, cut_after=30)
+    assert list(torch.load(progress, weights_only=True)["seam_rngs"]) == ["generator"]
+    weights, resumed = act_phase(act_run, progress)
+    assert resumed.resumed_after_steps == [20]
+    assert dataclasses.replace(resumed, resumed_after_steps=[]) == reference
+    for name, tensor in reference_weights.items():
+        assert torch.equal(tensor, weights[name]), name
 
 
 # -------------------------------------------------------------------------------------------------

@@ -218,7 +218,7 @@ def train_on_rounds(
         task_dropout=getattr(policy_cfg, "task_dropout", 0.0),
     )
     if progress_path is not None:
-        key = phase_key(round_index, policy_cfg.type, options, split.train)
+        key = phase_key(round_index, config.student_type, options, split.train)
         options = replace(
             options, progress=PhaseProgress(progress_path, key, config.training.progress_every_s)
         )
