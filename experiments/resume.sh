@@ -39,7 +39,7 @@
 set -uo pipefail
 
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
-PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-3340fca}  # pixels-matched-eval's code: its README, "Round 0 shared"
+PIXELS_EVAL_COMMIT=${PIXELS_EVAL_COMMIT:-51623d0}  # pixels-matched-eval's code: its README, "Round 0 shared"
 MATCHED_TREE=${MATCHED_TREE:-study-code-pixels-matched-progress}  # its worktree ("Phases resume mid-way")
 ONE_RUN=${ONE_RUN:-$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh}  # read as it runs: do not edit meanwhile
 MATCHED_RUN=${MATCHED_RUN:-$PWD/experiments/pixels-matched-eval/one_run.sh}  # read as it runs: do not edit meanwhile
