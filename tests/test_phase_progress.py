@@ -180,7 +180,7 @@ def test_a_run_killed_mid_phase_resumes_from_the_saved_progress_to_the_uninterru
 
     experiment = ExperimentDir(killed)
     assert verify_experiment(experiment) == (2, 2, [])
-    assert not progress.exists() and not any(progress.parent.iterdir())  # deleted at commit
+    assert not progress.parent.exists()  # deleted at commit
     records = {
         r: json.loads((ExperimentDir(r).policy_root(1) / "training.json").read_text())
         for r in (reference, killed)

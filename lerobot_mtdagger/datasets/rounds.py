@@ -417,7 +417,7 @@ class ExperimentDir:
                 logger.info("Discarding unfinished work in %s", staging)
                 shutil.rmtree(staging)
         for round_index in self.committed_phases():
-            self.phase_progress_path(round_index).unlink(missing_ok=True)
+            self.discard_phase_progress(round_index)
 
     # ---------------------------------------------------------------------------------------------
     # Rounds
@@ -588,8 +588,15 @@ class ExperimentDir:
             raise FileExistsError(f"Training phase {round_index} is already committed at {final}.")
         os.replace(staging, final)
         self.update_ledger()
-        self.phase_progress_path(round_index).unlink(missing_ok=True)
+        self.discard_phase_progress(round_index)
         return final
+
+    def discard_phase_progress(self, round_index: int) -> None:
+        """Deletes a phase's saved progress, and its folder once it holds no other."""
+        path = self.phase_progress_path(round_index)
+        path.unlink(missing_ok=True)
+        if path.parent.is_dir() and not any(path.parent.iterdir()):
+            path.parent.rmdir()
 
     # ---------------------------------------------------------------------------------------------
     # The ledger (datasets/ledger.py)
