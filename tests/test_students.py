@@ -366,7 +366,7 @@ class CutError(Exception):
 
 
 def act_phase(act_run: Path, progress: Path | None = None, cut_after: int | None = None):
-    """65 steps of the trained ACT student on its run's frames, with task dropout (the seam's generator)."""
+    """45 steps of the trained ACT student on its run's frames, with task dropout (the seam's generator)."""
     from lerobot_mtdagger.runner.normalise import NormalisedData
     from lerobot_mtdagger.runner.phase_progress import PhaseProgress
     from lerobot_mtdagger.runner.steps import StepOptions, train_phase
@@ -376,7 +376,7 @@ def act_phase(act_run: Path, progress: Path | None = None, cut_after: int | None
     runner = PolicyRunner.from_pretrained(experiment.policy_root(2))
     data = RoundCache().load([experiment.round_root(k) for k in range(3)], runner.input_keys)
     normalised = NormalisedData(data, runner.preprocessor, [], ["toy-left", "toy-right", "toy-up-windy"])
-    options = StepOptions(steps=65, batch_size=16, lr=1e-3, seed=0, log_interval=10, task_dropout=0.5)
+    options = StepOptions(steps=45, batch_size=8, lr=1e-3, seed=0, log_interval=10, task_dropout=0.5)
     if progress is not None:
         options = dataclasses.replace(options, progress=PhaseProgress(progress, {"round": 2}, 1e-9))
 
@@ -386,7 +386,7 @@ def act_phase(act_run: Path, progress: Path | None = None, cut_after: int | None
 
     torch.manual_seed(0)
     index = torch.arange(len(data))
-    result = train_phase(runner.policy, normalised, index, index[::5], options, on_step)
+    result = train_phase(runner.policy, normalised, index, index[::40], options, on_step)
     return runner.policy.state_dict(), result
 
 
