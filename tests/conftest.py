@@ -1,12 +1,28 @@
-"""Shared test factories."""
+"""Shared test factories, and one torch thread per pytest-xdist worker."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Gives each pytest-xdist worker, and the runs it starts, one thread.
+
+    The workers take every core; two threads per process beside another busy one trained many times
+    slower (``studies.compare.run_resources``). ``-n 0`` keeps torch's default.
+    """
+    del config
+    if os.environ.get("PYTEST_XDIST_WORKER") is None:
+        return
+    os.environ["OMP_NUM_THREADS"] = os.environ["MKL_NUM_THREADS"] = "1"
+    import torch
+
+    torch.set_num_threads(1)
 
 
 def record_expert_dataset(
