@@ -14,11 +14,10 @@ from pathlib import Path
 
 import pytest
 import torch
-from lerobot.configs.types import FeatureType, PolicyFeature
 
 from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
-from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
+from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.phase_progress import PhaseProgress, phase_key
@@ -26,7 +25,8 @@ from lerobot_mtdagger.runner.plateau import PlateauStop
 from lerobot_mtdagger.runner.steps import StepOptions, train_phase
 from lerobot_mtdagger.utils.parsing import parse_options
 from tests.helpers import kill_9_and_check_workers_end
-from tests.test_train import ACTION_DIM, STATE_DIM, TASKS, normalised, synthetic_data
+from tests.test_toy import TOY_RUN
+from tests.test_train import normalised, small_policy, synthetic_data
 
 EVERY_INTERVAL = 1e-9
 """``every_s`` that saves the progress at the start of every log interval."""
@@ -38,21 +38,7 @@ class CutError(Exception):
 
 def dropout_policy() -> MTDAggerPolicy:
     """A small policy that draws from the global random state at every step (dropout, task dropout)."""
-    config = MTDAggerConfig(
-        device="cpu",
-        task_names=list(TASKS),
-        input_features={"observation.state": PolicyFeature(type=FeatureType.STATE, shape=(STATE_DIM,))},
-        output_features={"action": PolicyFeature(type=FeatureType.ACTION, shape=(ACTION_DIM,))},
-        state_hidden_dims=(32,),
-        state_embedding_dim=32,
-        head_hidden_dims=(32,),
-        task_embedding_dim=8,
-        dropout=0.2,
-        task_dropout=0.3,
-        push_to_hub=False,
-    )
-    torch.manual_seed(0)
-    return MTDAggerPolicy(config)
+    return small_policy(dropout=0.2, task_dropout=0.3)
 
 
 def phase(
@@ -148,19 +134,8 @@ def test_a_plateau_phase_and_every_s_zero_never_save_progress(tmp_path):
     assert not saved.exists() and not never.exists()
 
 
-TOY_LONG_PHASES = [
-    "--suite.name=toy",
-    "--dagger.rounds=1",
-    "--dagger.initial_demos=1",
-    "--dagger.budget_per_task=2",
-    "--training.steps_per_round=1500",  # a phase of seconds, so that the kill lands in it
-    "--rollout.eval_episodes=2",
-    "--rollout.max_steps=40",
-    "--policy.batch_size=32",
-    "--policy.state_hidden_dims=[32]",
-    "--policy.head_hidden_dims=[32]",
-    "--progress=false",
-]
+TOY_LONG_PHASES = [*TOY_RUN, "--dagger.rounds=1", "--training.steps_per_round=1500"]
+"""One DAgger round, phases of seconds so that the kill lands in one."""
 
 
 def test_a_run_killed_mid_phase_resumes_from_the_saved_progress_to_the_uninterrupted_run(tmp_path):

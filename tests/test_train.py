@@ -31,7 +31,8 @@ ACTION_DIM = 2
 # ---------------------------------------------------------------------------------------------
 
 
-def small_policy(seed: int = 0, tasks: list[str] | None = None) -> MTDAggerPolicy:
+def small_policy(seed: int = 0, tasks: list[str] | None = None, **options) -> MTDAggerPolicy:
+    """A small ``mtdagger`` policy over the synthetic frames (``options``: more config fields)."""
     config = MTDAggerConfig(
         device="cpu",
         task_names=list(tasks or TASKS),
@@ -42,6 +43,7 @@ def small_policy(seed: int = 0, tasks: list[str] | None = None) -> MTDAggerPolic
         head_hidden_dims=(32,),
         task_embedding_dim=8,
         push_to_hub=False,
+        **options,
     )
     torch.manual_seed(seed)
     return MTDAggerPolicy(config)
