@@ -41,7 +41,7 @@ class SavedProgress:
 
     Attributes:
         done: Steps taken.
-        state: The rest, for ``StepLoop.restore``.
+        state: The rest, for ``restore_loop``.
         steps_s: Seconds the earlier processes spent in these steps.
     """
 
