@@ -592,9 +592,10 @@ class ExperimentDir:
         return final
 
     def discard_phase_progress(self, round_index: int) -> None:
-        """Deletes a phase's saved progress, and its folder once it holds no other."""
+        """Deletes a phase's saved progress (and one cut off while written), and its folder once empty."""
         path = self.phase_progress_path(round_index)
         path.unlink(missing_ok=True)
+        path.with_name(path.name + ".partial").unlink(missing_ok=True)
         if path.parent.is_dir() and not any(path.parent.iterdir()):
             path.parent.rmdir()
 
