@@ -51,6 +51,7 @@ from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digest
 from lerobot_mtdagger.datasets.layout import (
     CONFIG_FILE,
     LOCK_FILE,
+    PARTIAL_SUFFIX,
     POLICIES_DIR,
     PROGRESS_DIR,
     ROUNDS_DIR,
@@ -595,7 +596,7 @@ class ExperimentDir:
         """Deletes a phase's saved progress (and one cut off while written), and its folder once empty."""
         path = self.phase_progress_path(round_index)
         path.unlink(missing_ok=True)
-        path.with_name(path.name + ".partial").unlink(missing_ok=True)
+        path.with_name(path.name + PARTIAL_SUFFIX).unlink(missing_ok=True)
         if path.parent.is_dir() and not any(path.parent.iterdir()):
             path.parent.rmdir()
 

@@ -29,6 +29,8 @@ from typing import Any
 
 import torch
 
+from lerobot_mtdagger.datasets.layout import PARTIAL_SUFFIX
+
 logger = logging.getLogger(__name__)
 
 FORMAT = 1
@@ -73,7 +75,7 @@ class PhaseProgress:
     def save(self, done: int, state: dict[str, Any], steps_s: float) -> None:
         """Writes the progress after ``done`` steps (a temporary file, then an atomic rename)."""
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        partial = self.path.with_name(self.path.name + ".partial")
+        partial = self.path.with_name(self.path.name + PARTIAL_SUFFIX)
         torch.save({"format": FORMAT, "key": self.key, "done": done, "steps_s": steps_s, **state}, partial)
         os.replace(partial, self.path)
         self.last_save = time.perf_counter()
@@ -104,7 +106,7 @@ class PhaseProgress:
     def discard(self) -> None:
         """Deletes the saved progress (the phase is committed, or the file is of no use)."""
         self.path.unlink(missing_ok=True)
-        self.path.with_name(self.path.name + ".partial").unlink(missing_ok=True)
+        self.path.with_name(self.path.name + PARTIAL_SUFFIX).unlink(missing_ok=True)
 
     def _discard(self, why: str) -> None:
         logger.warning("Discarding %s: %s; the phase starts over.", self.path, why)
