@@ -22,9 +22,12 @@
 # its report.sh (the reports and table that pixels-matched-eval's gate reads, DEV below). Then
 # pixels-matched-eval one run at a time (its one_run.sh: run.sh's gate first; it runs because its
 # gate-deviation.md says why, though the development rule proposed no rerun; each run as long as an
-# epochs run), seed 0 on core 0, seed 1 on core 1, seed 2 split. Nine runs on two cores leave one core
-# idle for the last run: when every other run of the study is in its records, that run gets both cores
-# (2 torch threads, as pixels-dagger-epochs-dev's seed 102 had; threads change floating-point sums only).
+# epochs run), each run on both cores with 2 torch threads (decided 2026-11-30 11:00; until then one
+# run per core, the last on both): on two cores a pixel phase went 1.8-1.9x faster than on one core beside
+# another run (../pixels-dagger-epochs-dev, "How it ran"), so the study's pace is nearly the same, and a
+# run ends inside one session on either machine (about 1.5 hours on an AVX-512 one, 2.3 on an AVX2 one),
+# where two runs side by side, 2.75 and 4 hours, end together or not at all when a machine keeps no
+# outputs/ (threads change floating-point sums only). A run cut by a stop resumes first.
 # With SESSION_END set (a UTC time, e.g. SESSION_END=09:50), a run that would not end before it is put
 # off: the chain runs the ones that fit first, then the ones it put off, in order (a stop cuts them;
 # `compare` resumes them if outputs/ is kept, and nothing else would use the core meanwhile). A run is
@@ -36,6 +39,7 @@
 #   - with AVX2 only (2026-11-29): a fixed phase took about 23 min (1 500 steps 223-230 s, a 20-episode
 #     evaluation 710-750 s, 1.7x and 1.6x the other machine), so a fixed run takes about 2.3 hours and
 #     an epochs run about 4 (estimated: seed 100's phases at those ratios): longer than a session.
+# BOTH_MIN: an epochs run on both cores, those times over 1.8 (less for one that copies its round 0).
 set -uo pipefail
 
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
@@ -44,10 +48,8 @@ MATCHED_TREE=${MATCHED_TREE:-study-code-pixels-matched-progress}  # its worktree
 ONE_RUN=${ONE_RUN:-$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh}  # read as it runs: do not edit meanwhile
 MATCHED_RUN=${MATCHED_RUN:-$PWD/experiments/pixels-matched-eval/one_run.sh}  # read as it runs: do not edit meanwhile
 DEV=${DEV:-$PWD/experiments/pixels-dagger-epochs-dev}  # its records/ and, once report.sh has run, report/
-MATCHED_RECORDS=${MATCHED_RECORDS:-$PWD/experiments/pixels-matched-eval/records}  # seed*/runs-records.tar.gz
-MATCHED_DONE=${MATCHED_DONE:-$PWD/experiments/pixels-matched-eval/run_done.sh}  # whether one run is done
-if grep -qw avx512f /proc/cpuinfo; then FIXED_MIN=${FIXED_MIN:-75} EPOCHS_MIN=${EPOCHS_MIN:-165}
-else FIXED_MIN=${FIXED_MIN:-145} EPOCHS_MIN=${EPOCHS_MIN:-250}; fi  # minutes a run takes (above)
+if grep -qw avx512f /proc/cpuinfo; then FIXED_MIN=${FIXED_MIN:-75} EPOCHS_MIN=${EPOCHS_MIN:-165} BOTH_MIN=${BOTH_MIN:-95}
+else FIXED_MIN=${FIXED_MIN:-145} EPOCHS_MIN=${EPOCHS_MIN:-250} BOTH_MIN=${BOTH_MIN:-140}; fi  # minutes a run takes (above)
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
@@ -152,30 +154,14 @@ dev_report() {  # pixels-dagger-epochs-dev's reports and table (report.sh), once
     >> outputs/pixels-dagger-epochs-dev.log 2>&1
 }
 
-matched_run() {  # matched_run CORE METHOD SEED MINUTES: matched_start, or put off if it would not fit
-  later_if_long "$4" matched_start "$1" "$2" "$3" || return 1
-  matched_start "$1" "$2" "$3"
+matched_run() {  # matched_run METHOD SEED: matched_start, or put off if it would not fit
+  later_if_long "$BOTH_MIN" matched_start "$1" "$2" || return 1
+  matched_start "$1" "$2"
 }
 
-matched_others_done() {  # matched_others_done METHOD SEED: every other run of the study is in its records
-  local method seed
-  for seed in 0 1 2; do
-    for method in uniform need gain; do
-      [ "$method $seed" = "$1 $2" ] && continue
-      bash "$MATCHED_DONE" "$method" "$seed" "$MATCHED_RECORDS" || return 1
-    done
-  done
-}
-
-matched_start() {  # matched_start CORE METHOD SEED: one pixels-matched-eval run (its one_run.sh) on CORE
-  # The study's last run (every other one in its records, so the other core has nothing left) gets both.
-  local cores=$1 threads=1
-  if matched_others_done "$2" "$3"; then
-    cores=0,1 threads=2
-    log "pixels-matched-eval ($2 $3): every other run is in the records, so both cores and 2 threads"
-  fi
-  OMP_NUM_THREADS=$threads DEV=$DEV study pixels-matched-eval "$MATCHED_TREE" "$PIXELS_EVAL_COMMIT" \
-    "$cores" "$MATCHED_RUN" "$2" "$3"
+matched_start() {  # matched_start METHOD SEED: one pixels-matched-eval run (its one_run.sh) on both cores
+  OMP_NUM_THREADS=2 DEV=$DEV study pixels-matched-eval "$MATCHED_TREE" "$PIXELS_EVAL_COMMIT" 0,1 \
+    "$MATCHED_RUN" "$1" "$2"
 }
 
 if [ "${BASH_SOURCE[0]}" != "$0" ]; then return 0; fi  # sourced (its tests): functions only
@@ -185,14 +171,15 @@ mkdir -p outputs
   dev_run 0 fixed 100 "$FIXED_MIN"
   dev_run 0 fixed 101 "$FIXED_MIN"
   dev_report || PUT_OFF+=(dev_report)
-  for method in uniform need gain; do matched_run 0 "$method" 0 "$EPOCHS_MIN"; done
-  matched_run 0 uniform 2 "$EPOCHS_MIN"
-  matched_run 0 need 2 "$EPOCHS_MIN"
   run_put_off) &
 (dev_run 1 epochs 102 "$EPOCHS_MIN"
   dev_run 1 fixed 102 "$FIXED_MIN"
   dev_report || PUT_OFF+=(dev_report)
-  for method in uniform need gain; do matched_run 1 "$method" 1 "$EPOCHS_MIN"; done
-  matched_run 1 gain 2 "$EPOCHS_MIN"
   run_put_off) &
 wait
+# Seeds 0 and 1 first (uniform's are done; a run the last stop cut resumes first), then seed 2 with
+# uniform first, whose round 0 need and gain copy.
+for run in "uniform 0" "uniform 1" "need 0" "need 1" "gain 0" "gain 1" "uniform 2" "need 2" "gain 2"; do
+  matched_run $run  # METHOD SEED
+done
+run_put_off

@@ -159,7 +159,7 @@ def test_the_development_report_waits_for_all_six_runs(tmp_path):
     assert (main / "outputs" / "reported").exists()
 
 
-def test_the_queue_runs_what_fits_first_then_what_it_put_off_on_each_core(checkout, tmp_path):
+def test_the_queue_puts_off_what_does_not_fit_then_runs_matched_runs_on_both_cores(checkout, tmp_path):
     main, commit, script = checkout
     script.write_text('echo "$(grep Cpus_allowed_list /proc/self/status | cut -f2) $*" >> outputs/calls\n')
     result = subprocess.run(
@@ -171,6 +171,7 @@ def test_the_queue_runs_what_fits_first_then_what_it_put_off_on_each_core(checko
             "SESSION_END": in_minutes(60),
             "FIXED_MIN": "30",
             "EPOCHS_MIN": "500",
+            "BOTH_MIN": "500",
             "PIXELS_COMMIT": commit,
             "PIXELS_EVAL_COMMIT": commit,
             "ONE_RUN": str(script),
@@ -183,18 +184,23 @@ def test_the_queue_runs_what_fits_first_then_what_it_put_off_on_each_core(checko
     )
     assert result.returncode == 0, result.stdout + result.stderr
     calls = (main / "outputs" / "calls").read_text().splitlines()
-    by_core = {core: [call.split(maxsplit=1)[1] for call in calls if call.startswith(core)] for core in "01"}
-    assert by_core["0"] == [
-        "fixed 100",
-        "fixed 101",
-        "epochs 101",
+    by_core = {c: [call.split(maxsplit=1)[1] for call in calls if call.split()[0] == c] for c in "01"}
+    assert by_core["0"] == ["fixed 100", "fixed 101", "epochs 101"]
+    assert by_core["1"] == ["fixed 102", "epochs 102"]
+    matched = [call.split(maxsplit=1)[1] for call in calls if call.split()[0] == "0-1"]
+    assert matched == [
         "uniform 0",
+        "uniform 1",
         "need 0",
+        "need 1",
         "gain 0",
+        "gain 1",
         "uniform 2",
         "need 2",
-    ]
-    assert by_core["1"] == ["fixed 102", "epochs 102", "uniform 1", "need 1", "gain 1", "gain 2"]
+        "gain 2",
+    ]  # one at a time, after the development steps of both cores
+    assert calls[-len(matched) :] == [f"0-1 {run}" for run in matched]
+    assert result.stdout.count("put off: about 500 min") == 11  # the 2 epochs runs and the 9 matched runs
     assert result.stdout.count("not in its records yet") == 4  # each core's report: when due, and again
 
 
@@ -217,38 +223,12 @@ def test_the_development_report_waits_for_a_run_another_chain_is_running(tmp_pat
     assert (main / "outputs" / "reported").exists()
 
 
-def matched_records(root: Path, missing: set[tuple[str, int]]) -> Path:
-    """Stand-in pixels-matched-eval records: each seed's archive holds every run's phase 5 but
-    ``missing``'s."""
-    for seed in (0, 1, 2):
-        runs = root / "unpacked" / f"seed{seed}"
-        for method in ("uniform", "need", "gain"):
-            if (method, seed) not in missing:
-                last = runs / f"{method}-seed{seed}" / "policies" / "round-005"
-                last.mkdir(parents=True)
-                (last / "training.json").write_text('{"round": 5, "eval": {}}')
-        (root / f"seed{seed}").mkdir(parents=True)
-        runs.mkdir(parents=True, exist_ok=True)
-        archive = root / f"seed{seed}" / "runs-records.tar.gz"
-        subprocess.run(["tar", "czf", str(archive), "-C", str(runs), "."], check=True)
-    return root
-
-
 @pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="needs two cores to pin a run to both")
-@pytest.mark.parametrize(
-    ("missing", "cores", "threads"),
-    [({("need", 2)}, "0-1", "2"), ({("need", 2), ("gain", 2)}, "0", "1")],
-)
-def test_the_studys_last_run_gets_both_cores_and_no_other_does(checkout, tmp_path, missing, cores, threads):
+def test_every_matched_run_gets_both_cores_and_two_threads(checkout):
     main, commit, script = checkout
     script.write_text(
         'echo "$(grep Cpus_allowed_list /proc/self/status | cut -f2) $OMP_NUM_THREADS $*" >> outputs/calls\n'
     )
-    records = matched_records(tmp_path / "records", missing)
-    done = RESUME.parent / "pixels-matched-eval" / "run_done.sh"
-    options = f"MATCHED_RUN={script} MATCHED_RECORDS={records} MATCHED_DONE={done}"
-    step = f"{options} PIXELS_EVAL_COMMIT={commit}\nmatched_start 0 need 2"
-    result = bash(step, main)
+    result = bash(f"MATCHED_RUN={script} PIXELS_EVAL_COMMIT={commit}\nmatched_start need 0", main)
     assert result.returncode == 0, result.stdout + result.stderr
-    assert (main / "outputs" / "calls").read_text().split() == [cores, threads, "need", "2"]
-    assert ("both cores and 2 threads" in result.stdout) is (cores == "0-1")
+    assert (main / "outputs" / "calls").read_text().split() == ["0-1", "2", "need", "0"]
