@@ -25,7 +25,7 @@
 # epochs run), each run on both cores with 2 torch threads (decided 2026-11-30 11:00; until then one
 # run per core, the last on both): on two cores a pixel phase went 1.8-1.9x faster than on one core beside
 # another run (../pixels-dagger-epochs-dev, "How it ran"), so the study's pace is nearly the same, and a
-# run ends inside one session on either machine (about 1.5 hours on an AVX-512 one, 2.3 on an AVX2 one),
+# run ends inside one session on either machine (about 1 hour on an AVX-512 one, 1.7 on an AVX2 one),
 # where two runs side by side, 2.75 and 4 hours, end together or not at all when a machine keeps no
 # outputs/ (threads change floating-point sums only). A run cut by a stop resumes first.
 # With SESSION_END set (a UTC time, e.g. SESSION_END=09:50), a run that would not end before it is put
@@ -39,7 +39,8 @@
 #   - with AVX2 only (2026-11-29): a fixed phase took about 23 min (1 500 steps 223-230 s, a 20-episode
 #     evaluation 710-750 s, 1.7x and 1.6x the other machine), so a fixed run takes about 2.3 hours and
 #     an epochs run about 4 (estimated: seed 100's phases at those ratios): longer than a session.
-# BOTH_MIN: an epochs run on both cores, those times over 1.8 (less for one that copies its round 0).
+# BOTH_MIN: an epochs run on both cores: 57 minutes for phases 1-5 of need seed 0 on the AVX-512
+# machine (2026-11-30, docs/benchmarks.md), about 1.7x that on the AVX2 one (estimated).
 set -uo pipefail
 
 PIXELS_COMMIT=${PIXELS_COMMIT:-a10a67e}  # the commit that added pixels-dagger-epochs-dev
@@ -48,8 +49,8 @@ MATCHED_TREE=${MATCHED_TREE:-study-code-pixels-matched-progress}  # its worktree
 ONE_RUN=${ONE_RUN:-$PWD/experiments/pixels-dagger-epochs-dev/one_run.sh}  # read as it runs: do not edit meanwhile
 MATCHED_RUN=${MATCHED_RUN:-$PWD/experiments/pixels-matched-eval/one_run.sh}  # read as it runs: do not edit meanwhile
 DEV=${DEV:-$PWD/experiments/pixels-dagger-epochs-dev}  # its records/ and, once report.sh has run, report/
-if grep -qw avx512f /proc/cpuinfo; then FIXED_MIN=${FIXED_MIN:-75} EPOCHS_MIN=${EPOCHS_MIN:-165} BOTH_MIN=${BOTH_MIN:-95}
-else FIXED_MIN=${FIXED_MIN:-145} EPOCHS_MIN=${EPOCHS_MIN:-250} BOTH_MIN=${BOTH_MIN:-140}; fi  # minutes a run takes (above)
+if grep -qw avx512f /proc/cpuinfo; then FIXED_MIN=${FIXED_MIN:-75} EPOCHS_MIN=${EPOCHS_MIN:-165} BOTH_MIN=${BOTH_MIN:-65}
+else FIXED_MIN=${FIXED_MIN:-145} EPOCHS_MIN=${EPOCHS_MIN:-250} BOTH_MIN=${BOTH_MIN:-110}; fi  # minutes a run takes (above)
 
 log() { echo "$(date -u +%FT%H:%M:%S) $*"; }
 
