@@ -15,7 +15,9 @@ result. Two uses (``lab`` on the path: ``PYTHONPATH=experiments``), from the rep
   reads ``FOLDER/decision.txt`` and the runs in ``FOLDER/seed<k>/runs/``; without, the saved records
   here (``save_records.sh``): ``records/decision.txt`` and ``records/seed<k>/runs-records.tar.gz``.
   BC and the earlier protocol are read from ``../pixels-eval/records/``. Every outcome says
-  "not finished" until all 9 runs (uniform, need, gain x seeds 0-2) have their phases 0-5.
+  "not finished" until all 9 runs (uniform, need, gain x seeds 0-2) have their phases 0-5. Where the
+  gate proposed no rerun and ``gate-deviation.md`` says why the runs ran anyway (``one_run.sh``'s
+  condition), it prints the gate's answer, then the outcomes, each reading marked as run by it.
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ HERE = Path(__file__).resolve().parent
 RECORDS = HERE / "records"
 PIXELS_EVAL_RECORDS = HERE.parent / "pixels-eval" / "records"
 DECISION_FILE = "decision.txt"
+DEVIATION = HERE / "gate-deviation.md"  # why the runs ran though the gate proposed no rerun
 PRESET = "metaworld-pixels"
 METHODS = ("uniform", "need", "gain")
 SEEDS = (0, 1, 2)
@@ -388,6 +391,7 @@ def outcome_lines(
     earlier: Runs,
     hardest: Mapping[int, list[int]],
     blocked: str | None,
+    caveat: str = "",
 ) -> list[str]:
     """One outcome under matched training, its reading, and pixels-eval's number beside it.
 
@@ -397,6 +401,7 @@ def outcome_lines(
         earlier: pixels-eval's runs.
         hardest: Each seed's hardest tasks.
         blocked: Why no number is given yet (``not finished (...)``), or ``None``.
+        caveat: Appended to the reading (the gate deviation, where the runs ran by it).
     """
     earlier_line = paired_line(f"  {EARLIER}", pairs(earlier, comparison, hardest))
     if blocked is not None:
@@ -404,7 +409,7 @@ def outcome_lines(
     values = pairs(matched, comparison, hardest)
     first, second = zip(*values, strict=True)
     interval = paired_difference(first, second)
-    return [paired_line(comparison.name, values), f"  reading: {reading(interval)}", earlier_line]
+    return [paired_line(comparison.name, values), f"  reading: {reading(interval)}{caveat}", earlier_line]
 
 
 def success_table(matched: Runs, earlier: Runs) -> list[str]:
@@ -500,12 +505,40 @@ def loss_table(study: Runs, tasks: Sequence[str]) -> list[str]:
     return lines
 
 
-def report(decision_text: str, study: Runs, earlier: Runs) -> list[str]:
-    """Everything ``table.py [FOLDER]`` prints, as lines (the gate first)."""
+def deviation_lines(decided: Gate, deviation: Path | None) -> tuple[list[str], str] | None:
+    """The lines saying the runs ran by ``deviation`` though the gate said no, and each reading's caveat.
+
+    ``None`` where the gate's answer stands (it ran them, the preset stays fixed, or no deviation file):
+    the cases ``one_run.sh`` runs by are the ones reported here.
+    """
+    if decided.run or deviation is None or DEV_NOT_PROPOSED not in decided.line:
+        return None
+    lines = [
+        f"Gate (run.sh, pre-specified): {decided.line}",
+        f"The runs ran anyway, by a deviation declared after the development result and before any run "
+        f"({deviation.name}); every reading below carries it.",
+    ]
+    return lines, f" [run by the gate deviation, {deviation.name}]"
+
+
+def report(decision_text: str, study: Runs, earlier: Runs, deviation: Path | None = None) -> list[str]:
+    """Everything ``table.py [FOLDER]`` prints, as lines (the gate first).
+
+    Args:
+        decision_text: The development study's decision (``decision.txt``).
+        study: This study's runs.
+        earlier: pixels-eval's runs.
+        deviation: The file that says why the runs ran though the gate proposed no rerun, if it exists.
+    """
     decided = gate(decision_text)
     lines = [line for line in decision_text.splitlines() if line.startswith("Decision: ")]
+    caveat = ""
     if not decided.run:
-        return [*lines, f"Verdict: {decided.line}"]
+        by_deviation = deviation_lines(decided, deviation)
+        if by_deviation is None:
+            return [*lines, f"Verdict: {decided.line}"]
+        lines += by_deviation[0]
+        caveat = by_deviation[1]
     tasks = task_names(earlier)
     hardest = hardest_tasks(earlier)
     matched = Runs(dagger=study.dagger, bc=earlier.bc)
@@ -524,7 +557,7 @@ def report(decision_text: str, study: Runs, earlier: Runs) -> list[str]:
         blocked = f"{NOT_FINISHED} (missing: {'; '.join(missing)})" if missing else None
         if blocked is None and problems and comparison.baseline == "bc":
             blocked = "not read: the BC reuse check fails (above)"
-        lines += outcome_lines(comparison, matched, earlier, hardest, blocked)
+        lines += outcome_lines(comparison, matched, earlier, hardest, blocked, caveat)
     lines += [
         "",
         "Passes per phase, this study (passes per task: the frames its steps drew over its frames):",
@@ -556,7 +589,8 @@ def main(argv: Sequence[str]) -> int:
         return 0
     study = read_runs(study_run_folders(folder))
     earlier = read_runs(saved_records_runs(PIXELS_EVAL_RECORDS))
-    print("\n".join(report(decision_file.read_text(), study, earlier)))
+    deviation = DEVIATION if DEVIATION.is_file() else None
+    print("\n".join(report(decision_file.read_text(), study, earlier, deviation)))
     return 0
 
 

@@ -469,3 +469,32 @@ def test_a_negative_or_missing_decision(table, tmp_path, capsys):
     (tmp_path / "decision.txt").write_text(stays)
     lines = printed(table, capsys, str(tmp_path))
     assert lines[-1].startswith(f"Verdict: {NOT_RUN} (the preset stays fixed), so this study is not run.")
+
+
+NOT_PROPOSED = DECIDED.replace("a pixels-eval rerun is proposed", "a pixels-eval rerun is not proposed")
+
+
+def test_runs_made_by_the_gate_deviation_are_reported_with_it(table, stand_in, tmp_path, capsys, monkeypatch):
+    """The gate proposed no rerun, the runs ran by gate-deviation.md: the outcomes, each marked."""
+    (stand_in / "decision.txt").write_text(NOT_PROPOSED)
+    deviation = tmp_path / "gate-deviation.md"
+    deviation.write_text("why\n")
+    monkeypatch.setattr(table, "DEVIATION", deviation)
+    lines = printed(table, capsys, str(stand_in))
+    assert lines[1].startswith(f"Gate (run.sh, pre-specified): {NOT_RUN} (the DAgger phases switch to epochs")
+    assert "(gate-deviation.md); every reading below carries it." in lines[2]
+    marked = " [run by the gate deviation, gate-deviation.md]"
+    assert [line for line in OUTCOMES if line.startswith("primary")] == [
+        line for line in lines if line.startswith("primary")
+    ]
+    assert f"  reading: reproduced (the interval is above 0){marked}" in lines
+    readings = [line for line in lines if line.startswith("  reading: ")]
+    assert len(readings) == 8 and all(line.endswith(marked) for line in readings)
+
+
+def test_without_the_deviation_file_the_gate_stands(table, stand_in, tmp_path, capsys, monkeypatch):
+    (stand_in / "decision.txt").write_text(NOT_PROPOSED)
+    monkeypatch.setattr(table, "DEVIATION", tmp_path / "no-such-file.md")
+    lines = printed(table, capsys, str(stand_in))
+    assert lines[-1].startswith(f"Verdict: {NOT_RUN} (the DAgger phases switch to epochs")
+    assert not any(line.startswith("primary") for line in lines)
