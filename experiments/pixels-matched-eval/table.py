@@ -60,8 +60,10 @@ CLAIM_SIZE = 0.05  # docs/results.md, "Verdicts": an interval narrow enough, abo
 MATCHED = {"training.steps_rule": "epochs", "training.epochs": 10.0}
 BC_TRAINING = {"training.sampling": "balanced", "training.steps_rule": "fixed"}
 RUN_SPECIFIC = frozenset(
-    {"mode", "output_dir", "seed", "resume", "progress", "scheduler.type", "dagger.rounds"}
-)  # options that name a run rather than its training (BC at the budget of round k has k rounds)
+    {"mode", "output_dir", "seed", "resume", "progress", "scheduler.type", "dagger.rounds", "rollout.workers"}
+)  # options that name a run rather than its training (BC at the budget of round k has k rounds), and
+# the env worker count, which `compare` sets from the run's cores and which changes no collection or
+# evaluation (tests/test_workers.py): the runs on both cores store 2 where pixels-eval's BC stored 0
 FROM_COMMAND_LINE = frozenset({"dagger.rounds", "rollout.eval_episodes"})  # not the preset's values
 NOT_FINISHED = "not finished"
 EARLIER = "earlier protocol (pixels-eval, 1 500 fixed steps per phase)"

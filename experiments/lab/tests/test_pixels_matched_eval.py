@@ -498,3 +498,14 @@ def test_without_the_deviation_file_the_gate_stands(table, stand_in, tmp_path, c
     lines = printed(table, capsys, str(stand_in))
     assert lines[-1].startswith(f"Verdict: {NOT_RUN} (the DAgger phases switch to epochs")
     assert not any(line.startswith("primary") for line in lines)
+
+
+def test_a_run_on_both_cores_passes_the_bc_reuse_check(table, stand_in, capsys):
+    """`compare` gives a run on two cores 2 env workers, which change no result (tests/test_workers.py)."""
+    path = stand_in / "seed2" / "runs" / "gain-seed2" / "config.json"
+    on_two_cores = json.loads(path.read_text())
+    on_two_cores["rollout"]["workers"] = 2
+    path.write_text(json.dumps(on_two_cores))
+    lines = printed(table, capsys, str(stand_in))
+    assert any(line.startswith("BC reuse check") and line.endswith(": holds") for line in lines)
+    assert OUTCOMES[0] in lines
