@@ -34,8 +34,20 @@ resume() {
   echo "$line"
   mkdir -p "$(dirname "$LOG")" && echo "$line" >> "$LOG"
 }
+wait_stopped() {  # until each paused process is stopped, at most about 5 s in all: a process handles
+  # SIGSTOP when it next runs, which on a loaded machine may be a moment after kill returns
+  local pid state tries=0
+  for pid in $PAUSED; do
+    while [ "$tries" -lt 100 ]; do
+      state=$(cut -d')' -f2 "/proc/$pid/stat" 2> /dev/null | cut -d' ' -f2) || break
+      [ -z "$state" ] || [ "$state" = T ] && break  # stopped, or gone
+      sleep 0.05
+      tries=$((tries + 1))
+    done
+  done
+}
 trap 'resume "$@"' EXIT
 trap 'exit 130' INT TERM
 # shellcheck disable=SC2086
-[ -n "$PAUSED" ] && kill -STOP $PAUSED
+[ -n "$PAUSED" ] && kill -STOP $PAUSED && wait_stopped
 "$@"
