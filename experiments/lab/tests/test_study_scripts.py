@@ -83,3 +83,58 @@ def test_the_default_pattern_matches_the_runs_compare_starts_and_not_compare_its
     assert re.search(DEFAULT_PATTERN, " ".join(command))
     assert re.search(DEFAULT_PATTERN, ".venv/bin/lerobot-mtdagger run --preset=small")
     assert not re.search(DEFAULT_PATTERN, ".venv/bin/lerobot-mtdagger compare --methods=[need]")
+
+
+def wait_stopped_function() -> str:
+    """The text of the script's ``wait_stopped`` function."""
+    function = re.search(r"^wait_stopped\(\) \{.*?^\}\n", SCRIPT.read_text(), re.DOTALL | re.MULTILINE)
+    assert function is not None, "with_studies_paused.sh defines no wait_stopped() function"
+    return function.group(0)
+
+
+def wait_stopped_seconds(pids: list[int], stop_after: float | None) -> tuple[float, str]:
+    """Runs the script's ``wait_stopped`` on ``pids``; returns its seconds and the first pid's state after
+    (``gone`` if it has ended).
+
+    Args:
+        pids: The processes ``wait_stopped`` waits for (the script's ``PAUSED``).
+        stop_after: Seconds after which a background ``kill -STOP`` stops them, or ``None`` for never.
+    """
+    paused = " ".join(str(pid) for pid in pids)
+    stopper = f"(sleep {stop_after}; kill -STOP {paused}) &" if stop_after is not None else ""
+    body = "\n".join(
+        [
+            wait_stopped_function(),
+            f'PAUSED="{paused}"',
+            stopper,
+            "start=$EPOCHREALTIME; wait_stopped; end=$EPOCHREALTIME",
+            f"state=$(cut -d')' -f2 /proc/{pids[0]}/stat 2> /dev/null | cut -d' ' -f2)",
+            'echo "$start $end ${state:-gone}"',
+        ]
+    )
+    result = subprocess.run(["bash", "-c", body], capture_output=True, text=True, check=True)
+    start, end, state = result.stdout.split()
+    return float(end) - float(start), state
+
+
+def test_wait_stopped_returns_once_a_process_that_stops_late_is_stopped(fake_study):
+    """A loaded machine may handle SIGSTOP a moment after ``kill`` returns: the command waits for it."""
+    _, pids = fake_study
+    seconds, state = wait_stopped_seconds(pids, stop_after=1.0)
+    assert state == "T"
+    assert 0.9 <= seconds < 4.0
+
+
+def test_wait_stopped_gives_up_after_about_five_seconds_on_a_process_that_never_stops(fake_study):
+    _, pids = fake_study
+    seconds, state = wait_stopped_seconds(pids, stop_after=None)
+    assert state != "T"
+    assert 4.0 <= seconds < 12.0
+
+
+def test_wait_stopped_returns_at_once_for_a_process_that_is_gone():
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    seconds, state = wait_stopped_seconds([gone.pid], stop_after=None)
+    assert state == "gone"
+    assert seconds < 1.0
