@@ -17,6 +17,8 @@
 # phase when outputs/ is still there. Complete studies are not in the queue (their records and READMEs
 # hold their results): paper-regime-eval, paper-regime-pertask-dev, paper-regime-training-dev,
 # plateau-dagger-training-dev, plateau-dagger-eval; drawers-preset-dev stopped (its README).
+# Every run of the queue below is done (pixels-matched-eval complete 2026-11-30 19:30): run now, the script
+# skips each and starts nothing; it stays as the record of how the studies were carried out.
 # Queue (2026-11-29): pixels-dagger-epochs-dev's runs not yet in its records (its one_run.sh: a run whose
 # records hold phase 5 is skipped; all 6 are in since 2026-11-29 19:55). Once all 6 are in its records,
 # its report.sh (the reports and table that pixels-matched-eval's gate reads, DEV below). Then
