@@ -108,6 +108,7 @@ def wait_stopped_seconds(pids: list[int], stop_after: float | None) -> tuple[flo
             f'PAUSED="{paused}"',
             stopper,
             "start=$EPOCHREALTIME; wait_stopped; end=$EPOCHREALTIME",
+            # read here, as wait_stopped returns: once bash exits the stopper has run too
             f"state=$(cut -d')' -f2 /proc/{pids[0]}/stat 2> /dev/null | cut -d' ' -f2)",
             'echo "$start $end ${state:-gone}"',
         ]
