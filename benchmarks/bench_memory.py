@@ -42,7 +42,7 @@ REPO = Path(__file__).resolve().parents[1]
 def replay(experiment: Path, run_options: list[str], steps: int, rounds: int | None) -> dict:
     """The training phases of ``experiment`` in this process; their memory and load times."""
     import lerobot_mtdagger
-    from lerobot_mtdagger.datasets.rounds import ExperimentDir
+    from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.runner.configs import RunConfig
     from lerobot_mtdagger.runner.train import RoundCache, student_config, train_on_rounds

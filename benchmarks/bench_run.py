@@ -33,7 +33,7 @@ import threading
 import time
 from pathlib import Path
 
-from lerobot_mtdagger.studies.results import PHASE_TIMINGS as PHASES
+from lerobot_mtdagger.analysis.results import PHASE_TIMINGS as PHASES
 
 TARGET_S = 60.0
 PRESET_TARGETS_S = {"drawers-pointcloud": 3600.0, "metaworld-pixels": 5400.0}

@@ -36,6 +36,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Sequence
 
+from lerobot_mtdagger.analysis.compare import split_arguments
 from lerobot_mtdagger.commands.compare import CompareConfig, compare_command
 from lerobot_mtdagger.commands.console import configure_console_logging, error_line
 from lerobot_mtdagger.commands.demo import DemoConfig, run_demo
@@ -48,7 +49,6 @@ from lerobot_mtdagger.commands.run import RunConfig, run_experiment
 from lerobot_mtdagger.commands.shift import ShiftConfig, shift_command
 from lerobot_mtdagger.commands.verify import VerifyConfig, verify_command
 from lerobot_mtdagger.runner.configs import RUN_OPTION_RENAMES, SUITE_OPTION_RENAMES, renamed_option_error
-from lerobot_mtdagger.studies.compare import split_arguments
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
 

@@ -14,7 +14,7 @@ def pytest_configure(config: pytest.Config) -> None:
     """Gives each pytest-xdist worker, and the runs it starts, one thread.
 
     The workers take every core; two threads per process beside another busy one trained many times
-    slower (``studies.compare.run_resources``). ``-n 0`` keeps torch's default.
+    slower (``analysis.compare.run_resources``). ``-n 0`` keeps torch's default.
     """
     del config
     if os.environ.get("PYTEST_XDIST_WORKER") is None:

@@ -25,7 +25,7 @@ def edit_round_record(round_root: Path, edit: Callable[[dict[str, Any]], None]) 
     # the state the test makes is one a run could have committed: its ledger is made anew to match
     experiment_root = round_root.parent.parent
     if (experiment_root / "ledger.json").is_file():
-        from lerobot_mtdagger.datasets.rounds import ExperimentDir
+        from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 
         (experiment_root / "ledger.json").unlink()
         ExperimentDir(experiment_root).update_ledger()

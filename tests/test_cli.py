@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from lerobot_mtdagger.analysis.simulate import SyntheticTasks, simulate
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets_cards import card_template
 from lerobot_mtdagger.scheduler import allocation_mismatches, make_scheduler
-from lerobot_mtdagger.studies.simulate import SyntheticTasks, simulate
 
 
 def test_console_script_demo_runs_and_writes_records(tmp_path):

@@ -17,13 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS
-from lerobot_mtdagger.datasets.rounds import ExperimentDir, writer_lock_holder
-from lerobot_mtdagger.envs import SuiteConfig
-from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.option_groups import DAggerConfig
-from lerobot_mtdagger.studies.compare import (
+from lerobot_mtdagger.analysis.compare import (
     PARENT_PID_ENV,
     CompareConfig,
     bc_rounds_for,
@@ -31,8 +25,14 @@ from lerobot_mtdagger.studies.compare import (
     jobs_for,
     split_arguments,
 )
-from lerobot_mtdagger.studies.figures import hardest_tasks, seed_reach
-from lerobot_mtdagger.studies.launchers import Job, RunPool, is_finished
+from lerobot_mtdagger.analysis.figures import hardest_tasks, seed_reach
+from lerobot_mtdagger.analysis.launchers import Job, RunPool, is_finished
+from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir, writer_lock_holder
+from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS
+from lerobot_mtdagger.envs import SuiteConfig
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.option_groups import DAggerConfig
 from lerobot_mtdagger.utils.errors import UserError
 from tests.helpers import TOY_COMPARE, child_pids, is_running
 
@@ -705,7 +705,7 @@ def test_report_refuses_a_variant_folder_that_holds_no_runs(compared, tmp_path, 
 
 
 def test_reach_table_gives_demos_and_frames_at_the_first_crossing():
-    from lerobot_mtdagger.studies.figures import reach_lines
+    from lerobot_mtdagger.analysis.summary import reach_lines
 
     def curve(seed, successes):
         return [
@@ -793,7 +793,7 @@ def test_a_saved_table_without_phase_timings_is_refused_naming_the_column(tmp_pa
 )
 def test_runs_get_the_cores_they_are_given_and_no_more(monkeypatch, cores, jobs, environ, run_args, expected):
     """Two threads per run beside another job trained point clouds over 10x slower (1.4 vs 16.5 steps/s)."""
-    from lerobot_mtdagger.studies import compare as compare_module
+    from lerobot_mtdagger.analysis import compare as compare_module
 
     monkeypatch.setattr(compare_module, "default_worker_count", lambda: 2)
     config = CompareConfig(cores=cores, jobs=jobs)
@@ -801,7 +801,7 @@ def test_runs_get_the_cores_they_are_given_and_no_more(monkeypatch, cores, jobs,
 
 
 def test_a_run_launched_with_the_run_options_workers_keeps_them(tmp_path):
-    from lerobot_mtdagger.studies.launchers import Job, job_command
+    from lerobot_mtdagger.analysis.launchers import Job, job_command
 
     job = Job("uniform-seed0", ("--rollout.workers=1",), last_phase=1)
     command, variables = job_command(job, tmp_path / "uniform-seed0", threads=1, workers=None)

@@ -13,16 +13,16 @@ from pathlib import Path
 import draccus
 import pytest
 
+from lerobot_mtdagger.analysis.results import results_rows
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets.config_layout import flatten, option
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS, is_flat, migrate_run_config
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.option_groups import DAggerConfig, TrainingConfig
 from lerobot_mtdagger.runner.presets import PRESET_FIELDS, PRESETS
-from lerobot_mtdagger.studies.results import results_rows
 from lerobot_mtdagger.utils import parsing
 from lerobot_mtdagger.utils.errors import UserError
 

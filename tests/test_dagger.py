@@ -14,8 +14,8 @@ import pytest
 import torch
 
 from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir, merge_rounds
 from lerobot_mtdagger.datasets.records import RoundRecord
-from lerobot_mtdagger.datasets.rounds import ExperimentDir, merge_rounds
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.envs.drawers.catalogue import HELDOUT_TASKS
 from lerobot_mtdagger.policies import MTDAggerPolicy
@@ -126,7 +126,7 @@ def test_merged_rounds_load_as_one_dataset_with_the_same_task_indices(experiment
 
 
 def test_report_gives_success_against_demos(experiment, tmp_path, capsys):
-    from lerobot_mtdagger.studies.results import learning_curves
+    from lerobot_mtdagger.analysis.results import learning_curves
 
     curves = learning_curves([experiment.root])
     assert [(p.method, p.round, p.demos_per_task, p.seeds) for p in curves][:2] == [
@@ -141,7 +141,7 @@ def test_report_gives_success_against_demos(experiment, tmp_path, capsys):
 
 
 def test_report_refuses_to_average_runs_of_different_configs(experiment, tmp_path):
-    from lerobot_mtdagger.studies.results import learning_curves
+    from lerobot_mtdagger.analysis.results import learning_curves
 
     other = tmp_path / "need-longer"
     shutil.copytree(experiment.root, other)
@@ -153,7 +153,7 @@ def test_report_refuses_to_average_runs_of_different_configs(experiment, tmp_pat
 
 
 def test_report_refuses_runs_without_evaluation(tmp_path):
-    from lerobot_mtdagger.studies.results import learning_curves
+    from lerobot_mtdagger.analysis.results import learning_curves
     from tests.test_toy import toy_config
 
     run(toy_config(tmp_path / "blind", "--dagger.rounds=0", "--rollout.eval_episodes=0"))
@@ -265,8 +265,8 @@ def test_drawer_suite_runs_with_point_clouds_and_evaluates_the_unseen_drawers(tm
     assert result["task_names"] == list(HELDOUT_TASKS) and len(result["progress"]) == len(HELDOUT_TASKS)
 
     # report carries them: the in-domain / unseen table and the unseen-success figure.
-    from lerobot_mtdagger.studies.figures import write_report
-    from lerobot_mtdagger.studies.results import results_rows
+    from lerobot_mtdagger.analysis.results import results_rows
+    from lerobot_mtdagger.analysis.summary import write_report
 
     rows = results_rows([experiment.root])
     assert [row["unseen_tasks"] for row in rows] == [list(HELDOUT_TASKS)] * 2

@@ -201,7 +201,7 @@ def test_verify_refuses_a_round_whose_recorded_experts_differ_from_the_run(tmp_p
 
 
 def test_compare_gives_every_arm_the_same_experts():
-    from lerobot_mtdagger.studies.compare import CompareConfig, jobs_for
+    from lerobot_mtdagger.analysis.compare import CompareConfig, jobs_for
 
     noisy = ["--expert.noise=0.3", "--expert.noise_correlation=0.9", "--expert.labels=clean"]
     jobs = jobs_for(

@@ -11,7 +11,7 @@ import draccus
 import pytest
 import torch
 
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run

@@ -29,9 +29,9 @@ from huggingface_hub.utils import filter_repo_objects
 
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets import hub
+from lerobot_mtdagger.datasets.experiment_dir import RECORD_FILES, ExperimentDir
 from lerobot_mtdagger.datasets.hub import PushConfig, push_command, push_experiment, render_dataset_card
 from lerobot_mtdagger.datasets.integrity import folder_digests
-from lerobot_mtdagger.datasets.rounds import RECORD_FILES, ExperimentDir
 from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
 from tests.helpers import edit_round_record
 

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from tests.helpers import kill_9_and_check_workers_end
 from tests.test_dagger import _cli

@@ -113,7 +113,7 @@ def test_stock_lerobot_train_and_eval_on_a_merged_point_cloud_experiment(tmp_pat
     """The README's route for the paper's main setting: point-cloud rounds -> D(k) -> stock tools."""
     import draccus
 
-    from lerobot_mtdagger.datasets.rounds import ExperimentDir, merge_rounds
+    from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir, merge_rounds
     from lerobot_mtdagger.runner.configs import RunConfig
     from lerobot_mtdagger.runner.dagger import run
 

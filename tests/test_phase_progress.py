@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 import torch
 
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.runner.configs import RunConfig

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 import torch
 
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.runner.collect import (
     EpisodeOptions,

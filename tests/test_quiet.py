@@ -20,9 +20,9 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir, round_name
 from lerobot_mtdagger.datasets.records import StepOutcome, dagger_columns, round_features
 from lerobot_mtdagger.datasets.round_writer import _vector_episode_stats, save_episode_with_success
-from lerobot_mtdagger.datasets.rounds import ExperimentDir, round_name
 from lerobot_mtdagger.utils import quiet
 from lerobot_mtdagger.utils.quiet import quiet_third_party
 
@@ -430,7 +430,7 @@ def test_write_round_falls_back_to_lerobots_stats_if_the_fast_ones_differ(
     episodes = _episodes(np.random.default_rng(6), [5, 7, 3])
     theirs = _write_with_lerobot_loop(ExperimentDir(tmp_path / "theirs"), 0, _features(), episodes)
     ours_dir = ExperimentDir(tmp_path / "ours")
-    with caplog.at_level(logging.WARNING, logger="lerobot_mtdagger.datasets.rounds"):
+    with caplog.at_level(logging.WARNING, logger="lerobot_mtdagger.datasets.experiment_dir"):
         ours = ours_dir.commit_round(0, ours_dir.write_round(0, _features(), TASKS, episodes), _record_stub())
     assert "do not match this LeRobot version" in caplog.text
     _assert_same_dataset_files(ours, theirs)

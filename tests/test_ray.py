@@ -21,7 +21,7 @@ import pytest
 from safetensors.numpy import load_file
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.envs import SuiteConfig, suite_from_config
 from lerobot_mtdagger.runner import dagger

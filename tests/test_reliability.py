@@ -19,7 +19,7 @@ from safetensors.torch import load_file, save_file
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets import rounds as rounds_module
 from lerobot_mtdagger.datasets.checkpoints import UntrustedCheckpointError
-from lerobot_mtdagger.datasets.rounds import LOCK_FILE, ExperimentDir, ExperimentLockedError
+from lerobot_mtdagger.datasets.experiment_dir import LOCK_FILE, ExperimentDir, ExperimentLockedError
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.runner import dagger as dagger_module
 from lerobot_mtdagger.runner.configs import RunConfig
@@ -50,7 +50,7 @@ def test_a_second_writer_is_refused_at_once_naming_the_folder_and_the_process(fi
 def test_a_killed_writer_leaves_no_stale_lock(finished):
     code = (
         "import sys, time\n"
-        "from lerobot_mtdagger.datasets.rounds import ExperimentDir\n"
+        "from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir\n"
         f"with ExperimentDir({str(finished)!r}).writer_lock():\n"
         "    print('locked', flush=True)\n"
         "    time.sleep(60)\n"
@@ -165,8 +165,8 @@ def drop_info_records(root: Path) -> None:
 
 def test_the_round_record_survives_lerobot_rewriting_info_json(finished, tmp_path):
     """The record lives in meta/mtdagger.json: verify, resume, merge and report read it there."""
-    from lerobot_mtdagger.datasets.rounds import merge_rounds
-    from lerobot_mtdagger.studies.results import results_rows
+    from lerobot_mtdagger.analysis.results import results_rows
+    from lerobot_mtdagger.datasets.experiment_dir import merge_rounds
 
     copy = damaged_copy(finished, tmp_path, drop_info_records)
     experiment = ExperimentDir(copy)

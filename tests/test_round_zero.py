@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
+from lerobot_mtdagger.analysis.round_zero import round_zero_differences, round_zero_source
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.studies.round_zero import round_zero_differences, round_zero_source
 from lerobot_mtdagger.utils.parsing import parse_options
 from tests.helpers import TOY_COMPARE
 

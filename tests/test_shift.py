@@ -8,13 +8,13 @@ import math
 import numpy as np
 import pytest
 
+from lerobot_mtdagger.analysis.shift import ShiftResult, measure_shift, shift_ratio
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.toy import START_BOX, TOY_TASKS
 from lerobot_mtdagger.experts.toy import ToyExpert
 from lerobot_mtdagger.runner.evaluate import evaluate
 from lerobot_mtdagger.runner.workers import EnvWorkers
-from lerobot_mtdagger.studies.shift import ShiftResult, measure_shift, shift_ratio
 
 EXPERT = ToyExpert()
 

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from lerobot_mtdagger.studies.stats import (
+from lerobot_mtdagger.analysis.stats import (
     Interval,
     correlation,
     demos_to_reach,

@@ -231,7 +231,7 @@ def test_verify_loads_policies_without_the_rollout_stack():
 WING_RANKS = {
     "lerobot_mtdagger.cli": 6,
     "lerobot_mtdagger.commands": 6,
-    "lerobot_mtdagger.studies": 5,
+    "lerobot_mtdagger.analysis": 5,
     "lerobot_mtdagger.planning": 5,
     "lerobot_mtdagger.runner": 4,
     "lerobot_mtdagger.envs": 3,
@@ -241,7 +241,7 @@ WING_RANKS = {
     "lerobot_mtdagger.scheduler": 1,
     "lerobot_mtdagger.utils": 0,
 }
-"""Imports run one way: cli and commands -> studies -> runner -> envs and experts -> datasets and
+"""Imports run one way: cli and commands -> analysis -> runner -> envs and experts -> datasets and
 policies -> scheduler -> utils. Within a rank, cli may use commands, experts may use envs and datasets
 may use policies (not the reverse)."""
 
@@ -287,7 +287,7 @@ MAX_CLI_LINES = 150
 
 SHARED_CONFIGS = {
     "run": "lerobot_mtdagger.runner.configs",
-    "compare": "lerobot_mtdagger.studies.compare",
+    "compare": "lerobot_mtdagger.analysis.compare",
     "push": "lerobot_mtdagger.datasets.push_config",
     "plan": "lerobot_mtdagger.planning.plan",
 }

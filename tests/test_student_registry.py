@@ -14,7 +14,7 @@ import pytest
 
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets.checkpoints import check_local_policy
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.runner import student as student_registry
 from lerobot_mtdagger.runner.mtdagger_student import MTDAggerStudent
 from lerobot_mtdagger.runner.student import Student, get_student, register_student, student_names

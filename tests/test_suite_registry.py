@@ -9,7 +9,7 @@ import textwrap
 import pytest
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.envs import (
     SUITE_NAMES,

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import torch
 
+from lerobot_mtdagger.datasets.experiment_dir import STAGING_DIR, ExperimentDir
 from lerobot_mtdagger.datasets.records import (
     DAGGER_ROUND,
     EXECUTED_ACTION,
@@ -17,7 +18,6 @@ from lerobot_mtdagger.datasets.records import (
     RoundRecord,
     round_features,
 )
-from lerobot_mtdagger.datasets.rounds import STAGING_DIR, ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.envs.toy import MAX_EPISODE_STEPS, TOY_TASKS

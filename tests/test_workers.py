@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.envs import SuiteConfig, make_suite
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.runner.collect import EpisodeOptions, run_episodes

@@ -19,8 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.studies.figures import format_difference
-from lerobot_mtdagger.studies.stats import paired_difference
+from lerobot_mtdagger.analysis.stats import format_difference, paired_difference
 
 DEFAULT = Path("experiments/beyond-plateau-dev/report/results.csv")
 SHOWN = (21, 33, 45, 63)

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.datasets.rounds import open_run
-from lerobot_mtdagger.studies.results import experiment_rows
+from lerobot_mtdagger.analysis.results import experiment_rows
+from lerobot_mtdagger.datasets.experiment_dir import open_run
 
 DEFAULT = Path("experiments/drawers-training-spread-dev/records")
 RUN_NAME = re.compile(r"^bc20-seed(\d+)-train(\d+)$")

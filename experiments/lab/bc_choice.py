@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.studies.saved_records import ARCHIVE_NAME, unpack
+from lerobot_mtdagger.analysis.saved_records import ARCHIVE_NAME, unpack
 
 BC_RUN_NAME = re.compile(r"bc-(\d+)demos-seed(\d+)")
 DROP_ALLOWED = 0.01

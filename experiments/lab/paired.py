@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from lerobot_mtdagger.studies.stats import format_difference, paired_difference
+from lerobot_mtdagger.analysis.stats import format_difference, paired_difference
 
 
 def paired_line(name: str, pairs: Sequence[tuple[float, float]]) -> str:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.studies.saved_records import ARCHIVE_NAME, saved_records_runs
+from lerobot_mtdagger.analysis.saved_records import ARCHIVE_NAME, saved_records_runs
 
 
 def compare_runs(compare: Path) -> list[Path]:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from lerobot_mtdagger.studies.results import read_results
+from lerobot_mtdagger.analysis.results import read_results
 
 REPORT = Path("experiments/mt50-state-eval/report")
 BUDGETS = (3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 33)

@@ -29,9 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.studies.figures import format_difference
-from lerobot_mtdagger.studies.results import SavedTable, merge_tables, read_results
-from lerobot_mtdagger.studies.stats import Interval, mean_interval, paired_difference
+from lerobot_mtdagger.analysis.results import SavedTable, merge_tables, read_results
+from lerobot_mtdagger.analysis.stats import Interval, format_difference, mean_interval, paired_difference
 
 HERE = Path("experiments/mt50-state-eval")
 MAIN_TABLES = tuple(HERE / "seeds" / f"seed{seed}" for seed in (0, 1, 2))

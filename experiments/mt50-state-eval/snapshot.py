@@ -22,7 +22,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from lerobot_mtdagger.studies.results import run_progress
+from lerobot_mtdagger.analysis.results import run_progress
 
 CLI = ".venv/bin/lerobot-mtdagger"
 OUT = Path("outputs/mt50-state-eval")

@@ -23,10 +23,9 @@ from pathlib import Path
 import numpy as np
 
 from lab.passes import compare_runs, phase_passes
-from lerobot_mtdagger.datasets.rounds import open_run
-from lerobot_mtdagger.studies.figures import format_difference
-from lerobot_mtdagger.studies.results import experiment_rows
-from lerobot_mtdagger.studies.stats import Interval, demos_to_reach, paired_difference
+from lerobot_mtdagger.analysis.results import experiment_rows
+from lerobot_mtdagger.analysis.stats import Interval, demos_to_reach, format_difference, paired_difference
+from lerobot_mtdagger.datasets.experiment_dir import open_run
 
 ARMS = ("bc", "uniform", "need", "need_raw", "gain")
 SEARCHED = ("bc", "uniform", "need")  # need_raw and gain take need's training

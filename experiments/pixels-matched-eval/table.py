@@ -35,13 +35,13 @@ from typing import Any
 import numpy as np
 
 from lab.paired import paired_line
+from lerobot_mtdagger.analysis.saved_records import ARCHIVE_NAME, saved_records_runs
+from lerobot_mtdagger.analysis.stats import Interval, paired_difference
 from lerobot_mtdagger.datasets.config_layout import flatten
+from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE
 from lerobot_mtdagger.datasets.records import PhaseRecord
-from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.presets import preset_values
-from lerobot_mtdagger.studies.saved_records import ARCHIVE_NAME, saved_records_runs
-from lerobot_mtdagger.studies.stats import Interval, paired_difference
 
 HERE = Path(__file__).resolve().parent
 RECORDS = HERE / "records"

@@ -31,8 +31,8 @@ import numpy as np
 
 from lab.bc_choice import read_bc_records
 from lab.paired import paired_line
-from lerobot_mtdagger.studies.saved_records import ARCHIVE_NAME, unpack
-from lerobot_mtdagger.studies.stats import paired_difference
+from lerobot_mtdagger.analysis.saved_records import ARCHIVE_NAME, unpack
+from lerobot_mtdagger.analysis.stats import paired_difference
 
 HERE = Path(__file__).resolve().parent
 PLAIN_RESULTS = HERE.parent / "beyond-plateau-eval" / "report" / "results.csv"

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from lerobot_mtdagger.studies.stats import paired_difference
+from lerobot_mtdagger.analysis.stats import paired_difference
 
 HERE = Path(__file__).parent
 VARIANTS = [

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.studies.stats import mean_interval
+from lerobot_mtdagger.analysis.stats import mean_interval
 
 NAME = re.compile(r"^(?P<run>.+)-seed(?P<seed>\d+)-round-(?P<round>\d+)\.json$")
 

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_mtdagger.studies.stats import mean_interval
+from lerobot_mtdagger.analysis.stats import mean_interval
 
 NAME = re.compile(r"^kitchen-seed(?P<seed>\d+)-phase(?P<phase>\d)-(?P<rule>shared|nearest)\.json$")
 PHASES = (0, 1, 2)

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lerobot_mtdagger.analysis.simulate import SyntheticTasks, simulate
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, Scheduler, SchedulerConfig
-from lerobot_mtdagger.studies.simulate import SyntheticTasks, simulate
 
 
 @dataclass

@@ -108,7 +108,7 @@ def check_committed_policy(folder: Path, allow_changed: bool) -> None:
     Raises:
         UserError: Naming the changed files and ``--allow_changed_policy=true``.
     """
-    from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, TRAINING_FILE, ExperimentDir
+    from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE, TRAINING_FILE, ExperimentDir
 
     experiment_root = folder.parent.parent
     if folder.parent.name != "policies" or not (experiment_root / CONFIG_FILE).is_file():

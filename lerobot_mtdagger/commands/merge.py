@@ -33,7 +33,7 @@ class MergeConfig:
 
 def merge_command(config: MergeConfig) -> Path:
     """Merges rounds 0..k with LeRobot's aggregation; the result trains with stock lerobot-train."""
-    from lerobot_mtdagger.datasets.rounds import ExperimentDir, merge_rounds
+    from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir, merge_rounds
 
     experiment = ExperimentDir(config.experiment_dir)
     experiment.read_config()  # refuses a folder that is not an experiment

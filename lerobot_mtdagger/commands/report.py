@@ -39,7 +39,7 @@ class ReportConfig:
             agree). Default ``output_dir`` for one table: its folder.
         records: Runs' saved records (``scripts/save_run_records.sh``: config, round and training
             records, no frames or weights), each a run's records folder, a folder of them, or a
-            study's ``runs-records.tar.gz`` (or a folder holding them: ``studies.saved_records``), reported
+            study's ``runs-records.tar.gz`` (or a folder holding them: ``analysis.saved_records``), reported
             beside ``experiments`` and ``compare_dir`` as their runs are: a study whose ``outputs/`` was
             lost keeps its finished runs. Their frames per task are known only on average.
     """
@@ -71,7 +71,7 @@ class ReportConfig:
         if self.compare_dir is not None and self.output_dir is None:
             self.output_dir = self.compare_dir / "report"
         self._check_outputs()
-        from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
+        from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE
 
         for name, folder in self.variants.items():
             if not (Path(folder) / "runs").is_dir() and not (Path(folder) / CONFIG_FILE).is_file():
@@ -126,7 +126,7 @@ class ReportConfig:
     @property
     def runs_not_started(self) -> list[str]:
         """The runs the compare folders plan (``compare.json``) that have no folder yet."""
-        from lerobot_mtdagger.studies.compare import runs_not_started
+        from lerobot_mtdagger.analysis.compare import runs_not_started
 
         folders = [self.compare_dir] if self.compare_dir is not None else []
         folders += [Path(folder) for folder in self.variants.values() if (Path(folder) / "runs").is_dir()]
@@ -139,8 +139,8 @@ def _compare_runs(compare_dir: Path) -> list[Path]:
 
 
 def _saved_records_runs(folder: Path) -> list[Path]:
-    """The runs' records at ``folder`` (``studies.saved_records``: folders or archives)."""
-    from lerobot_mtdagger.studies.saved_records import saved_records_runs
+    """The runs' records at ``folder`` (``analysis.saved_records``: folders or archives)."""
+    from lerobot_mtdagger.analysis.saved_records import saved_records_runs
 
     return saved_records_runs(folder)
 
@@ -154,8 +154,8 @@ def report_command(config: ReportConfig) -> str:
     """
     if config.results:
         return _report_saved_tables(config)
-    from lerobot_mtdagger.studies.report import curves_table
-    from lerobot_mtdagger.studies.results import check_comparable, learning_curves, run_progress
+    from lerobot_mtdagger.analysis.curves import curves_table
+    from lerobot_mtdagger.analysis.results import check_comparable, learning_curves, run_progress
 
     all_roots, labels = config.experiment_dirs, config.labels  # each lists the run folders once
     configs = check_comparable(all_roots, labels)
@@ -176,9 +176,9 @@ def report_command(config: ReportConfig) -> str:
         )
     table = _print_table(curves_table(learning_curves(roots, labels)), config)
     if config.output_dir is not None:
-        from lerobot_mtdagger.datasets.rounds import open_run
-        from lerobot_mtdagger.studies.results import results_rows, write_results
-        from lerobot_mtdagger.studies.saved_records import shown_name
+        from lerobot_mtdagger.analysis.results import results_rows, write_results
+        from lerobot_mtdagger.analysis.saved_records import shown_name
+        from lerobot_mtdagger.datasets.experiment_dir import open_run
 
         rows = results_rows(roots, labels)
         for row in rows:
@@ -195,8 +195,8 @@ def _report_saved_tables(config: ReportConfig) -> str:
     Several tables joined are also saved as one (``results.csv``, ``results.json``, beside the figures),
     as ``report`` saves the table of the runs it reads; one table is where it was read from.
     """
-    from lerobot_mtdagger.studies.report import curves_from_rows, curves_table
-    from lerobot_mtdagger.studies.results import merge_tables, read_results, write_results
+    from lerobot_mtdagger.analysis.curves import curves_from_rows, curves_table
+    from lerobot_mtdagger.analysis.results import merge_tables, read_results, write_results
 
     saved = merge_tables([read_results(path) for path in config.results])
     if len(config.results) > 1:
@@ -219,7 +219,7 @@ def _write_figures(
     rows: list[dict], task_names: list[str], config: ReportConfig, unfinished: list[str]
 ) -> None:
     """Writes every figure and ``report.md`` into ``--output_dir`` and prints where."""
-    from lerobot_mtdagger.studies.figures import write_report
+    from lerobot_mtdagger.analysis.summary import write_report
 
     path = write_report(rows, task_names, config.output_dir, levels=config.levels, unfinished=unfinished)
     print(f"figures and summary: {path}")

@@ -6,7 +6,7 @@ Its options are ``RunConfig`` (``runner/configs.py``), which the runner reads to
 from __future__ import annotations
 
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.studies.compare import follow_parent
+from lerobot_mtdagger.utils.parent import follow_parent
 
 __all__ = ["RunConfig", "run_experiment"]
 

@@ -15,7 +15,7 @@ import numpy as np
 from lerobot_mtdagger.commands.eval import EvalConfig, suite_and_policy
 
 if TYPE_CHECKING:
-    from lerobot_mtdagger.studies.shift import ShiftResult
+    from lerobot_mtdagger.analysis.shift import ShiftResult
 
 
 @dataclass
@@ -31,7 +31,7 @@ class ShiftConfig(EvalConfig):
 
 def shift_command(config: ShiftConfig) -> dict:
     """Measures a pretrained policy's covariate shift per task and prints it."""
-    from lerobot_mtdagger.studies.shift import measure_shift
+    from lerobot_mtdagger.analysis.shift import measure_shift
 
     suite, runner = suite_and_policy(config)
     with config.env_workers(suite) as workers:

@@ -25,7 +25,7 @@ class VerifyConfig:
 
 def verify_command(config: VerifyConfig) -> list[str]:
     """Checks every committed round and policy against its files and record; exits 1 on a problem."""
-    from lerobot_mtdagger.datasets.rounds import ExperimentDir
+    from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
     from lerobot_mtdagger.datasets.verify import verify_experiment
 
     experiment = ExperimentDir(config.experiment_dir)

@@ -34,9 +34,9 @@ from typing import Any
 from huggingface_hub import DatasetCardData, HfApi
 
 from lerobot_mtdagger.datasets.config_layout import option
+from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE, ExperimentDir, round_name
 from lerobot_mtdagger.datasets.push_config import PushConfig
 from lerobot_mtdagger.datasets.records import PhaseRecord, RoundRecord
-from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, ExperimentDir, round_name
 from lerobot_mtdagger.datasets_cards import card_template
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.markdown import markdown_table

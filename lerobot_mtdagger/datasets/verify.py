@@ -22,8 +22,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from lerobot_mtdagger.datasets.checkpoints import load_policy
+from lerobot_mtdagger.datasets.experiment_dir import EXPERT_CHECK_FILE, ExperimentDir, round_name
 from lerobot_mtdagger.datasets.records import RoundRecord
-from lerobot_mtdagger.datasets.rounds import EXPERT_CHECK_FILE, ExperimentDir, round_name
 from lerobot_mtdagger.scheduler import allocation_mismatches
 from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
 

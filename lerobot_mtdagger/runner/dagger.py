@@ -49,8 +49,8 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.records import RoundRecord
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
 from lerobot_mtdagger.envs import suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.runner.collect import (

@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from lerobot_mtdagger.datasets.rounds import EXPERT_CHECK_FILE
+from lerobot_mtdagger.datasets.experiment_dir import EXPERT_CHECK_FILE
 from lerobot_mtdagger.experts import make_expert, run_expert_episode
 from lerobot_mtdagger.runner.collect import episode_seed
 from lerobot_mtdagger.utils.errors import UserError

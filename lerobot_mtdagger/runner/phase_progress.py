@@ -29,7 +29,7 @@ from typing import Any
 
 import torch
 
-from lerobot_mtdagger.datasets.layout import PARTIAL_SUFFIX
+from lerobot_mtdagger.datasets.experiment_files import PARTIAL_SUFFIX
 
 logger = logging.getLogger(__name__)
 

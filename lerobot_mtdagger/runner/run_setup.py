@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import logging
 
-from lerobot_mtdagger.datasets.rounds import ExperimentDir
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.expert_check import EXPERT_CHECK_FILE, ExpertCheck, measure_expert_check

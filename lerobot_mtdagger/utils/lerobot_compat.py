@@ -18,7 +18,7 @@ Everything else the package imports from LeRobot has one spelling in both lines 
 that too). Behaviour that differs without a name moving is handled where it is used: LeRobot 0.6 logs
 through named loggers (``utils/quiet.py``), reads ``meta/info.json`` into a typed ``DatasetInfo`` that
 drops unknown keys (the round record is read from ``meta/mtdagger.json``), and probes torchcodec unless
-a dataset is created with a ``video_backend`` (``datasets/rounds.py``).
+a dataset is created with a ``video_backend`` (``datasets/experiment_dir.py``).
 """
 
 from __future__ import annotations

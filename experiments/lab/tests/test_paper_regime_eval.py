@@ -171,7 +171,7 @@ def test_a_curve_still_running_is_not_censored(table, tmp_path):
 
 def test_a_run_just_started_gives_no_row(table, tmp_path):
     """A run with its config written and no round committed yet (compare has just started it) is skipped."""
-    from lerobot_mtdagger.studies.saved_records import saved_records_runs
+    from lerobot_mtdagger.analysis.saved_records import saved_records_runs
 
     saved = EXPERIMENTS / "paper-regime-eval" / "records" / "cosine-seed0"
     runs = tmp_path / "cosine-seed0" / "runs"

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from lerobot_mtdagger.studies.compare import CompareConfig, jobs_for, split_arguments
+from lerobot_mtdagger.analysis.compare import CompareConfig, jobs_for, split_arguments
 from lerobot_mtdagger.utils.parsing import parse_options
 
 SCRIPT = Path(__file__).resolve().parents[2] / "pixels-eval" / "run-missing.sh"

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from lerobot_mtdagger.studies.launchers import Job, job_command
+from lerobot_mtdagger.analysis.launchers import Job, job_command
 
 SCRIPT = Path(__file__).resolve().parents[2] / "with_studies_paused.sh"
 DEFAULT_PATTERN = re.search(r'STUDY_PATTERN:-"([^"]+)"', SCRIPT.read_text()).group(1)

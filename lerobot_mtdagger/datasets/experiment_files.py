@@ -1,7 +1,8 @@
-"""Names of an experiment folder's files and folders (the layout: ``lerobot_mtdagger.datasets.rounds``).
+"""Names of an experiment folder's files and folders (the layout ``datasets.experiment_dir`` makes).
 
-In a module that imports nothing, so that readers of saved records (``studies.saved_records`` and the
-studies' table scripts) need not import LeRobot and torch, as ``rounds`` does, to know a file's name.
+In a module that imports nothing, so that readers of saved records (``analysis.saved_records`` and the
+studies' table scripts) need not import LeRobot and torch, as ``experiment_dir`` does, to know a file's
+name.
 """
 
 from __future__ import annotations

@@ -27,12 +27,10 @@ from pathlib import Path
 from typing import Any
 
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.parent import PARENT_PID_ENV
 from lerobot_mtdagger.utils.ray_session import connect
 
 logger = logging.getLogger(__name__)
-
-PARENT_PID_ENV = "LEROBOT_MTDAGGER_PARENT_PID"
-"""Set by ``compare`` in each run's environment: the process id the run must not outlive."""
 
 
 class RunHeldError(UserError):
@@ -45,7 +43,7 @@ def check_not_held(folder: Path, name: str) -> None:
     Raises:
         RunHeldError: If another process holds the run folder's writer lock (naming its pid).
     """
-    from lerobot_mtdagger.datasets.rounds import writer_lock_holder
+    from lerobot_mtdagger.datasets.experiment_dir import writer_lock_holder
 
     holder = writer_lock_holder(folder)
     if holder is not None:
@@ -90,7 +88,7 @@ def is_finished(folder: Path, last_phase: int) -> bool:
     A DAgger run finished at fewer rounds than asked is not: resuming it with more ``--dagger.rounds``
     extends it (``ExperimentDir.check_resumable``).
     """
-    from lerobot_mtdagger.datasets.rounds import (  # LeRobot: loaded only when needed
+    from lerobot_mtdagger.datasets.experiment_dir import (  # LeRobot: loaded only when needed
         CONFIG_FILE,
         ExperimentDir,
     )
@@ -108,7 +106,7 @@ def job_command(
     The variables are the thread counts; the pid the run must not outlive is the launcher's to add.
     ``workers`` None leaves ``--rollout.workers`` to the job's own options.
     """
-    from lerobot_mtdagger.datasets.rounds import CONFIG_FILE
+    from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE
 
     resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []
     arguments = run_arguments(job, folder, workers)
@@ -129,13 +127,13 @@ def run_arguments(job: Job, folder: Path, workers: int | None) -> list[str]:
 def start_from_shared_round_zero(job: Job, folder: Path, workers: int | None) -> None:
     """Copies into a job not started yet the round 0 and phase 0 of a run beside it that made the same.
 
-    ``studies/round_zero.py``: DAgger runs of one seed whose options differ only in the scheduler. The
+    ``analysis/round_zero.py``: DAgger runs of one seed whose options differ only in the scheduler. The
     job then starts as a resume, at round 1.
 
     Raises:
         UserError: On bad run options, or if another process started writing ``folder`` meanwhile.
     """
-    from lerobot_mtdagger.studies.round_zero import share_round_zero  # LeRobot: loaded only when needed
+    from lerobot_mtdagger.analysis.round_zero import share_round_zero  # LeRobot: loaded only when needed
 
     share_round_zero(folder, run_arguments(job, folder, workers))
 

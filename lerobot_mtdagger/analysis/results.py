@@ -8,7 +8,7 @@ method's runs share and, for a study in progress, its unfinished runs in ``resul
 ``read_results`` reads them back and ``merge_tables`` joins tables made apart (other seeds, other
 machines), so a report can be drawn from saved tables alone, when the run folders are gone. This is
 the one module that reads experiment folders for studies (also ``learning_curves``,
-``check_comparable`` and ``run_progress``); ``report`` and ``figures`` work from its rows::
+``check_comparable`` and ``run_progress``); ``curves``, ``figures`` and ``summary`` work from its rows::
 
     <folder>/
         results.csv         one row per run x evaluated phase, list columns as JSON
@@ -28,11 +28,11 @@ from typing import Any
 import numpy as np
 import pyarrow.parquet as pq
 
+from lerobot_mtdagger.analysis.curves import CurvePoint, RunPoints, average_runs, curve_name
 from lerobot_mtdagger.datasets.config_layout import flatten, option
+from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE, SavedRunRecords, open_run
 from lerobot_mtdagger.datasets.migrations import migrate_run_config
-from lerobot_mtdagger.datasets.rounds import CONFIG_FILE, SavedRunRecords, open_run
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.studies.report import CurvePoint, RunPoints, average_runs, curve_name
 from lerobot_mtdagger.utils.errors import UserError
 
 RESULTS_FILE = "results.json"

@@ -17,7 +17,7 @@ import tarfile
 import tempfile
 from pathlib import Path
 
-from lerobot_mtdagger.datasets.layout import CONFIG_FILE
+from lerobot_mtdagger.datasets.experiment_files import CONFIG_FILE
 from lerobot_mtdagger.utils.errors import UserError
 
 logger = logging.getLogger(__name__)

@@ -25,7 +25,7 @@ Asked again with more ``--dagger.rounds``, it extends the finished DAgger runs b
 at the new budgets; the rounds already made are kept as they are.
 The DAgger methods of a seed make the same round 0 and phase 0 (the scheduler acts from round 1), so a
 run that starts after another of its seed has committed them copies them and begins at round 1
-(``studies/round_zero.py``; ``--share_round0=false`` to make each its own).
+(``analysis/round_zero.py``; ``--share_round0=false`` to make each its own).
 """
 
 from __future__ import annotations
@@ -33,19 +33,17 @@ from __future__ import annotations
 import json
 import logging
 import os
-import signal
-import threading
-import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar
 
+from lerobot_mtdagger.analysis.launchers import Job, RayRunPool, RunPool
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.option_groups import default_worker_count
 from lerobot_mtdagger.scheduler import scheduling_methods
-from lerobot_mtdagger.studies.launchers import PARENT_PID_ENV, Job, RayRunPool, RunPool
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.parent import PARENT_PID_ENV, follow_parent  # noqa: F401  (compare's API)
 from lerobot_mtdagger.utils.parsing import parse_options
 from lerobot_mtdagger.utils.ray_session import import_ray
 
@@ -53,7 +51,6 @@ logger = logging.getLogger(__name__)
 
 RUNS_DIR = "runs"
 COMPARE_FILE = "compare.json"
-PARENT_POLL_S = 0.5
 
 
 @dataclass
@@ -70,7 +67,7 @@ class CompareConfig:
             ``cores // jobs`` torch threads (``run_resources``).
         output_dir: The compare folder (on storage every Ray node sees, with ``launcher=ray``).
         launcher: ``local`` (each run a process on this machine) or ``ray`` (each run a Ray task
-            on the cluster at ``ray_address``, ``studies/launchers.py``).
+            on the cluster at ``ray_address``, ``analysis/launchers.py``).
         ray_address: The Ray cluster of ``launcher=ray`` (``auto``: the one ``ray start`` left on
             this machine; ``ray://host:10001``; None: start a local Ray).
         ray_cpus_per_run: CPUs each run holds with ``launcher=ray`` (its torch threads, and from 2
@@ -79,7 +76,7 @@ class CompareConfig:
             ``--policy.device=cuda`` for the runs to use them).
         share_round0: A DAgger run copies the round 0 and phase 0 that a run of its seed with the same
             options but the scheduler committed before it started, and begins at round 1
-            (``studies/round_zero.py``: the scheduler acts from round 1, so they are the same to the
+            (``analysis/round_zero.py``: the scheduler acts from round 1, so they are the same to the
             bit); false: every run makes its own.
     """
 
@@ -199,40 +196,6 @@ def runs_not_started(compare_dir: Path) -> list[str]:
     return [name for name in jobs if not (Path(compare_dir) / RUNS_DIR / name).is_dir()]
 
 
-def follow_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread | None:
-    """Ends this process (SIGTERM) once the ``compare`` that started it has ended.
-
-    Called by ``lerobot-mtdagger run`` at start. Without it, a ``compare`` killed by ``kill`` or
-    ``kill -9`` leaves its runs going on in the background, writing into run folders that a new
-    ``compare`` then resumes at the same time. The run ends as a killed run does: committed rounds and
-    phases stay, the next ``compare`` resumes it. Does nothing when ``PARENT_PID_ENV`` is not set
-    (a run started by hand).
-
-    Args:
-        poll_s: Seconds between two checks of the parent process.
-
-    Returns:
-        The daemon thread that watches the parent, or None when there is no parent to follow.
-    """
-    expected = os.environ.get(PARENT_PID_ENV)
-    if not expected:
-        return None
-    parent = int(expected)
-    watcher = threading.Thread(
-        target=_end_when_orphaned, args=(parent, poll_s), name="follow-parent", daemon=True
-    )
-    watcher.start()
-    return watcher
-
-
-def _end_when_orphaned(parent: int, poll_s: float) -> None:
-    """Waits until this process's parent is no longer ``parent`` (it ended), then ends this process."""
-    while os.getppid() == parent:
-        time.sleep(poll_s)
-    logger.error("compare (pid %d) has ended; ending this run, which compare resumes when run again.", parent)
-    os.kill(os.getpid(), signal.SIGTERM)
-
-
 def run_resources(
     compare_config: CompareConfig, run_args: Sequence[str], environ: Mapping[str, str]
 ) -> tuple[int, int, int | None]:
@@ -294,8 +257,8 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
     unknown = [method for method in compare_config.methods if method not in known]
     if unknown:
         raise UserError(f"Unknown method(s) {unknown} in --methods; choose among {list(known)}.")
+    from lerobot_mtdagger.analysis.results import check_comparable, results_rows, write_results
     from lerobot_mtdagger.envs import suite_from_config
-    from lerobot_mtdagger.studies.results import check_comparable, results_rows, write_results
 
     task_names = suite_from_config(base_run_config(run_args).suite).task_names
     jobs = jobs_for(compare_config, run_args, len(task_names))

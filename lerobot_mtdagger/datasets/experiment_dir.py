@@ -47,8 +47,7 @@ from lerobot.datasets.lerobot_dataset import LeRobotDataset
 from lerobot.datasets.utils import update_chunk_file_indices
 
 from lerobot_mtdagger.datasets.config_layout import RESULT_NEUTRAL_OPTIONS, result_options
-from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
-from lerobot_mtdagger.datasets.layout import (
+from lerobot_mtdagger.datasets.experiment_files import (
     CONFIG_FILE,
     LOCK_FILE,
     PARTIAL_SUFFIX,
@@ -58,6 +57,7 @@ from lerobot_mtdagger.datasets.layout import (
     STAGING_DIR,
     TRAINING_FILE,
 )
+from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.datasets.ledger import Ledger
 from lerobot_mtdagger.datasets.migrations import migrate_run_config, resume_hint
 from lerobot_mtdagger.datasets.records import (
@@ -662,7 +662,7 @@ class SavedRunRecords(ExperimentDir):
         <run>/rounds/round-000/info.json        the round's meta/info.json (its record, "mtdagger")
         <run>/policies/round-000/training.json  the phase's training record, evaluation included
 
-    Enough to tabulate and report the run (``studies.results``), not to verify, resume, merge or push
+    Enough to tabulate and report the run (``analysis.results``), not to verify, resume, merge or push
     it: there are no frames and no weights. A round's frames are known only in total (the record's
     ``frames``), not per task.
     """

@@ -30,14 +30,14 @@ from pathlib import Path
 from typing import Any
 
 from lerobot_mtdagger.datasets.config_layout import RESULT_NEUTRAL_OPTIONS, result_options
-from lerobot_mtdagger.datasets.layout import CONFIG_FILE, STAGING_DIR
-from lerobot_mtdagger.datasets.rounds import (
+from lerobot_mtdagger.datasets.experiment_dir import (
     EXPERT_CHECK_FILE,
     ExperimentDir,
     fill_added_options,
     round_name,
     write_record_files,
 )
+from lerobot_mtdagger.datasets.experiment_files import CONFIG_FILE, STAGING_DIR
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.utils.errors import UserError
 

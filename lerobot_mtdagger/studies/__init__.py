@@ -1,1 +1,0 @@
-"""Studies: grids of runs (``compare``), results tables, reports, figures, statistics, shift."""

@@ -1,0 +1,55 @@
+"""A run that ends with the ``compare`` that started it (``follow_parent``).
+
+``compare`` sets ``PARENT_PID_ENV`` in each run's environment (``analysis.launchers``); ``run`` calls
+``follow_parent`` at start, so a ``compare`` that is killed leaves no run writing on into its folder.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import threading
+import time
+
+logger = logging.getLogger(__name__)
+
+PARENT_PID_ENV = "LEROBOT_MTDAGGER_PARENT_PID"
+"""Set by ``compare`` in each run's environment: the process id the run must not outlive."""
+
+PARENT_POLL_S = 0.5
+"""Seconds between two checks of the parent process."""
+
+
+def follow_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread | None:
+    """Ends this process (SIGTERM) once the ``compare`` that started it has ended.
+
+    Called by ``lerobot-mtdagger run`` at start. Without it, a ``compare`` killed by ``kill`` or
+    ``kill -9`` leaves its runs going on in the background, writing into run folders that a new
+    ``compare`` then resumes at the same time. The run ends as a killed run does: committed rounds and
+    phases stay, the next ``compare`` resumes it. Does nothing when ``PARENT_PID_ENV`` is not set
+    (a run started by hand).
+
+    Args:
+        poll_s: Seconds between two checks of the parent process.
+
+    Returns:
+        The daemon thread that watches the parent, or None when there is no parent to follow.
+    """
+    expected = os.environ.get(PARENT_PID_ENV)
+    if not expected:
+        return None
+    parent = int(expected)
+    watcher = threading.Thread(
+        target=_end_when_orphaned, args=(parent, poll_s), name="follow-parent", daemon=True
+    )
+    watcher.start()
+    return watcher
+
+
+def _end_when_orphaned(parent: int, poll_s: float) -> None:
+    """Waits until this process's parent is no longer ``parent`` (it ended), then ends this process."""
+    while os.getppid() == parent:
+        time.sleep(poll_s)
+    logger.error("compare (pid %d) has ended; ending this run, which compare resumes when run again.", parent)
+    os.kill(os.getpid(), signal.SIGTERM)
