@@ -17,7 +17,7 @@ import time
 
 import torch
 
-from lerobot_mtdagger.runner.frame_parts import FrameParts
+from lerobot_mtdagger.runner.training.frame_parts import FrameParts
 
 ROUND_FRAMES = (9820, 16464, 30317, 32217, 31786, 31890)
 IMAGE = (84, 84, 3)

@@ -45,7 +45,7 @@ def replay(experiment: Path, run_options: list[str], steps: int, rounds: int | N
     from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.runner.configs import RunConfig
-    from lerobot_mtdagger.runner.train import RoundCache, student_config, train_on_rounds
+    from lerobot_mtdagger.runner.training.train import RoundCache, student_config, train_on_rounds
     from lerobot_mtdagger.utils.parsing import parse_options
 
     options = [*run_options, f"--output_dir={experiment}", f"--training.steps_per_round={steps}"]

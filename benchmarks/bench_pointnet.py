@@ -37,7 +37,7 @@ from lerobot.configs.types import FeatureType, PolicyFeature
 from torch import nn
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
-from lerobot_mtdagger.runner.steps import make_optimizer
+from lerobot_mtdagger.runner.training.steps import make_optimizer
 
 STATE_DIM, TASKS, TASK_DIM, ACTION_DIM = 7, 11, 32, 4
 

@@ -38,10 +38,10 @@ import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
-from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
-from lerobot_mtdagger.runner.round_data import TrainingData, load_round
-from lerobot_mtdagger.runner.steps import LOG_INTERVAL, StepOptions, train_phase
-from lerobot_mtdagger.runner.train import build_processors
+from lerobot_mtdagger.runner.training.normalise import NormalisedData, compute_stats
+from lerobot_mtdagger.runner.training.round_data import TrainingData, load_round
+from lerobot_mtdagger.runner.training.steps import LOG_INTERVAL, StepOptions, train_phase
+from lerobot_mtdagger.runner.training.train import build_processors
 
 FRAMES = 12_000
 STATE_DIM = 39

@@ -217,7 +217,7 @@ def test_min_success_keeps_the_tasks_whose_noisy_expert_passes_and_records_them(
     tmp_path, capsys, monkeypatch
 ):
     from lerobot_mtdagger.runner import run_setup
-    from lerobot_mtdagger.runner.expert_check import expert_success
+    from lerobot_mtdagger.runner.rollout.expert_check import expert_success
 
     suite = make_suite("toy").with_expert_noise(ExpertNoise(scale=0.8, correlation=0.9))
     rates = {task: expert_success(suite, i, 10, seed=0) for i, task in enumerate(suite.task_names)}

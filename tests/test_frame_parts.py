@@ -13,12 +13,12 @@ from lerobot.configs.types import FeatureType, PolicyFeature
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
 from lerobot_mtdagger.runner import normalise
-from lerobot_mtdagger.runner.frame_parts import FrameParts, join_frames, materialise
-from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
-from lerobot_mtdagger.runner.round_data import EPISODE_ID_STRIDE, TrainingData
-from lerobot_mtdagger.runner.steps import StepOptions, train_phase
-from lerobot_mtdagger.runner.task_loss import per_task_loss, per_task_loss_of
-from lerobot_mtdagger.runner.train import build_processors
+from lerobot_mtdagger.runner.training.frame_parts import FrameParts, join_frames, materialise
+from lerobot_mtdagger.runner.training.normalise import NormalisedData, compute_stats
+from lerobot_mtdagger.runner.training.round_data import EPISODE_ID_STRIDE, TrainingData
+from lerobot_mtdagger.runner.training.steps import StepOptions, train_phase
+from lerobot_mtdagger.runner.training.task_loss import per_task_loss, per_task_loss_of
+from lerobot_mtdagger.runner.training.train import build_processors
 
 TASKS = ["task-a", "task-b", "task-c"]
 IMAGE_SHAPE = (8, 8, 3)

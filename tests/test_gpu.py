@@ -15,9 +15,9 @@ from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
-from lerobot_mtdagger.runner.evaluate import PolicyRunner
-from lerobot_mtdagger.runner.frame_parts import FrameParts
-from lerobot_mtdagger.runner.round_data import load_round
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.training.frame_parts import FrameParts
+from lerobot_mtdagger.runner.training.round_data import load_round
 from tests.helpers import small_drawer_cloud_args
 
 pytestmark = [

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.runner.mixing import RolloutRules, episode_ends, expert_acts_now, step_limit
+from lerobot_mtdagger.runner.rollout.mixing import RolloutRules, episode_ends, expert_acts_now, step_limit
 
 
 def rules(**changes) -> RolloutRules:

@@ -20,9 +20,9 @@ from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
-from lerobot_mtdagger.runner.phase_progress import PhaseProgress, phase_key
-from lerobot_mtdagger.runner.plateau import PlateauStop
-from lerobot_mtdagger.runner.steps import StepOptions, train_phase
+from lerobot_mtdagger.runner.training.phase_progress import PhaseProgress, phase_key
+from lerobot_mtdagger.runner.training.plateau import PlateauStop
+from lerobot_mtdagger.runner.training.steps import StepOptions, train_phase
 from lerobot_mtdagger.utils.parsing import parse_options
 from tests.helpers import kill_9_and_check_workers_end
 from tests.test_toy import TOY_RUN

@@ -24,24 +24,24 @@ import torch
 
 from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.envs import make_suite
-from lerobot_mtdagger.runner.collect import (
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.dagger import run
+from lerobot_mtdagger.runner.option_groups import RolloutConfig, TrainingConfig
+from lerobot_mtdagger.runner.rollout.collect import (
     EpisodeOptions,
     learner_success_by_task,
     run_episodes,
     success_by_task,
 )
-from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.dagger import run
-from lerobot_mtdagger.runner.evaluate import PolicyRunner
-from lerobot_mtdagger.runner.mixing import expert_episode_coin
-from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
-from lerobot_mtdagger.runner.option_groups import RolloutConfig, TrainingConfig
-from lerobot_mtdagger.runner.round_data import EPISODE_ID_STRIDE, TrainingData
-from lerobot_mtdagger.runner.splits import heldout_episodes, split_frames
-from lerobot_mtdagger.runner.steps import batch_sampler
-from lerobot_mtdagger.runner.task_loss import per_task_loss, per_task_loss_of, performance_gain
-from lerobot_mtdagger.runner.train import build_processors
-from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.rollout.mixing import expert_episode_coin
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
+from lerobot_mtdagger.runner.training.normalise import NormalisedData, compute_stats
+from lerobot_mtdagger.runner.training.round_data import EPISODE_ID_STRIDE, TrainingData
+from lerobot_mtdagger.runner.training.splits import heldout_episodes, split_frames
+from lerobot_mtdagger.runner.training.steps import batch_sampler
+from lerobot_mtdagger.runner.training.task_loss import per_task_loss, per_task_loss_of, performance_gain
+from lerobot_mtdagger.runner.training.train import build_processors
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.seeds import BETA_STREAM, COLLECT_STREAM
 from tests.test_toy import TOY_RUN

@@ -26,8 +26,8 @@ from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.envs import SuiteConfig, suite_from_config
 from lerobot_mtdagger.runner import dagger
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.ray_workers import RayEnvWorkers
-from lerobot_mtdagger.runner.workers import WorkerDiedError
+from lerobot_mtdagger.runner.rollout.ray_workers import RayEnvWorkers
+from lerobot_mtdagger.runner.rollout.workers import WorkerDiedError
 from lerobot_mtdagger.utils.errors import UserError
 
 ray = pytest.importorskip("ray")

@@ -24,8 +24,8 @@ from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.runner import dagger as dagger_module
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
-from lerobot_mtdagger.runner.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.option_groups import TrainingConfig
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
 from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
 from tests.helpers import edit_round_record
 from tests.test_toy import TOY_RUN, toy_config

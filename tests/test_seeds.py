@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 import lerobot_mtdagger
-from lerobot_mtdagger.runner.collect import episode_seed
+from lerobot_mtdagger.runner.rollout.collect import episode_seed
 from lerobot_mtdagger.utils import seeds
 
 PACKAGE = Path(lerobot_mtdagger.__file__).parent

@@ -13,8 +13,8 @@ from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.toy import START_BOX, TOY_TASKS
 from lerobot_mtdagger.experts.toy import ToyExpert
-from lerobot_mtdagger.runner.evaluate import evaluate
-from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.runner.rollout.evaluate import evaluate
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
 
 EXPERT = ToyExpert()
 

@@ -194,7 +194,7 @@ def test_every_room_of_the_runner_is_small():
 
 def test_a_training_phase_reads_in_one_screen():
     """``steps.train_phase`` measures, hands the steps to ``StepLoop`` and records: one screen."""
-    tree = ast.parse(module_path("lerobot_mtdagger.runner.steps").read_text())
+    tree = ast.parse(module_path("lerobot_mtdagger.runner.training.steps").read_text())
     (train_phase,) = [n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == "train_phase"]
     assert train_phase.end_lineno - train_phase.lineno + 1 <= MAX_TRAIN_PHASE_LINES
 
@@ -205,7 +205,7 @@ def test_the_dagger_loop_hands_each_training_phase_to_train():
     from_train = [
         alias.name
         for node in tree.body
-        if isinstance(node, ast.ImportFrom) and node.module == "lerobot_mtdagger.runner.train"
+        if isinstance(node, ast.ImportFrom) and node.module == "lerobot_mtdagger.runner.training.train"
         for alias in node.names
     ]
     assert len(from_train) <= 4, from_train
@@ -222,11 +222,48 @@ def test_verify_loads_policies_without_the_rollout_stack():
             seen.add(name)
             todo.extend(imports_of(name))
     assert not seen & {
-        "lerobot_mtdagger.runner.workers",
-        "lerobot_mtdagger.runner.collect",
-        "lerobot_mtdagger.runner.evaluate",
+        "lerobot_mtdagger.runner.rollout.workers",
+        "lerobot_mtdagger.runner.rollout.collect",
+        "lerobot_mtdagger.runner.rollout.evaluate",
     }
 
+
+
+RUNNER = "lerobot_mtdagger.runner"
+RUNNER_ROOMS = {f"{RUNNER}.rollout": 1, f"{RUNNER}.training": 2}
+"""The runner's sub-wings, below its root (the loop, its configs, the ``Student`` contract): training
+may use rollout (the previous phase's ``PolicyRunner``), rollout never uses training."""
+
+LOOP_MODULES = {f"{RUNNER}.dagger", f"{RUNNER}.run_setup"}
+
+
+def runner_room(name: str) -> str | None:
+    """The runner sub-wing a module belongs to (None: the runner's root or outside the runner)."""
+    return next((room for room in RUNNER_ROOMS if name == room or name.startswith(room + ".")), None)
+
+
+def runner_room_violations(graph: dict[str, set[str]]) -> list[str]:
+    """Imports from a runner sub-wing up to the loop, or to a sub-wing of a higher rank."""
+    wrong = []
+    for name, targets in graph.items():
+        source = runner_room(name)
+        if source is None:
+            continue
+        for target in sorted(targets):
+            destination = runner_room(target)
+            upward = destination is not None and RUNNER_ROOMS[destination] > RUNNER_ROOMS[source]
+            if target in LOOP_MODULES or upward:
+                wrong.append(f"{name} -> {target}")
+    return wrong
+
+
+def test_the_runner_s_rooms_rank_below_the_loop():
+    """Function-level imports included: rollout and training never import the loop, rollout never training."""
+    graph = {name: imports_of(name) for name in package_modules()}
+    assert runner_room_violations(graph) == []
+    assert len([name for name in graph if runner_room(name)]) >= 18  # the rooms exist
+    assert runner_room_violations({f"{RUNNER}.rollout.collect": {f"{RUNNER}.training.steps"}}) != []
+    assert runner_room_violations({f"{RUNNER}.training.train": {f"{RUNNER}.dagger"}}) != []
 
 WING_RANKS = {
     "lerobot_mtdagger.cli": 6,

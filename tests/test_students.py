@@ -28,11 +28,11 @@ from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE, TaskOneHotProcessorStep, task_one_hot
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
-from lerobot_mtdagger.runner.evaluate import ChunkRunner, PolicyRunner, evaluate
+from lerobot_mtdagger.runner.rollout.evaluate import ChunkRunner, PolicyRunner, evaluate
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
 from lerobot_mtdagger.runner.student import get_student
 from lerobot_mtdagger.runner.student_options import lerobot_students
 from lerobot_mtdagger.runner.students import EpisodeWindows, LeRobotOps, lerobot_student_config
-from lerobot_mtdagger.runner.workers import EnvWorkers
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
 
@@ -345,8 +345,8 @@ class _Forward:
 
 
 def test_the_per_task_loss_of_a_lerobot_student_is_reproducible(act_run):
-    from lerobot_mtdagger.runner.normalise import NormalisedData
-    from lerobot_mtdagger.runner.train import RoundCache
+    from lerobot_mtdagger.runner.training.normalise import NormalisedData
+    from lerobot_mtdagger.runner.training.train import RoundCache
 
     runner = PolicyRunner.from_pretrained(ExperimentDir(act_run).policy_root(2))
     experiment = ExperimentDir(act_run)
@@ -367,10 +367,10 @@ class CutError(Exception):
 
 def act_phase(act_run: Path, progress: Path | None = None, cut_after: int | None = None):
     """45 steps of the trained ACT student on its run's frames, with task dropout (the seam's generator)."""
-    from lerobot_mtdagger.runner.normalise import NormalisedData
-    from lerobot_mtdagger.runner.phase_progress import PhaseProgress
-    from lerobot_mtdagger.runner.steps import StepOptions, train_phase
-    from lerobot_mtdagger.runner.train import RoundCache
+    from lerobot_mtdagger.runner.training.normalise import NormalisedData
+    from lerobot_mtdagger.runner.training.phase_progress import PhaseProgress
+    from lerobot_mtdagger.runner.training.steps import StepOptions, train_phase
+    from lerobot_mtdagger.runner.training.train import RoundCache
 
     experiment = ExperimentDir(act_run)
     runner = PolicyRunner.from_pretrained(experiment.policy_root(2))

@@ -22,12 +22,17 @@ from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.envs.toy import MAX_EPISODE_STEPS, TOY_TASKS
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.runner.collect import EpisodeOptions, episode_seed, run_episodes, success_by_task
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
-from lerobot_mtdagger.runner.round_data import TrainingData
-from lerobot_mtdagger.runner.splits import LOSS_SAMPLES_PER_TASK, split_frames
-from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.runner.rollout.collect import (
+    EpisodeOptions,
+    episode_seed,
+    run_episodes,
+    success_by_task,
+)
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
+from lerobot_mtdagger.runner.training.round_data import TrainingData
+from lerobot_mtdagger.runner.training.splits import LOSS_SAMPLES_PER_TASK, split_frames
 from lerobot_mtdagger.scheduler import scheduling_methods
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM, EVAL_STREAM

@@ -12,13 +12,18 @@ from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
-from lerobot_mtdagger.runner.frame_parts import materialise
-from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
-from lerobot_mtdagger.runner.plateau import PlateauStop
-from lerobot_mtdagger.runner.round_data import EPISODE_ID_STRIDE, TrainingData, load_round, load_rounds
-from lerobot_mtdagger.runner.steps import MTDAggerOps, StepOptions, train_phase
-from lerobot_mtdagger.runner.task_loss import per_task_loss
-from lerobot_mtdagger.runner.train import build_processors
+from lerobot_mtdagger.runner.training.frame_parts import materialise
+from lerobot_mtdagger.runner.training.normalise import NormalisedData, compute_stats
+from lerobot_mtdagger.runner.training.plateau import PlateauStop
+from lerobot_mtdagger.runner.training.round_data import (
+    EPISODE_ID_STRIDE,
+    TrainingData,
+    load_round,
+    load_rounds,
+)
+from lerobot_mtdagger.runner.training.steps import MTDAggerOps, StepOptions, train_phase
+from lerobot_mtdagger.runner.training.task_loss import per_task_loss
+from lerobot_mtdagger.runner.training.train import build_processors
 from tests.conftest import record_expert_dataset
 
 TASKS = ["task-a", "task-b", "task-c"]

@@ -16,7 +16,7 @@ from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.drawers.catalogue import HELDOUT_DRAWERS, TRAINING_DRAWERS, VARIANTS
 from lerobot_mtdagger.envs.drawers.variants import nearest_variant
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
-from lerobot_mtdagger.runner.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
 from lerobot_mtdagger.utils.errors import UserError
 
 TRAINED = ["drawer-kitchen", "drawer-lip-shallow"]

@@ -18,8 +18,8 @@ import pytest
 from lerobot_mtdagger.datasets.records import EXECUTED_ACTION, LEARNER_ACTED
 from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.runner.collect import EpisodeOptions, run_episodes
-from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.runner.rollout.collect import EpisodeOptions, run_episodes
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
 DRAWERS = ["drawer-bar-wide", "drawer-knob-small", "drawer-lip-shallow"]

@@ -13,12 +13,12 @@ import pytest
 from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.envs import SuiteConfig, make_suite
 from lerobot_mtdagger.experts import make_expert
-from lerobot_mtdagger.runner.collect import EpisodeOptions, run_episodes
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
-from lerobot_mtdagger.runner.evaluate import evaluate
 from lerobot_mtdagger.runner.option_groups import RolloutConfig
-from lerobot_mtdagger.runner.workers import EnvWorkers, RemoteWorkerError, WorkerDiedError
+from lerobot_mtdagger.runner.rollout.collect import EpisodeOptions, run_episodes
+from lerobot_mtdagger.runner.rollout.evaluate import evaluate
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers, RemoteWorkerError, WorkerDiedError
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
 from .test_toy import TOY_RUN
@@ -175,7 +175,7 @@ def test_lanes_are_spread_evenly_over_the_workers(tasks, workers):
     """
     from collections import deque
 
-    from lerobot_mtdagger.runner.collect import LANE_GROUPS, _assign, _Lane, _Schedule
+    from lerobot_mtdagger.runner.rollout.collect import LANE_GROUPS, _assign, _Lane, _Schedule
 
     lanes = [_Lane(home_task=task, group=task % LANE_GROUPS) for task in range(tasks)]
     schedule = _Schedule(

@@ -25,8 +25,8 @@ import torch
 
 from lerobot_mtdagger.analysis.shift import ShiftResult, measure_shift
 from lerobot_mtdagger.envs import ObservationConfig, make_suite
-from lerobot_mtdagger.runner.evaluate import PolicyRunner
-from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
 
 RUNS = Path("outputs/mt50-state-eval/runs")
 HERE = Path("experiments/mt50-state-eval")

@@ -22,8 +22,8 @@ from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.envs.drawers.variants import STATE_INDEX
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.experts.drawers import BRANCHES
-from lerobot_mtdagger.runner.collect import EVAL_STREAM, episode_seed
-from lerobot_mtdagger.runner.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.rollout.collect import EVAL_STREAM, episode_seed
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
 
 
 def misalignment(state: np.ndarray) -> tuple[float, float, float]:

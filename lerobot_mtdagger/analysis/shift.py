@@ -30,8 +30,8 @@ import gymnasium as gym
 import numpy as np
 
 from lerobot_mtdagger.envs.base import TaskSuite
-from lerobot_mtdagger.runner.collect import EpisodeOptions, PolicyFn, run_episodes, success_by_task
-from lerobot_mtdagger.runner.workers import EnvWorkers, Episode
+from lerobot_mtdagger.runner.rollout.collect import EpisodeOptions, PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers, Episode
 from lerobot_mtdagger.utils.seeds import EVAL_STREAM
 
 

@@ -22,7 +22,7 @@ from lerobot_mtdagger.utils.paths import check_output_file
 
 if TYPE_CHECKING:
     from lerobot_mtdagger.envs.base import TaskSuite
-    from lerobot_mtdagger.runner.evaluate import PolicyRunner
+    from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
 
 HELDOUT_TASKS = "heldout"
 """``--suite.tasks='[heldout]'``: the suite's unseen tasks (``eval``, ``shift``)."""
@@ -133,7 +133,7 @@ def check_committed_policy(folder: Path, allow_changed: bool) -> None:
 def suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
     """The suite the config names and its pretrained policy, checked to take the suite's observations."""
     from lerobot_mtdagger.envs import suite_from_config
-    from lerobot_mtdagger.runner.evaluate import PolicyRunner
+    from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
 
     check_committed_policy(Path(config.policy_path), config.allow_changed_policy)
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
@@ -188,7 +188,7 @@ def observation_options(runner: PolicyRunner, suite: SuiteConfig) -> dict[str, A
 
 def eval_command(config: EvalConfig) -> dict:
     """Evaluates a pretrained policy per task with the pure policy acting."""
-    from lerobot_mtdagger.runner.evaluate import evaluate
+    from lerobot_mtdagger.runner.rollout.evaluate import evaluate
 
     suite, runner = suite_and_policy(config)
     with config.env_workers(suite) as workers:

@@ -47,7 +47,7 @@ RESULT_NEUTRAL_OPTIONS: tuple[str, ...] = (
     "rollout.worker_backend",
     "rollout.ray_address",
     "policy.device",
-    "training.progress_every_s",  # a resumed phase ends as it would have (runner.phase_progress)
+    "training.progress_every_s",  # a resumed phase ends as it would have (runner.training.phase_progress)
 )
 """Options (dotted paths) that never change a result, free to differ on resume."""
 

@@ -16,7 +16,7 @@ Layout of an experiment directory::
                                      processors) and training.json (per-task losses, gain, eval)
             .staging/round-001/      a training phase being written
             .progress/round-001.pt   its progress, saved every few minutes: kept on resume, which
-                                     goes on from it (runner.phase_progress); deleted at commit
+                                     goes on from it (runner.training.phase_progress); deleted at commit
 
 A round or training phase is committed by an atomic rename of its finished staging folder; anything
 cut off half-way stays in ``.staging`` and is discarded, so a committed round is immutable and
@@ -75,7 +75,7 @@ from lerobot_mtdagger.utils.quiet import quiet_third_party
 logger = logging.getLogger(__name__)
 
 EXPERT_CHECK_FILE = "expert_check.json"
-"""The measurement that chose an experiment's tasks (``--expert.min_success``, ``runner/expert_check.py``)."""
+"""The measurement that chose an experiment's tasks (``--expert.min_success``, ``rollout.expert_check``)."""
 
 
 STATS_FILE = "meta/stats.json"
@@ -569,7 +569,7 @@ class ExperimentDir:
         )
 
     def phase_progress_path(self, round_index: int) -> Path:
-        """The saved progress of a phase being trained (``runner.phase_progress``)."""
+        """The saved progress of a phase being trained (``runner.training.phase_progress``)."""
         return self.policies / PROGRESS_DIR / f"{round_name(round_index)}.pt"
 
     def staging_policy_root(self, round_index: int) -> Path:

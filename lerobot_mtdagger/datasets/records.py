@@ -277,7 +277,7 @@ class PhaseRecord:
         passes_per_task: Per task, the frames the phase's steps drew over its training frames (how
             many passes over each task's data it made); None in phases written before it was recorded.
         resumed_after_steps: The steps after which a cut phase was resumed from its saved progress
-            (``runner.phase_progress``), in order; empty: trained in one go; None in phases written
+            (``runner.training.phase_progress``), in order; empty: trained in one go; None in phases written
             before progress was saved. Its ``steps_s`` and ``train_s`` count every process's steps.
     """
 

@@ -236,7 +236,7 @@ class TaskSuite(abc.ABC):
         """A copy of the suite whose experts act with ``noise`` (``experts.noise.ExpertNoise``).
 
         The rollout workers add it to every expert action they execute
-        (``runner/rollout_worker.py``); None, or a noise of scale 0, leaves the experts as they are.
+        (``runner/rollout/rollout_worker.py``); None, or a noise of scale 0, leaves the experts as they are.
         """
         clone = self.with_observation()
         clone.expert_noise = noise if noise is not None and noise.active else None

@@ -1,1 +1,1 @@
-"""The runner: the DAgger loop, collection, env workers, mixing, training, evaluation, students."""
+"""The runner: the DAgger loop, its configs and the ``Student`` contract; ``rollout/`` and ``training/``."""

@@ -32,7 +32,7 @@ a warm-started policy sees its inputs as before; held-out episodes (``gain_split
 ``steps_rule=plateau``) are chosen once per episode and stay held out.
 
 Resuming: committed rounds and phases are immutable; a run restarts at the first uncommitted step (a
-training phase from its saved progress, where it has some: ``runner.phase_progress``).
+training phase from its saved progress, where it has some: ``runner.training.phase_progress``).
 Every random choice derives from the seed and the round, and the scheduler's state after each round
 is stored in the round's record, so a resumed run makes the same allocations as an uninterrupted one.
 """
@@ -53,16 +53,17 @@ from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.records import RoundRecord
 from lerobot_mtdagger.envs import suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
-from lerobot_mtdagger.runner.collect import (
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.rollout.collect import (
     Episode,
     EpisodeOptions,
     learner_success_by_task,
     run_episodes,
     success_by_task,
 )
-from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.evaluate import EvalResult, PolicyRunner, evaluate
-from lerobot_mtdagger.runner.expert_check import EXPERT_CHECK_FILE
+from lerobot_mtdagger.runner.rollout.evaluate import EvalResult, PolicyRunner, evaluate
+from lerobot_mtdagger.runner.rollout.expert_check import EXPERT_CHECK_FILE
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
 from lerobot_mtdagger.runner.run_setup import (
     beta_for_round,
     check_budget,
@@ -70,8 +71,7 @@ from lerobot_mtdagger.runner.run_setup import (
     new_scheduler,
     unseen_task_suite,
 )
-from lerobot_mtdagger.runner.train import RoundCache, check_heldout, student_config, train_on_rounds
-from lerobot_mtdagger.runner.workers import EnvWorkers
+from lerobot_mtdagger.runner.training.train import RoundCache, check_heldout, student_config, train_on_rounds
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
 from lerobot_mtdagger.utils.quiet import quiet_third_party
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM

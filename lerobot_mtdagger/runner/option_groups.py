@@ -127,7 +127,7 @@ class WorkerOptions:
             the envs in the main process; with ``worker_backend=ray``, at least one actor). Never
             changes a result.
         worker_backend: ``local`` (forked processes on this machine) or ``ray`` (Ray actors spread
-            over a Ray cluster, ``runner/ray_workers.py``). Never changes a result.
+            over a Ray cluster, ``runner/rollout/ray_workers.py``). Never changes a result.
         ray_address: The Ray cluster of ``worker_backend=ray`` (``auto``: the one ``ray start`` left
             on this machine; ``ray://host:10001``; None: start a local Ray).
     """
@@ -160,7 +160,7 @@ class WorkerOptions:
         ``reserve_cpus=False``: a pool that runs only while the run's own workers wait (on Ray its
         actors reserve no CPU, so a cluster the size of ``workers`` does not wait on itself).
         """
-        from lerobot_mtdagger.runner.ray_workers import make_env_workers
+        from lerobot_mtdagger.runner.rollout.ray_workers import make_env_workers
 
         return make_env_workers(suite, self.worker_count, self.worker_backend, self.ray_address, reserve_cpus)
 
@@ -227,7 +227,7 @@ class ExpertConfig:
             ``register_expert_type``, or an importable ``module:attribute``. None: the registered experts.
         min_success: Keep only the tasks whose expert (as the run uses it, noise included) succeeds at
             least this often over ``success_episodes`` episodes, measured before round 0 (the paper kept
-            the MT50 tasks its SAC experts passed at 80%; ``runner/expert_check.py``). None: every task.
+            the MT50 tasks its SAC experts passed at 80%; ``rollout/expert_check.py``). None: every task.
         success_episodes: Episodes per task that ``min_success`` is measured on.
     """
 
@@ -318,7 +318,7 @@ class TrainingConfig:
             same data: the spread between trainings, apart from the data's. None: ``--seed``.
         progress_every_s: Seconds of training between two saves of a phase's progress
             (``policies/.progress``), from which a phase cut off part-way resumes with
-            ``--resume=true`` and ends as it would have (``runner.phase_progress``); 0: never saved,
+            ``--resume=true`` and ends as it would have (``runner.training.phase_progress``); 0: never saved,
             a cut phase starts over. Changes no result.
     """
 

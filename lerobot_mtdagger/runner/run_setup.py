@@ -11,7 +11,7 @@ import logging
 from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.expert_check import EXPERT_CHECK_FILE, ExpertCheck, measure_expert_check
+from lerobot_mtdagger.runner.rollout.expert_check import EXPERT_CHECK_FILE, ExpertCheck, measure_expert_check
 from lerobot_mtdagger.scheduler import Scheduler
 from lerobot_mtdagger.utils.errors import UserError
 

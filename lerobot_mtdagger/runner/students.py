@@ -312,7 +312,7 @@ class LeRobotStudent(Student):
 
     def make_runner(self, policy: Any, preprocessor: Any, postprocessor: Any) -> Any:
         """``evaluate.ChunkRunner``: an action queue per running episode, chunks from ``predict_chunk``."""
-        from lerobot_mtdagger.runner.evaluate import ChunkRunner
+        from lerobot_mtdagger.runner.rollout.evaluate import ChunkRunner
 
         return ChunkRunner(policy, preprocessor, postprocessor, predict_chunk=self.predict_chunk)
 

@@ -14,7 +14,7 @@ Streams (number; the keys after it; what it decides):
 - ``NOISE_STREAM`` (4; round, task, episode): an imperfect expert's action noise (``experts/noise.py``),
   seeded by ``--expert.noise_seed`` in place of the run's seed.
 - ``EXPERT_CHECK_STREAM`` (5; 0, task, episode): the env reset of an episode that measures a task's
-  expert for ``--expert.min_success`` (``runner/expert_check.py``).
+  expert for ``--expert.min_success`` (``runner/rollout/expert_check.py``).
 - ``HELDOUT_STREAM`` (7; task): which episodes a run holds out of training.
 
 The frames each phase measures its per-task loss on are drawn from ``np.random.default_rng(seed)``

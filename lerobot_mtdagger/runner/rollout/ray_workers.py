@@ -28,8 +28,8 @@ from collections import deque
 from typing import Any
 
 from lerobot_mtdagger.envs.base import TaskSuite
-from lerobot_mtdagger.runner.rollout_worker import RolloutWorker
-from lerobot_mtdagger.runner.workers import EnvWorkers, WorkerDiedError, answer, reply_payload
+from lerobot_mtdagger.runner.rollout.rollout_worker import RolloutWorker
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers, WorkerDiedError, answer, reply_payload
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.ray_session import connect
 

@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 import torch
 
-from lerobot_mtdagger.runner.frame_parts import FrameParts, FrameTensor, materialise
-from lerobot_mtdagger.runner.round_data import TrainingData
+from lerobot_mtdagger.runner.training.frame_parts import FrameParts, FrameTensor, materialise
+from lerobot_mtdagger.runner.training.round_data import TrainingData
 
 STATS_CHUNK = 8192
 """Frames read at a time for the normalisation statistics."""

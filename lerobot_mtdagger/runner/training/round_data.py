@@ -18,7 +18,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import torch
 
-from lerobot_mtdagger.runner.frame_parts import FrameTensor, join_frames
+from lerobot_mtdagger.runner.training.frame_parts import FrameTensor, join_frames
 
 EPISODE_ID_STRIDE = 1_000_000
 """``episode_id = episode_index + round_position * EPISODE_ID_STRIDE``."""

@@ -19,9 +19,9 @@ import torch
 from lerobot_mtdagger.datasets.checkpoints import load_policy
 from lerobot_mtdagger.policies import TASK_FEATURE
 from lerobot_mtdagger.policies.task_conditioning import TaskOneHotProcessorStep
-from lerobot_mtdagger.runner.collect import EpisodeOptions, PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.runner.rollout.collect import EpisodeOptions, PolicyFn, run_episodes, success_by_task
+from lerobot_mtdagger.runner.rollout.workers import EnvWorkers, Episode
 from lerobot_mtdagger.runner.student import student_of_policy
-from lerobot_mtdagger.runner.workers import EnvWorkers, Episode
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 from lerobot_mtdagger.utils.seeds import EVAL_STREAM

@@ -23,11 +23,11 @@ import torch
 
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE
-from lerobot_mtdagger.runner.normalise import NormalisedData
-from lerobot_mtdagger.runner.phase_progress import PhaseProgress, loop_state, restore_loop
-from lerobot_mtdagger.runner.plateau import PlateauStop, PlateauTracker
 from lerobot_mtdagger.runner.student import Student, student_of_policy
-from lerobot_mtdagger.runner.task_loss import per_task_loss, performance_gain
+from lerobot_mtdagger.runner.training.normalise import NormalisedData
+from lerobot_mtdagger.runner.training.phase_progress import PhaseProgress, loop_state, restore_loop
+from lerobot_mtdagger.runner.training.plateau import PlateauStop, PlateauTracker
+from lerobot_mtdagger.runner.training.task_loss import per_task_loss, performance_gain
 from lerobot_mtdagger.utils.errors import UserError
 
 logger = logging.getLogger(__name__)

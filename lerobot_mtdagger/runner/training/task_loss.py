@@ -13,7 +13,7 @@ import torch
 
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
-from lerobot_mtdagger.runner.normalise import NormalisedData
+from lerobot_mtdagger.runner.training.normalise import NormalisedData
 
 
 @torch.no_grad()

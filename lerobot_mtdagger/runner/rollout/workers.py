@@ -1,8 +1,8 @@
 """Env workers: the simulators of a run stepped in worker processes, one per core by default.
 
 A ``RolloutWorker`` owns envs and experts and runs each episode of a rollout (reset, the expert's
-label, the env step, recording) by the DAgger mixing rules of ``lerobot_mtdagger.runner.mixing`` (who acts,
-when an episode ends). The main process
+label, the env step, recording) by the DAgger mixing rules of ``mixing`` (who acts, when an
+episode ends). The main process
 keeps the policy and talks to the workers (see ``collect.run_episodes``): one message per worker
 per step of a group of episodes, carrying the learner's actions for that worker's episodes and the episodes to
 start, one reply carrying the new observations and the finished episodes.
@@ -35,10 +35,10 @@ from typing import Any
 import numpy as np
 
 from lerobot_mtdagger.envs.base import TaskSuite
-from lerobot_mtdagger.runner.mixing import (
+from lerobot_mtdagger.runner.rollout.mixing import (
     RolloutRules,
 )
-from lerobot_mtdagger.runner.rollout_worker import Episode, EpisodeSpec, RolloutWorker
+from lerobot_mtdagger.runner.rollout.rollout_worker import Episode, EpisodeSpec, RolloutWorker
 
 logger = logging.getLogger(__name__)
 

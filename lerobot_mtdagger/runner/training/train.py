@@ -23,15 +23,15 @@ from tqdm import tqdm
 from lerobot_mtdagger.datasets.records import PhaseRecord
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.evaluate import PolicyRunner
-from lerobot_mtdagger.runner.normalise import NormalisedData, compute_stats
-from lerobot_mtdagger.runner.phase_progress import PhaseProgress, phase_key
-from lerobot_mtdagger.runner.plateau import plateau_stop
-from lerobot_mtdagger.runner.provenance import training_environment
-from lerobot_mtdagger.runner.round_data import TrainingData, load_round
-from lerobot_mtdagger.runner.splits import heldout_mask, normalisation_frames, split_frames
-from lerobot_mtdagger.runner.steps import PhaseResult, StepOptions, train_phase
-from lerobot_mtdagger.runner.task_loss import performance_gain
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.training.normalise import NormalisedData, compute_stats
+from lerobot_mtdagger.runner.training.phase_progress import PhaseProgress, phase_key
+from lerobot_mtdagger.runner.training.plateau import plateau_stop
+from lerobot_mtdagger.runner.training.provenance import training_environment
+from lerobot_mtdagger.runner.training.round_data import TrainingData, load_round
+from lerobot_mtdagger.runner.training.splits import heldout_mask, normalisation_frames, split_frames
+from lerobot_mtdagger.runner.training.steps import PhaseResult, StepOptions, train_phase
+from lerobot_mtdagger.runner.training.task_loss import performance_gain
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 from lerobot_mtdagger.utils.seeds import TRAINING_STREAM, stream_seed

@@ -21,7 +21,7 @@ from typing import Any
 
 from lerobot_mtdagger.datasets.experiment_dir import EXPERT_CHECK_FILE
 from lerobot_mtdagger.experts import make_expert, run_expert_episode
-from lerobot_mtdagger.runner.collect import episode_seed
+from lerobot_mtdagger.runner.rollout.collect import episode_seed
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.seeds import EXPERT_CHECK_STREAM
 

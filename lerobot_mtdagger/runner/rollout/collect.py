@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lerobot_mtdagger.runner.mixing import RolloutRules
-from lerobot_mtdagger.runner.workers import (
+from lerobot_mtdagger.runner.rollout.mixing import RolloutRules
+from lerobot_mtdagger.runner.rollout.workers import (
     EnvWorkers,
     Episode,
     EpisodeSpec,

@@ -1,7 +1,7 @@
 """A rollout worker: its envs and experts, and each episode it runs (reset, label, step, record).
 
 A ``RolloutWorker`` runs each episode of a rollout by the DAgger mixing rules of
-``lerobot_mtdagger.runner.mixing`` (who acts, when an episode ends); ``workers.EnvWorkers`` drives
+``lerobot_mtdagger.runner.rollout.mixing`` (who acts, when an episode ends); ``workers.EnvWorkers`` drives
 one in the calling process or in each worker process. Everything an episode does depends only on its
 seeds and on the learner's actions, never on which worker ran it or which env of its pool it reused.
 """
@@ -19,7 +19,7 @@ from lerobot_mtdagger.datasets.records import StepOutcome, dagger_columns
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.experts import make_expert
 from lerobot_mtdagger.experts.noise import ActionNoise
-from lerobot_mtdagger.runner.mixing import (
+from lerobot_mtdagger.runner.rollout.mixing import (
     RolloutRules,
     episode_ends,
     expert_acts_now,

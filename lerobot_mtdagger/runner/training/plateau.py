@@ -10,8 +10,8 @@ import numpy as np
 import torch
 
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.normalise import NormalisedData
-from lerobot_mtdagger.runner.splits import FrameSplit
+from lerobot_mtdagger.runner.training.normalise import NormalisedData
+from lerobot_mtdagger.runner.training.splits import FrameSplit
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ import numpy as np
 import torch
 
 from lerobot_mtdagger.runner.configs import RunConfig
-from lerobot_mtdagger.runner.round_data import EPISODE_ID_STRIDE, TrainingData
+from lerobot_mtdagger.runner.training.round_data import EPISODE_ID_STRIDE, TrainingData
 from lerobot_mtdagger.utils.sampling import systematic_picks
 from lerobot_mtdagger.utils.seeds import HELDOUT_STREAM
 

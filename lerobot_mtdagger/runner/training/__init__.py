@@ -1,0 +1,1 @@
+"""Training phases: round data, normalisation, splits, steps, per-task loss, plateau, progress, provenance."""
