@@ -34,11 +34,11 @@ from lerobot_mtdagger.datasets.records import EXECUTED_ACTION
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.metaworld import _make_raw_env
 from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.runner.policy_options import PolicyOptions
 from lerobot_mtdagger.runner.rollout.collect import EpisodeOptions, run_episodes
 from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner, evaluate
 from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
-from lerobot_mtdagger.runner.student_options import PolicyOptions
-from lerobot_mtdagger.runner.training.train import build_processors, policy_config
+from lerobot_mtdagger.students.mtdagger import build_processors, policy_config
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
 
 TARGET = 0.7

@@ -15,7 +15,7 @@ Two ways to train each:
 
 - ``bare``: a plain PyTorch loop (forward with ``max`` over points, MSE, backward, AdamW step);
 - ``policy``: the ``mtdagger`` policy of the same layers, trained as ``train.train_phase`` trains it
-  (``imitation_loss``, gradient clipping, the fused AdamW of ``train.make_optimizer``); its PointNet
+  (``imitation_loss``, gradient clipping, the fused AdamW of ``make_optimizer``); its PointNet
   back-propagates through the winning points of the max-pool only (``max_pool_of_winners``).
 
 The loops run in interleaved rounds and the medians are compared, so the ratios are side by side;
@@ -37,7 +37,7 @@ from lerobot.configs.types import FeatureType, PolicyFeature
 from torch import nn
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
-from lerobot_mtdagger.runner.training.steps import make_optimizer
+from lerobot_mtdagger.students.mtdagger import make_optimizer
 
 STATE_DIM, TASKS, TASK_DIM, ACTION_DIM = 7, 11, 32, 4
 

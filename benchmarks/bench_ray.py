@@ -25,11 +25,11 @@ from bench_collect import collect_rate, eval_rate  # the same round and evaluati
 
 from lerobot_mtdagger.envs import ObservationConfig, make_suite
 from lerobot_mtdagger.policies import MTDAggerPolicy
+from lerobot_mtdagger.runner.policy_options import PolicyOptions
 from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.rollout.ray_workers import RayEnvWorkers
 from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
-from lerobot_mtdagger.runner.student_options import PolicyOptions
-from lerobot_mtdagger.runner.training.train import build_processors, policy_config
+from lerobot_mtdagger.students.mtdagger import build_processors, policy_config
 
 TARGET = 0.8
 DRAWERS = ["drawer-bar-wide", "drawer-knob-large", "drawer-lip-wide"]

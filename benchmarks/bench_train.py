@@ -41,7 +41,7 @@ from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
 from lerobot_mtdagger.runner.training.normalise import NormalisedData, compute_stats
 from lerobot_mtdagger.runner.training.round_data import TrainingData, load_round
 from lerobot_mtdagger.runner.training.steps import LOG_INTERVAL, StepOptions, train_phase
-from lerobot_mtdagger.runner.training.train import build_processors
+from lerobot_mtdagger.students.mtdagger import build_processors
 
 FRAMES = 12_000
 STATE_DIM = 39

@@ -18,10 +18,8 @@ from pathlib import Path
 import pytest
 
 from lerobot_mtdagger.analysis.compare import (
-    PARENT_PID_ENV,
     CompareConfig,
     bc_rounds_for,
-    follow_parent,
     jobs_for,
     split_arguments,
 )
@@ -34,6 +32,7 @@ from lerobot_mtdagger.envs import SuiteConfig
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.option_groups import DAggerConfig
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.parent import PARENT_PID_ENV, follow_parent
 from tests.helpers import TOY_COMPARE, child_pids, is_running
 
 TINY = TOY_COMPARE

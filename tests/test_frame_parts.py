@@ -12,13 +12,12 @@ import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy
-from lerobot_mtdagger.runner import normalise
+from lerobot_mtdagger.runner.training import normalise
 from lerobot_mtdagger.runner.training.frame_parts import FrameParts, join_frames, materialise
 from lerobot_mtdagger.runner.training.normalise import NormalisedData, compute_stats
 from lerobot_mtdagger.runner.training.round_data import EPISODE_ID_STRIDE, TrainingData
 from lerobot_mtdagger.runner.training.steps import StepOptions, train_phase
-from lerobot_mtdagger.runner.training.task_loss import per_task_loss, per_task_loss_of
-from lerobot_mtdagger.runner.training.train import build_processors
+from lerobot_mtdagger.students.mtdagger import build_processors, per_task_loss, per_task_loss_of
 
 TASKS = ["task-a", "task-b", "task-c"]
 IMAGE_SHAPE = (8, 8, 3)

@@ -20,8 +20,8 @@ PLUGIN_MODULE = '''
 from dataclasses import dataclass
 
 from lerobot_mtdagger.envs.toy import TOY_TASKS, ToySuite
-from lerobot_mtdagger.runner.mtdagger_student import MTDAggerStudent
-from lerobot_mtdagger.runner.student_options import PolicyOptions
+from lerobot_mtdagger.students.mtdagger import MTDAggerStudent
+from lerobot_mtdagger.runner.policy_options import PolicyOptions
 
 
 @dataclass

@@ -40,8 +40,8 @@ from lerobot_mtdagger.runner.training.normalise import NormalisedData, compute_s
 from lerobot_mtdagger.runner.training.round_data import EPISODE_ID_STRIDE, TrainingData
 from lerobot_mtdagger.runner.training.splits import heldout_episodes, split_frames
 from lerobot_mtdagger.runner.training.steps import batch_sampler
-from lerobot_mtdagger.runner.training.task_loss import per_task_loss, per_task_loss_of, performance_gain
-from lerobot_mtdagger.runner.training.train import build_processors
+from lerobot_mtdagger.runner.training.task_loss import performance_gain
+from lerobot_mtdagger.students.mtdagger import build_processors, per_task_loss, per_task_loss_of
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.seeds import BETA_STREAM, COLLECT_STREAM
 from tests.test_toy import TOY_RUN

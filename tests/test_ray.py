@@ -137,7 +137,7 @@ def test_a_pool_reserving_no_cpu_starts_beside_actors_holding_every_cpu_and_a_fu
 ):
     """The unseen drawers' pool runs while the run's own actors hold every CPU (a cluster sized to
     ``--rollout.workers`` used to wait on itself forever); actors that cannot be placed are an error."""
-    from lerobot_mtdagger.runner import ray_workers
+    from lerobot_mtdagger.runner.rollout import ray_workers
 
     suite = suite_from_config(SuiteConfig(name="toy"))
     cpus = int(ray.cluster_resources()["CPU"])

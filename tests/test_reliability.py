@@ -17,7 +17,7 @@ from safetensors import safe_open
 from safetensors.torch import load_file, save_file
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.datasets import rounds as rounds_module
+from lerobot_mtdagger.datasets import experiment_dir as rounds_module
 from lerobot_mtdagger.datasets.checkpoints import UntrustedCheckpointError
 from lerobot_mtdagger.datasets.experiment_dir import LOCK_FILE, ExperimentDir, ExperimentLockedError
 from lerobot_mtdagger.datasets.verify import verify_experiment

@@ -228,7 +228,6 @@ def test_verify_loads_policies_without_the_rollout_stack():
     }
 
 
-
 RUNNER = "lerobot_mtdagger.runner"
 RUNNER_ROOMS = {f"{RUNNER}.rollout": 1, f"{RUNNER}.training": 2}
 """The runner's sub-wings, below its root (the loop, its configs, the ``Student`` contract): training
@@ -265,11 +264,13 @@ def test_the_runner_s_rooms_rank_below_the_loop():
     assert runner_room_violations({f"{RUNNER}.rollout.collect": {f"{RUNNER}.training.steps"}}) != []
     assert runner_room_violations({f"{RUNNER}.training.train": {f"{RUNNER}.dagger"}}) != []
 
+
 WING_RANKS = {
-    "lerobot_mtdagger.cli": 6,
-    "lerobot_mtdagger.commands": 6,
-    "lerobot_mtdagger.analysis": 5,
-    "lerobot_mtdagger.planning": 5,
+    "lerobot_mtdagger.cli": 7,
+    "lerobot_mtdagger.commands": 7,
+    "lerobot_mtdagger.analysis": 6,
+    "lerobot_mtdagger.planning": 6,
+    "lerobot_mtdagger.students": 5,
     "lerobot_mtdagger.runner": 4,
     "lerobot_mtdagger.envs": 3,
     "lerobot_mtdagger.experts": 3,
@@ -278,9 +279,9 @@ WING_RANKS = {
     "lerobot_mtdagger.scheduler": 1,
     "lerobot_mtdagger.utils": 0,
 }
-"""Imports run one way: cli and commands -> analysis -> runner -> envs and experts -> datasets and
-policies -> scheduler -> utils. Within a rank, cli may use commands, experts may use envs and datasets
-may use policies (not the reverse)."""
+"""Imports run one way: cli and commands -> analysis -> students -> runner -> envs and experts -> datasets
+and policies -> scheduler -> utils (the runner finds a student by name, ``runner.student``). Within a
+rank, cli may use commands, experts may use envs and datasets may use policies (not the reverse)."""
 
 SAME_RANK_ALLOWED = {
     ("lerobot_mtdagger.cli", "lerobot_mtdagger.commands"),
@@ -386,8 +387,10 @@ def test_every_command_takes_its_worker_options_from_one_group():
 STUDENT_CLASSES = {"MTDAggerPolicy", "MTDAggerConfig", "PolicyOptions"}
 """Classes of one student: the runner asks the student (``runner/student.py``) instead of testing for them."""
 
-STUDENT_MODULES = {"lerobot_mtdagger.runner.mtdagger_student", "lerobot_mtdagger.runner.students"}
+STUDENTS_WING = "lerobot_mtdagger.students"
 """The student implementations: the only modules that may test a value for a student's class."""
+
+STUDENT_MODULES = {name for name in package_modules() if name.startswith(STUDENTS_WING + ".")}
 
 
 def student_type_forks(source: str) -> list[int]:
@@ -420,7 +423,53 @@ def test_only_the_students_fork_on_a_student_type():
     ]
     assert reaching_in == []
     assert student_type_forks("isinstance(policy, (int, MTDAggerPolicy))") == [1]
-    assert student_type_forks("isinstance(options, student_options.PolicyOptions)") == [1]
+    assert student_type_forks("isinstance(options, policy_options.PolicyOptions)") == [1]
+
+
+def runner_imports_of_students(graph: dict[str, set[str]]) -> list[str]:
+    """Module-level imports of the students' wing by the runner's modules."""
+    return [
+        f"{name} -> {target}"
+        for name, targets in graph.items()
+        if name == RUNNER or name.startswith(RUNNER + ".")
+        for target in sorted(targets)
+        if target == STUDENTS_WING or target.startswith(STUDENTS_WING + ".")
+    ]
+
+
+def test_the_runner_finds_students_by_name_only():
+    """The runner imports no student module at module level: ``runner.student``'s registry names them."""
+    graph = {name: module_level_imports(name) for name in package_modules()}
+    assert runner_imports_of_students(graph) == []
+    assert runner_imports_of_students({f"{RUNNER}.dagger": {f"{STUDENTS_WING}.mtdagger"}}) != []
+
+
+def student_classes(sources: dict[str, str]) -> dict[str, str]:
+    """Class name -> module of every class that derives from ``Student`` (through any of ours)."""
+    bases: dict[str, tuple[str, set[str]]] = {}
+    for module, source in sources.items():
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, ast.ClassDef):
+                names = {getattr(base, "id", getattr(base, "attr", None)) for base in node.bases}
+                bases[node.name] = (module, names)
+    students = {"Student"}
+    while True:
+        more = {name for name, (_, names) in bases.items() if names & students} - students
+        if not more:
+            break
+        students |= more
+    return {name: bases[name][0] for name in students - {"Student"}}
+
+
+def test_every_student_lives_in_the_students_wing():
+    """Adding a student touches ``students/`` only: every ``Student`` subclass of the package is there."""
+    sources = {name: module_path(name).read_text() for name in package_modules()}
+    found = student_classes(sources)
+    assert {"MTDAggerStudent", "LeRobotStudent", "DiffusionStudent"} <= set(found)
+    elsewhere = {name: module for name, module in found.items() if not module.startswith(STUDENTS_WING)}
+    assert elsewhere == {}
+    stray = student_classes({**sources, f"{RUNNER}.dagger": "class Mine(LeRobotStudent): ..."})
+    assert stray["Mine"] == f"{RUNNER}.dagger"
 
 
 MIGRATIONS_MODULE = "lerobot_mtdagger.datasets.migrations"

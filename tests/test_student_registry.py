@@ -16,9 +16,9 @@ from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets.checkpoints import check_local_policy
 from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.runner import student as student_registry
-from lerobot_mtdagger.runner.mtdagger_student import MTDAggerStudent
+from lerobot_mtdagger.runner.policy_options import PolicyOptions
 from lerobot_mtdagger.runner.student import Student, get_student, register_student, student_names
-from lerobot_mtdagger.runner.student_options import PolicyOptions
+from lerobot_mtdagger.students.mtdagger import MTDAggerStudent
 from lerobot_mtdagger.utils.errors import UserError
 from tests.helpers import TINY_ROUND
 
@@ -52,7 +52,7 @@ class CopyStudent(MTDAggerStudent):
 @pytest.fixture
 def copy_registered(monkeypatch):
     """``CopyStudent`` registered for one test (the registry is restored after it)."""
-    monkeypatch.setattr(student_registry, "_STUDENTS", dict(student_registry._STUDENTS))
+    monkeypatch.setattr(student_registry, "STUDENTS", student_registry.STUDENTS.copy())
     register_student(NAME, CopyStudent)
     CopyStudent.calls.clear()
     yield

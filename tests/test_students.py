@@ -28,11 +28,12 @@ from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE, TaskOneHotProcessorStep, task_one_hot
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
-from lerobot_mtdagger.runner.rollout.evaluate import ChunkRunner, PolicyRunner, evaluate
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner, evaluate
 from lerobot_mtdagger.runner.rollout.workers import EnvWorkers
 from lerobot_mtdagger.runner.student import get_student
-from lerobot_mtdagger.runner.student_options import lerobot_students
-from lerobot_mtdagger.runner.students import EpisodeWindows, LeRobotOps, lerobot_student_config
+from lerobot_mtdagger.students.chunk_runner import ChunkRunner
+from lerobot_mtdagger.students.lerobot import EpisodeWindows, LeRobotOps, lerobot_student_config
+from lerobot_mtdagger.students.options import lerobot_students
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
 
@@ -234,7 +235,7 @@ def tiny_act_policy(suite, n_action_steps: int = 3, student: list[str] = TINY_AC
         RunConfig, ["--suite.name=toy", *student, f"--policy.n_action_steps={n_action_steps}"], "t"
     )
     spec = lerobot_student_config(options.policy, suite.features, suite.task_names, task_dropout=0.0)
-    from lerobot_mtdagger.runner.students import make_lerobot_processors, make_lerobot_student
+    from lerobot_mtdagger.students.lerobot import make_lerobot_processors, make_lerobot_student
 
     torch.manual_seed(0)
     policy = make_lerobot_student(spec)

@@ -21,9 +21,8 @@ from lerobot_mtdagger.runner.training.round_data import (
     load_round,
     load_rounds,
 )
-from lerobot_mtdagger.runner.training.steps import MTDAggerOps, StepOptions, train_phase
-from lerobot_mtdagger.runner.training.task_loss import per_task_loss
-from lerobot_mtdagger.runner.training.train import build_processors
+from lerobot_mtdagger.runner.training.steps import StepOptions, train_phase
+from lerobot_mtdagger.students.mtdagger import MTDAggerOps, build_processors, per_task_loss
 from tests.conftest import record_expert_dataset
 
 TASKS = ["task-a", "task-b", "task-c"]

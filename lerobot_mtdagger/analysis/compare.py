@@ -43,7 +43,6 @@ from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.option_groups import default_worker_count
 from lerobot_mtdagger.scheduler import scheduling_methods
 from lerobot_mtdagger.utils.errors import UserError
-from lerobot_mtdagger.utils.parent import PARENT_PID_ENV, follow_parent  # noqa: F401  (compare's API)
 from lerobot_mtdagger.utils.parsing import parse_options
 from lerobot_mtdagger.utils.ray_session import import_ray
 

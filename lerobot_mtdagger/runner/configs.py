@@ -3,7 +3,7 @@
 Every option a preset fills (``presets.PRESET_FIELDS``) has one home, its own field; None there means
 "from the preset" (``--preset``, default ``small``), so a value given on the command line always wins.
 The option groups are in ``option_groups`` (``--dagger.*``, ``--rollout.*``, ``--expert.*``,
-``--training.*``) and ``student_options`` (``--policy.*``); the presets' values in ``presets``.
+``--training.*``) and ``policy_options`` (``--policy.*``); the presets' values in ``presets``.
 """
 
 from __future__ import annotations
@@ -26,15 +26,15 @@ from lerobot_mtdagger.runner.option_groups import (
     TrainingConfig,
     check_device,
 )
-from lerobot_mtdagger.runner.presets import PRESETS, preset_values
-from lerobot_mtdagger.runner.student import Student, student_names, student_of_options
-from lerobot_mtdagger.runner.student_options import (
+from lerobot_mtdagger.runner.policy_options import (
     PolicyOptions,
     StudentOptions,
     names_lerobot_student,
     policy_options_dict,
     students_for,
 )
+from lerobot_mtdagger.runner.presets import PRESETS, preset_values
+from lerobot_mtdagger.runner.student import Student, student_names, student_of_options
 from lerobot_mtdagger.scheduler import NeedSchedulerConfig, SchedulerConfig
 from lerobot_mtdagger.utils.parsing import cache_dataclass_sources
 from lerobot_mtdagger.utils.paths import check_output_dir

@@ -20,8 +20,7 @@ from __future__ import annotations
 import abc
 import dataclasses
 import functools
-import importlib
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 from typing import Any
 
 from lerobot_mtdagger.datasets.student_types import (
@@ -30,7 +29,8 @@ from lerobot_mtdagger.datasets.student_types import (
     add_student_policy_type,
 )
 from lerobot_mtdagger.utils.errors import UserError
-from lerobot_mtdagger.utils.plugins import STUDENT_ENTRY_POINTS, register_installed
+from lerobot_mtdagger.utils.plugins import STUDENT_ENTRY_POINTS
+from lerobot_mtdagger.utils.registry import Registry
 
 
 class Student(abc.ABC):
@@ -137,7 +137,21 @@ class Student(abc.ABC):
 StudentEntry = type[Student] | str
 """A ``Student`` subclass, or its ``"module:attribute"`` entry point."""
 
-_STUDENTS: dict[str, StudentEntry] = {}
+
+def _refusal(name: Hashable, student: object) -> str:
+    """The ``TypeError`` message for a registration neither a ``Student`` subclass nor an entry point."""
+    if isinstance(student, str):
+        return f"The student {name!r} must be a 'module:attribute' string, got {student!r}."
+    return f"The student {name!r} must be a Student subclass, got {student!r}."
+
+
+STUDENTS: Registry[type[Student]] = Registry(
+    "student",
+    accepts=lambda student: isinstance(student, type) and issubclass(student, Student),
+    entry_point_group=STUDENT_ENTRY_POINTS,
+    refusal=_refusal,
+)
+"""The students by ``--policy.type``."""
 
 
 def register_student(name: str, student: StudentEntry) -> None:
@@ -152,46 +166,47 @@ def register_student(name: str, student: StudentEntry) -> None:
         UserError: If ``name`` is already registered.
         TypeError: If ``student`` is neither a ``Student`` subclass nor an entry-point string.
     """
-    if name in _STUDENTS:
-        raise UserError(f"A student named {name!r} is already registered; register yours under another name.")
-    if isinstance(student, str):
-        if ":" not in student:
-            raise TypeError(f"The student {name!r} must be a 'module:attribute' string, got {student!r}.")
-        add_student_policy_type(name)  # another saved type is added when the student is built
-    elif not (isinstance(student, type) and issubclass(student, Student)):
-        raise TypeError(f"The student {name!r} must be a Student subclass, got {student!r}.")
-    else:
-        add_student_policy_type(student.policy_type or name)
-    _STUDENTS[name] = student
+    STUDENTS.register(name, student)
+    # an entry point's saved type is added when the student is built
+    add_student_policy_type(name if isinstance(student, str) else student.policy_type or name)
 
 
 def student_names() -> list[str]:
     """Every registered ``--policy.type``, the built-in ones first."""
-    return list(_STUDENTS)
+    return STUDENTS.names()
+
+
+def check_student_name(name: str) -> str:
+    """``name`` if a student is registered under it, without building the student.
+
+    Raises:
+        UserError: On a name no student is registered for (one line listing the registered ones).
+    """
+    if name not in STUDENTS:
+        raise UserError(
+            f"Unknown --policy.type {name!r}; registered students: {', '.join(student_names())} (a student "
+            "from outside the package is registered with lerobot_mtdagger.runner.student.register_student, "
+            f"or installed by a package's entry point in the group {STUDENT_ENTRY_POINTS!r})."
+        )
+    return name
 
 
 def get_student(name: str) -> Student:
     """The student of a ``--policy.type``.
 
     Raises:
-        UserError: On a name no student is registered for (one line listing the registered ones).
+        UserError: On a name no student is registered for (one line listing the registered ones), or
+            an entry point that does not import.
     """
-    if name not in _STUDENTS:
-        raise UserError(
-            f"Unknown --policy.type {name!r}; registered students: {', '.join(student_names())} (a student "
-            "from outside the package is registered with lerobot_mtdagger.runner.student.register_student, "
-            f"or installed by a package's entry point in the group {STUDENT_ENTRY_POINTS!r})."
-        )
-    return _student(name, _STUDENTS[name])
+    check_student_name(name)
+    return _student(name, STUDENTS.entry(name), STUDENTS.get(name))
 
 
 @functools.cache
-def _student(name: str, entry: StudentEntry) -> Student:
+def _student(name: str, entry: StudentEntry, student_class: type[Student]) -> Student:
     """The student built from a registry entry (once per name and entry)."""
-    if isinstance(entry, str):
-        module_name, _, attribute = entry.partition(":")
-        entry = getattr(importlib.import_module(module_name), attribute)
-    student = entry(name)
+    del entry  # the cache key: a name registered anew builds anew
+    student = student_class(name)
     add_student_policy_type(student.saved_type)
     return student
 
@@ -216,7 +231,7 @@ def student_of_policy(policy: Any) -> Student:
         UserError: If no registered student builds policies of that type.
     """
     policy_type = policy.config.type
-    if policy_type in _STUDENTS:
+    if policy_type in STUDENTS:
         return get_student(policy_type)
     for name in student_names():
         if get_student(name).saved_type == policy_type:
@@ -225,9 +240,9 @@ def student_of_policy(policy: Any) -> Student:
 
 
 _BUILTIN_ENTRIES = {
-    MTDAGGER_TYPE: "lerobot_mtdagger.runner.mtdagger_student:MTDAggerStudent",
-    "diffusion": "lerobot_mtdagger.runner.students:DiffusionStudent",
+    MTDAGGER_TYPE: "lerobot_mtdagger.students.mtdagger:MTDAggerStudent",
+    "diffusion": "lerobot_mtdagger.students.lerobot:DiffusionStudent",
 }
 for _name in BUILTIN_STUDENT_TYPES:
-    register_student(_name, _BUILTIN_ENTRIES.get(_name, "lerobot_mtdagger.runner.students:LeRobotStudent"))
-register_installed(STUDENT_ENTRY_POINTS, _STUDENTS, register_student)
+    register_student(_name, _BUILTIN_ENTRIES.get(_name, "lerobot_mtdagger.students.lerobot:LeRobotStudent"))
+STUDENTS.load_entry_points(register_student)

@@ -268,7 +268,7 @@ def _learner_actions(
 ) -> dict[int, np.ndarray | None]:
     """The learner's action for each lane of ``members`` with an observation (None: no learner).
 
-    A policy with ``tracks_episodes`` (an action queue per episode, ``evaluate.ChunkRunner``) is also
+    A policy with ``tracks_episodes`` (an action queue per episode, ``ChunkRunner``) is also
     told each row's lane and whether it is its episode's first observation.
     """
     ready = [handle for handle in members if lanes[handle].observation is not None]

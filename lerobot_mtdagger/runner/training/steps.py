@@ -5,7 +5,7 @@ Each step samples ``batch_size`` frames of the training frames with replacement 
 optimiser step on the student's loss: for ``mtdagger`` an AdamW step on ``policy.imitation_loss``
 with the gradient norm clipped to ``config.optimizer_grad_clip_norm`` (the first step of each
 interval calls the full ``policy.forward``, same loss and gradient, and logs its per-task losses at
-debug level); for a LeRobot student (``students.LeRobotOps``) its ``forward`` loss with its config's
+debug level); for a LeRobot student (``students.lerobot.LeRobotOps``) its ``forward`` loss with its config's
 optimiser and scheduler presets. Tasks are indices mapped once, and the losses stay on the device:
 they are read back only every ``log_interval`` steps and after the last one, where they are checked
 for NaN/inf and reported.
@@ -27,7 +27,7 @@ from lerobot_mtdagger.runner.student import Student, student_of_policy
 from lerobot_mtdagger.runner.training.normalise import NormalisedData
 from lerobot_mtdagger.runner.training.phase_progress import PhaseProgress, loop_state, restore_loop
 from lerobot_mtdagger.runner.training.plateau import PlateauStop, PlateauTracker
-from lerobot_mtdagger.runner.training.task_loss import per_task_loss, performance_gain
+from lerobot_mtdagger.runner.training.task_loss import performance_gain
 from lerobot_mtdagger.utils.errors import UserError
 
 logger = logging.getLogger(__name__)
@@ -76,60 +76,6 @@ class PhaseResult:
     passes_per_task: list[float | None] | None = None
     resumed_after_steps: list[int] = field(default_factory=list)
     earlier_steps_s: float = field(default=0.0, compare=False)
-
-
-def make_optimizer(policy: MTDAggerPolicy, lr: float) -> torch.optim.AdamW:
-    """AdamW over the policy's parameters with its configured weight decay.
-
-    The update is one fused kernel per step on CPU and CUDA rather than a Python loop over tensors.
-    """
-    fused = policy.task_embedding.weight.device.type in ("cpu", "cuda")
-    return torch.optim.AdamW(
-        policy.parameters(), lr=lr, weight_decay=policy.config.optimizer_weight_decay, fused=fused or None
-    )
-
-
-class MTDAggerOps:
-    """The training seam for the ``mtdagger`` policy (``students.LeRobotOps`` for LeRobot's).
-
-    A step's loss is ``policy.imitation_loss`` (the first step of each log interval calls the full
-    ``policy.forward``: same loss and gradient, with per-task losses logged at debug level); the
-    per-task loss is the action MSE of ``policy.predict``; the optimiser is a fused AdamW.
-    """
-
-    def __init__(
-        self, policy: MTDAggerPolicy, data: NormalisedData, lr: float, lr_schedule: str = "constant"
-    ) -> None:
-        """Remembers the policy, its frames, the learning rate and its schedule over a phase."""
-        self.policy = policy
-        self.data = data
-        self.lr = lr
-        self.lr_schedule = lr_schedule
-
-    def step_loss(self, index: torch.Tensor, first_of_interval: bool) -> torch.Tensor:
-        """The imitation loss on the frames at ``index``."""
-        batch = self.data.batch(index)
-        if not first_of_interval:
-            return self.policy.imitation_loss(batch, task_index=batch["task_index"])
-        loss, info = self.policy.forward(batch)
-        info = info or {}
-        logger.debug("loss %s, per task %s", info.get("loss"), info.get("per_task_loss"))
-        return loss
-
-    def task_losses(self, index: torch.Tensor, num_tasks: int) -> tuple[list, list]:
-        """Mean action MSE per task (``per_task_loss``)."""
-        return per_task_loss(self.policy, self.data, index, num_tasks)
-
-    def optimizer(self, steps: int) -> tuple[torch.optim.Optimizer, Any, float]:
-        """Fused AdamW (``make_optimizer``), its schedule over ``steps``, the config's gradient clip norm.
-
-        ``constant``: no scheduler; ``cosine``: the rate decays from ``lr`` to 0 at step ``steps``.
-        """
-        optimizer = make_optimizer(self.policy, self.lr)
-        scheduler = None
-        if self.lr_schedule == "cosine":
-            scheduler = torch.optim.lr_scheduler.CosineAnnealingLR(optimizer, T_max=max(steps, 1))
-        return optimizer, scheduler, self.policy.config.optimizer_grad_clip_norm
 
 
 def phase_ops(policy: Any, data: NormalisedData, options: StepOptions, student: Student | None = None) -> Any:

@@ -15,13 +15,11 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import torch
-from lerobot.configs.types import FeatureType, PolicyFeature
 from tqdm import tqdm
 
 from lerobot_mtdagger.datasets.records import PhaseRecord
-from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
+from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
 from lerobot_mtdagger.runner.training.normalise import NormalisedData, compute_stats
@@ -33,34 +31,7 @@ from lerobot_mtdagger.runner.training.splits import heldout_mask, normalisation_
 from lerobot_mtdagger.runner.training.steps import PhaseResult, StepOptions, train_phase
 from lerobot_mtdagger.runner.training.task_loss import performance_gain
 from lerobot_mtdagger.utils.errors import UserError
-from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 from lerobot_mtdagger.utils.seeds import TRAINING_STREAM, stream_seed
-
-
-def policy_config(
-    suite_features: dict[str, Any],
-    task_names: Sequence[str],
-    options: Any,
-    device: str = "cpu",
-    task_dropout: float = 0.0,
-) -> MTDAggerConfig:
-    """The ``mtdagger`` config for a suite's features and the run's policy options."""
-    features = dataset_to_policy_features(suite_features)
-    return MTDAggerConfig(
-        device=device,
-        task_names=list(task_names),
-        input_features={k: f for k, f in features.items() if f.type is not FeatureType.ACTION},
-        output_features={"action": PolicyFeature(type=FeatureType.ACTION, shape=features["action"].shape)},
-        optimizer_lr=options.lr,
-        state_hidden_dims=tuple(options.state_hidden_dims),
-        head_hidden_dims=tuple(options.head_hidden_dims),
-        pointnet_dims=tuple(options.pointnet_dims),
-        pointnet_layer_norm=options.pointnet_layer_norm,
-        pointcloud_embedding_dim=options.pointcloud_embedding_dim,
-        task_embedding_dim=options.task_embedding_dim,
-        task_dropout=task_dropout,
-        push_to_hub=False,
-    )
 
 
 def save_policy(policy: MTDAggerPolicy, preprocessor: Any, postprocessor: Any, folder: Path) -> None:
@@ -68,11 +39,6 @@ def save_policy(policy: MTDAggerPolicy, preprocessor: Any, postprocessor: Any, f
     policy.save_pretrained(folder)
     preprocessor.save_pretrained(folder)
     postprocessor.save_pretrained(folder)
-
-
-def build_processors(config: MTDAggerConfig, stats: dict[str, dict[str, np.ndarray]]) -> tuple[Any, Any]:
-    """The policy's LeRobot pre- and post-processors for ``stats``."""
-    return make_mtdagger_pre_post_processors(config, dataset_stats=stats)
 
 
 class RoundCache:
@@ -94,7 +60,7 @@ def student_config(
     """The student's policy config for a run on a suite's ``features`` (``unseen``: it has held-out tasks).
 
     ``Student.policy_config`` of the run's student: an ``MTDAggerConfig`` for ``--policy.type=mtdagger``,
-    a ``students.LeRobotStudentConfig`` for a LeRobot student.
+    a ``students.lerobot.LeRobotStudentConfig`` for a LeRobot student.
     """
     return config.student.policy_config(config.policy, features, task_names, unseen)
 

@@ -1,23 +1,21 @@
-"""The student's options, ``--policy.*``: ``mtdagger``'s own (``PolicyOptions``) or a LeRobot policy's.
+"""The run's ``--policy.*`` options: the default student's (``PolicyOptions``) or another student's.
 
 ``--policy.type`` chooses the student (``StudentOptions``, over the students registered in
-``runner.student``); LeRobot's students (``act``, ``diffusion``) take LeRobot's own config of that
-policy plus ``batch_size``, offered by the parser only when the options name a student other than
-``mtdagger`` (``students_for``), so a run of ``mtdagger`` never imports them.
+``runner.student``); other students' options classes (LeRobot's: ``students.options``) are offered
+by the parser only when the options name a student other than ``mtdagger`` (``students_for``), so
+parsing the options of a run of ``mtdagger`` imports no student module, no torch and no LeRobot.
 """
 
 from __future__ import annotations
 
 import contextlib
 import contextvars
-import dataclasses
-import functools
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from lerobot_mtdagger.datasets.student_types import BUILTIN_STUDENT_TYPES, MTDAGGER_TYPE
-from lerobot_mtdagger.runner.student import get_student, student_names, student_of_options
+from lerobot_mtdagger.datasets.student_types import MTDAGGER_TYPE
+from lerobot_mtdagger.runner.student import check_student_name, get_student, student_names, student_of_options
 
 
 @dataclass
@@ -62,51 +60,6 @@ UNSEEN_TASK_DROPOUT = 0.1
 """Task dropout of runs on suites with held-out tasks: one sample in ten trains the shared embedding."""
 
 
-def _lerobot_student(config_class: type) -> type:
-    """``config_class`` (a LeRobot policy config) with the run's training batch size added.
-
-    Every option is LeRobot's own (``--policy.type=act --policy.chunk_size=20``); the learning rate
-    is the policy's ``optimizer_lr`` (its optimiser preset), so a preset's ``policy.lr`` does not
-    apply. Defaults that differ from LeRobot's: ``device=cpu`` (as ``mtdagger``), ``push_to_hub=False``
-    (``push`` uploads), and no pretrained vision backbone (nothing is downloaded during a run; pass
-    ``--policy.pretrained_backbone_weights=...`` where the weights are cached).
-    """
-    extra: list[tuple[str, Any, Any]] = [
-        ("batch_size", int | None, field(default=None)),
-        ("device", str | None, field(default="cpu")),
-        ("push_to_hub", bool, field(default=False)),
-    ]
-    if any(f.name == "pretrained_backbone_weights" for f in dataclasses.fields(config_class)):
-        extra.append(("pretrained_backbone_weights", str | None, field(default=None)))
-    student = dataclasses.make_dataclass(f"{config_class.__name__}Student", extra, bases=(config_class,))
-    student.__doc__ = f"{config_class.__doc__ or config_class.__name__}\n\n{_lerobot_student.__doc__}"
-    return student
-
-
-UNSUPPORTED_STUDENT_OPTIONS: dict[str, str] = {
-    "use_amp": "its training, collection and evaluation run in float32 (lerobot-eval honours it for a "
-    "saved policy)",
-    "use_peft": "the student is trained in full",
-    "push_to_hub": "`lerobot-mtdagger push` uploads a run's rounds and policies",
-    "pretrained_path": "each phase starts from the previous phase's policy (training.warm_start) or afresh",
-}
-"""Options of LeRobot's policy configs that ``run`` would otherwise ignore: refused, naming why."""
-
-
-@functools.cache
-def lerobot_options_class(policy_type: str) -> type:
-    """The options class of a LeRobot policy type as a student (LeRobot's policies imported on first use)."""
-    import lerobot.policies  # noqa: F401  (registers LeRobot's policy configs)
-    from lerobot.configs.policies import PreTrainedConfig
-
-    return _lerobot_student(PreTrainedConfig.get_choice_class(policy_type))
-
-
-def lerobot_students() -> dict[str, type]:
-    """The options class of each built-in LeRobot student type (every one but ``mtdagger``)."""
-    return {name: lerobot_options_class(name) for name in BUILTIN_STUDENT_TYPES if name != MTDAGGER_TYPE}
-
-
 _LEROBOT_STUDENTS_PARSED: contextvars.ContextVar[bool] = contextvars.ContextVar(
     "lerobot_students_parsed", default=True
 )
@@ -128,7 +81,7 @@ def names_lerobot_student(options: Sequence[str]) -> bool:
         if name == "--policy.type":
             if not separator:
                 value = options[position + 1] if position + 1 < len(options) else ""
-            return get_student(value).name != MTDAGGER_TYPE
+            return check_student_name(value) != MTDAGGER_TYPE
     return False
 
 
@@ -151,7 +104,8 @@ class StudentOptions:
 
     Each registered student (``runner.student``) gives its options class: ``mtdagger`` takes
     ``PolicyOptions``; ``act`` and ``diffusion`` take LeRobot's own config of that policy
-    (``lerobot_students()``) plus ``batch_size``. A stored config without ``type`` is ``mtdagger``.
+    (``students.options.lerobot_students()``) plus ``batch_size``. A stored config without ``type``
+    is ``mtdagger``.
     """
 
     @classmethod
@@ -166,7 +120,7 @@ class StudentOptions:
         ``mtdagger`` alone while options that name no other student are parsed (``students_for``).
         """
         if not _LEROBOT_STUDENTS_PARSED.get():
-            return {MTDAGGER_TYPE: get_student(MTDAGGER_TYPE).options_class()}
+            return {MTDAGGER_TYPE: PolicyOptions}  # the mtdagger student's options_class()
         return {name: get_student(name).options_class() for name in student_names()}
 
     @classmethod
@@ -190,13 +144,6 @@ class StudentOptions:
 def student_type(options: Any) -> str:
     """The ``--policy.type`` of a run's policy options."""
     return student_of_options(options).name
-
-
-def lerobot_policy_config(options: Any) -> Any:
-    """The plain LeRobot config of a LeRobot student's options (without ``batch_size``)."""
-    base = type(options).__mro__[1]
-    values = {f.name: getattr(options, f.name) for f in dataclasses.fields(base) if f.init}
-    return base(**values)
 
 
 def policy_options_dict(options: Any) -> dict[str, Any]:

@@ -3,7 +3,7 @@
 The runner trains its student through one seam (``steps.phase_ops``): a training batch at given
 frames, the loss of one step, the per-task imitation loss and the optimiser. ``mtdagger`` has its
 fast implementation in ``steps.py``; ``LeRobotOps`` here implements it for any LeRobot
-``PreTrainedPolicy`` of ``student_options.lerobot_students()`` from what LeRobot's policies declare
+``PreTrainedPolicy`` of ``options.lerobot_students()`` from what LeRobot's policies declare
 (``LeRobotStudent`` is their ``runner.student.Student``, registered as ``act``, and
 ``DiffusionStudent`` as ``diffusion``):
 
@@ -41,9 +41,10 @@ from lerobot_mtdagger.policies.task_conditioning import (
     task_feature,
     task_one_hot,
 )
+from lerobot_mtdagger.runner.policy_options import UNSEEN_TASK_DROPOUT
 from lerobot_mtdagger.runner.student import Student
-from lerobot_mtdagger.runner.student_options import (
-    UNSEEN_TASK_DROPOUT,
+from lerobot_mtdagger.students.chunk_runner import ChunkRunner
+from lerobot_mtdagger.students.options import (
     UNSUPPORTED_STUDENT_OPTIONS,
     lerobot_options_class,
     lerobot_policy_config,
@@ -247,7 +248,7 @@ class LeRobotStudent(Student):
     """A LeRobot policy as the DAgger student, its ``--policy.type`` LeRobot's (``act``, ``diffusion``).
 
     Its options are LeRobot's config of the policy plus ``batch_size`` (``lerobot_options_class``);
-    its training seam ``LeRobotOps``; its evaluation runner ``evaluate.ChunkRunner`` (an action queue
+    its training seam ``LeRobotOps``; its evaluation runner ``chunk_runner.ChunkRunner`` (an action queue
     per episode).
     """
 
@@ -267,7 +268,7 @@ class LeRobotStudent(Student):
     def check_run(self, config: Any) -> None:
         """Refuses point clouds, temporal ensembling, ``lr_schedule`` and the options ``run`` ignores.
 
-        The ignored options are those of ``student_options.UNSUPPORTED_STUDENT_OPTIONS``.
+        The ignored options are those of ``options.UNSUPPORTED_STUDENT_OPTIONS``.
 
         Raises:
             ValueError: Naming the option and the fix.
@@ -311,9 +312,7 @@ class LeRobotStudent(Student):
         return self.phase_ops(runner.policy, data, options).task_losses(index, len(data.task_names))[0]
 
     def make_runner(self, policy: Any, preprocessor: Any, postprocessor: Any) -> Any:
-        """``evaluate.ChunkRunner``: an action queue per running episode, chunks from ``predict_chunk``."""
-        from lerobot_mtdagger.runner.rollout.evaluate import ChunkRunner
-
+        """``ChunkRunner``: an action queue per running episode, chunks from ``predict_chunk``."""
         return ChunkRunner(policy, preprocessor, postprocessor, predict_chunk=self.predict_chunk)
 
     def predict_chunk(self, policy: Any, batch: dict[str, torch.Tensor]) -> torch.Tensor:
