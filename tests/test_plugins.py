@@ -1,4 +1,4 @@
-"""Students and suites from an installed package: its entry points put them on the command line.
+"""Students, suites and expert types from an installed package: its entry points put them on the command line.
 
 The package here is a folder on ``PYTHONPATH`` with a ``.dist-info`` that declares the entry points,
 as ``pip install`` leaves one; a fresh process runs ``lerobot-mtdagger run`` with its names.
@@ -13,7 +13,17 @@ import sys
 import textwrap
 from pathlib import Path
 
-from lerobot_mtdagger.utils.plugins import STUDENT_ENTRY_POINTS, SUITE_ENTRY_POINTS, register_installed
+import pytest
+
+from lerobot_mtdagger.experts import command_line
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.plugins import (
+    EXPERT_ENTRY_POINTS,
+    STUDENT_ENTRY_POINTS,
+    SUITE_ENTRY_POINTS,
+    register_installed,
+)
+from lerobot_mtdagger.utils.registry import Registry, resolve
 from tests.helpers import TINY_ROUND
 
 PLUGIN_MODULE = '''
@@ -38,6 +48,13 @@ class PluginStudent(MTDAggerStudent):
 
 class TwoTaskSuite(ToySuite):
     name = "toy-two"
+
+
+def plugin_expert(suite, task):
+    """The toy suite's scripted expert, installed as an expert type."""
+    from lerobot_mtdagger.experts import make_expert
+
+    return make_expert(suite.with_experts({}), task).expert
 
 
 def two_task_suite(options):
@@ -77,15 +94,25 @@ def test_an_installed_student_and_suite_run_from_the_command_line(tmp_path):
 
         [{SUITE_ENTRY_POINTS}]
         toy-two = mtdagger_plugin_demo:two_task_suite
+
+        [{EXPERT_ENTRY_POINTS}]
+        plugin-expert = mtdagger_plugin_demo:plugin_expert
         """,
     )
     out = tmp_path / "run"
     done = lerobot_mtdagger(
-        env, "run", "--suite.name=toy-two", "--policy.type=plugin-student", *TINY_ROUND, f"--output_dir={out}"
+        env,
+        "run",
+        "--suite.name=toy-two",
+        "--policy.type=plugin-student",
+        "--expert.type=plugin-expert",
+        *TINY_ROUND,
+        f"--output_dir={out}",
     )
     assert done.returncode == 0, done.stderr[-3000:]
     config = json.loads((out / "config.json").read_text())
     assert config["suite"]["name"] == "toy-two" and config["policy"]["type"] == "plugin-student"
+    assert config["expert"]["type"] == "plugin-expert"
     record = json.loads((out / "policies" / "round-001" / "training.json").read_text())
     assert len(record["eval"]["success"]) == 2  # the suite's two tasks
     verified = lerobot_mtdagger(env, "verify", f"--experiment_dir={out}")
@@ -105,3 +132,37 @@ def test_an_installed_name_that_is_taken_is_skipped_with_a_warning(caplog, monke
     added = register_installed(STUDENT_ENTRY_POINTS, ["act"], registered.__setitem__)
     assert added == [] and registered == {}
     assert "act = mtdagger_plugin_demo:PluginStudent" in caplog.text and "rename it" in caplog.text
+
+
+def test_an_installed_expert_type_is_found_by_name(monkeypatch, tmp_path):
+    """A fake installed package's ``lerobot_mtdagger.experts`` entry point names an ``--expert.type``."""
+    install_plugin(tmp_path, f"[{EXPERT_ENTRY_POINTS}]\nplugin-expert = mtdagger_plugin_demo:plugin_expert\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(command_line, "EXPERT_TYPES", command_line.EXPERT_TYPES.copy())
+    assert command_line.EXPERT_TYPES.load_entry_points() == ["plugin-expert"]
+    assert command_line.expert_type_factory("plugin-expert").__module__ == "mtdagger_plugin_demo"
+
+
+def test_a_registry_resolves_module_attribute_once_and_refuses_bad_ones_in_one_line():
+    things: Registry[object] = Registry("thing")
+    things.register("json", "json:dumps")
+
+    @things.register("mine")
+    def mine():
+        return 1
+
+    assert things.get("json") is json.dumps and things.get("mine") is mine
+    assert things.names() == ["json", "mine"]
+    for bad, message in [
+        ("no-colon", "is not a 'module:attribute' string"),
+        ("no_such_module_xyz:f", "module 'no_such_module_xyz' cannot be imported"),
+        ("json:nothing", "module 'json' has no attribute 'nothing'"),
+    ]:
+        with pytest.raises(UserError, match=message):
+            resolve(bad)
+    with pytest.raises(UserError, match="Unknown thing 'other'; registered: json, mine"):
+        things.get("other")
+    with pytest.raises(UserError, match="already registered"):
+        things.register("json", "json:loads")
+    with pytest.raises(TypeError, match="must be callable or a 'module:attribute' string"):
+        things.register("number", 3)

@@ -60,7 +60,7 @@ def corner_suite(options: SuiteOptions) -> CornerSuite:
 @pytest.fixture
 def own_registry(monkeypatch):
     """The registry as the package leaves it, restored after the test (registrations are global)."""
-    monkeypatch.setattr(registry, "_FACTORIES", dict(registry._FACTORIES))
+    monkeypatch.setattr(registry, "SUITES", registry.SUITES.copy())
 
 
 def test_a_suite_registered_outside_the_package_runs_a_dagger_round(tmp_path, own_registry):

@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 
 from lerobot_mtdagger.envs.base import ObservationConfig, TaskSuite
 from lerobot_mtdagger.utils.errors import UserError
-from lerobot_mtdagger.utils.plugins import SUITE_ENTRY_POINTS, register_installed
+from lerobot_mtdagger.utils.plugins import SUITE_ENTRY_POINTS
+from lerobot_mtdagger.utils.registry import Registry
 
 logger = logging.getLogger(__name__)
 
@@ -68,7 +69,14 @@ class SuiteOptions:
 SuiteFactory = Callable[[SuiteOptions], TaskSuite]
 """``factory(options) -> TaskSuite``."""
 
-_FACTORIES: dict[str, SuiteFactory | str] = {}
+SUITES: Registry[SuiteFactory] = Registry(
+    "suite",
+    entry_point_group=SUITE_ENTRY_POINTS,
+    refusal=lambda name, factory: (
+        f"The factory of suite {name!r} must be callable or a 'module:attribute' string, got {factory!r}."
+    ),
+)
+"""The suite factories by name."""
 
 
 def register_suite(name: str, factory: SuiteFactory | str) -> None:
@@ -83,26 +91,12 @@ def register_suite(name: str, factory: SuiteFactory | str) -> None:
         UserError: If ``name`` is already registered (a ``ValueError``).
         TypeError: If ``factory`` is neither callable nor an entry-point string.
     """
-    if name in _FACTORIES:
-        raise UserError(f"A suite named {name!r} is already registered; register yours under another name.")
-    if not (callable(factory) or (isinstance(factory, str) and ":" in factory)):
-        raise TypeError(
-            f"The factory of suite {name!r} must be callable or a 'module:attribute' string, got {factory!r}."
-        )
-    _FACTORIES[name] = factory
+    SUITES.register(name, factory)
 
 
 def suite_names() -> list[str]:
     """Every registered suite name, in the order of registration (the built-in suites first)."""
-    return list(_FACTORIES)
-
-
-def _resolve(factory: SuiteFactory | str) -> SuiteFactory:
-    """The callable behind an entry point (a callable is returned as it is)."""
-    if callable(factory):
-        return factory
-    module_name, _, attribute = factory.partition(":")
-    return getattr(importlib.import_module(module_name), attribute)
+    return SUITES.names()
 
 
 def build_suite(options: SuiteOptions) -> TaskSuite:
@@ -112,15 +106,14 @@ def build_suite(options: SuiteOptions) -> TaskSuite:
         UserError: On a name no factory is registered for (one line listing the registered names).
         ValueError: On a task or observation setting the suite refuses.
     """
-    factory = _FACTORIES.get(options.name)
-    if factory is None:
+    if options.name not in SUITES:
         raise UserError(
             f"Unknown suite {options.name!r}; available suites: {', '.join(suite_names())} (a suite from "
             "outside the package is registered with lerobot_mtdagger.envs.register_suite by the module "
             "--suite.module names, or installed by a package's entry point in the group "
             f"{SUITE_ENTRY_POINTS!r})."
         )
-    return _resolve(factory)(options)
+    return SUITES.get(options.name)(options)
 
 
 def import_suite_module(module: str) -> None:
@@ -151,4 +144,4 @@ BUILT_IN_SUITES: dict[str, str] = {
 
 for _name, _entry_point in BUILT_IN_SUITES.items():
     register_suite(_name, _entry_point)
-register_installed(SUITE_ENTRY_POINTS, _FACTORIES, register_suite)
+SUITES.load_entry_points(register_suite)

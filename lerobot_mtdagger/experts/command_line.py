@@ -19,7 +19,6 @@ line naming the fix.
 from __future__ import annotations
 
 import copy
-import importlib
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -27,22 +26,27 @@ from typing import Any
 from lerobot_mtdagger.datasets.checkpoints import check_local_policy, load_policy
 from lerobot_mtdagger.experts.base import Expert, LeRobotPolicyExpert
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.plugins import EXPERT_ENTRY_POINTS
+from lerobot_mtdagger.utils.registry import EntryPointError, Registry, resolve
 
 STATE_KEY = "observation.state"
 """The input a policy expert reads the privileged state from."""
 
-_EXPERT_TYPES: dict[str, Callable[[Any, str], Expert]] = {}
+EXPERT_TYPES: Registry[Callable[[Any, str], Expert]] = Registry(
+    "expert type", entry_point_group=EXPERT_ENTRY_POINTS
+)
+"""Expert factories by the name ``--expert.type`` gives (installed ones by entry point)."""
 
 
 def register_expert_type(name: str, factory: Callable[[Any, str], Expert]) -> None:
-    """Registers an expert factory under a name ``--expert.type`` can give.
+    """Registers an expert factory under a name ``--expert.type`` can give (replacing one of that name).
 
     Raises:
         TypeError: If ``factory`` is not callable.
     """
     if not callable(factory):
         raise TypeError(f"The expert type {name!r} needs a callable factory(suite, task), got {factory!r}.")
-    _EXPERT_TYPES[name] = factory
+    EXPERT_TYPES.register(name, factory, replace=True)
 
 
 def expert_type_factory(name: str) -> Callable[[Any, str], Expert]:
@@ -51,22 +55,24 @@ def expert_type_factory(name: str) -> Callable[[Any, str], Expert]:
     Raises:
         UserError: If the name is neither registered nor importable, naming both ways to fix it.
     """
-    if name in _EXPERT_TYPES:
-        return _EXPERT_TYPES[name]
-    module_name, _, attribute = name.partition(":")
+    if name in EXPERT_TYPES:
+        return EXPERT_TYPES.get(name)
+    known = sorted(EXPERT_TYPES.names()) or "none"
     hint = (
-        f"--expert.type={name} is neither a registered expert type ({sorted(_EXPERT_TYPES) or 'none'}) nor "
-        "an importable module:attribute factory(suite, task) -> Expert"
+        f"--expert.type={name} is neither a registered expert type ({known}) nor an importable "
+        "module:attribute factory(suite, task) -> Expert"
     )
-    if not attribute:
-        raise UserError(hint + ".")
     try:
-        factory = getattr(importlib.import_module(module_name), attribute)
-    except (ImportError, AttributeError) as error:
-        raise UserError(f"{hint} ({type(error).__name__}: {error}).") from None
+        factory = resolve(name)
+    except EntryPointError as error:
+        cause = f" ({type(error.cause).__name__}: {error.cause})" if error.cause else ""
+        raise UserError(f"{hint}{cause}.") from None
     if not callable(factory):
         raise UserError(f"{hint} ({name} is a {type(factory).__name__}, not callable).")
     return factory
+
+
+EXPERT_TYPES.load_entry_points()
 
 
 def privileged_state_size(suite: Any) -> int:

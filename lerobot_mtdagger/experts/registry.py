@@ -16,12 +16,12 @@ wrong action size fails on its first action naming the task.
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Callable
 from typing import Any
 
 from lerobot_mtdagger.experts.base import ActionCheckedExpert, Expert
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.registry import Registry
 
 ANY_TASK = "*"
 """Task key of a factory that serves every task of its suite family."""
@@ -29,15 +29,20 @@ ANY_TASK = "*"
 ExpertFactory = Callable[[Any, str], Expert]
 """``factory(suite, task_name) -> Expert``."""
 
-_FACTORIES: dict[tuple[str, str], ExpertFactory | str] = {
-    ("metaworld", ANY_TASK): "lerobot_mtdagger.experts.metaworld:scripted_expert",
-    ("drawers", ANY_TASK): "lerobot_mtdagger.experts.drawers:scripted_expert",
-    ("toy", ANY_TASK): "lerobot_mtdagger.experts.toy:scripted_expert",
-}
+EXPERTS: Registry[ExpertFactory] = Registry(
+    "expert factory",
+    refusal=lambda key, factory: (
+        f"The expert factory for {key[0]}/{key[1]} must be callable or a 'module:attribute' string, "
+        f"got {factory!r}."
+    ),
+)
+"""Expert factories by ``(suite family, task)`` (``ANY_TASK``: every task of the family)."""
 
 
 def register_expert(suite_family: str, factory: ExpertFactory | str, task: str = ANY_TASK) -> None:
     """Registers the expert factory of a suite family's task (``ANY_TASK``: every task).
+
+    A factory registered before for the same family and task is replaced.
 
     Args:
         suite_family: The suites' ``expert_family``.
@@ -47,20 +52,11 @@ def register_expert(suite_family: str, factory: ExpertFactory | str, task: str =
     Raises:
         TypeError: If ``factory`` is neither callable nor an entry-point string.
     """
-    if not (callable(factory) or (isinstance(factory, str) and ":" in factory)):
-        raise TypeError(
-            f"The expert factory for {suite_family}/{task} must be callable or a 'module:attribute' string, "
-            f"got {factory!r}."
-        )
-    _FACTORIES[(suite_family, task)] = factory
+    EXPERTS.register((suite_family, task), factory, replace=True)
 
 
-def _resolve(factory: ExpertFactory | str) -> ExpertFactory:
-    """The callable behind an entry point (a callable is returned as it is)."""
-    if callable(factory):
-        return factory
-    module_name, _, attribute = factory.partition(":")
-    return getattr(importlib.import_module(module_name), attribute)
+for _family in ("metaworld", "drawers", "toy"):
+    register_expert(_family, f"lerobot_mtdagger.experts.{_family}:scripted_expert")
 
 
 def make_expert(suite: Any, task_name: str) -> ActionCheckedExpert:
@@ -77,12 +73,12 @@ def make_expert(suite: Any, task_name: str) -> ActionCheckedExpert:
     expert = suite.expert_overrides.get(task_name)
     if expert is None:
         family = suite.expert_family
-        factory = _FACTORIES.get((family, task_name)) or _FACTORIES.get((family, ANY_TASK))
-        if factory is None:
+        key = next((key for key in ((family, task_name), (family, ANY_TASK)) if key in EXPERTS), None)
+        if key is None:
             raise UserError(
                 f"No expert is registered for task {task_name!r} of suite family {family!r}; register one "
                 "with lerobot_mtdagger.experts.register_expert(family, factory) or give the suite one with "
                 "suite.with_experts({task: expert})."
             )
-        expert = _resolve(factory)(suite, task_name)
+        expert = EXPERTS.get(key)(suite, task_name)
     return ActionCheckedExpert(expert, task_name, suite.action_dim)

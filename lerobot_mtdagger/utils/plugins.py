@@ -1,6 +1,6 @@
 """Plugins installed as Python packages: the entry points a registry reads at import.
 
-A package adds a student or a suite to the command line by declaring an entry point in its
+A package adds a student, a suite or an expert type to the command line by declaring an entry point in its
 ``pyproject.toml``; the registry registers it (lazily, as a ``"module:attribute"`` string, so nothing
 is imported until it is asked for)::
 
@@ -9,6 +9,9 @@ is imported until it is asked for)::
 
     [project.entry-points."lerobot_mtdagger.suites"]
     my-suite = "my_package.suites:make_my_suite"
+
+    [project.entry-points."lerobot_mtdagger.experts"]
+    my-sac = "my_package.experts:sac_expert"
 """
 
 from __future__ import annotations
@@ -24,6 +27,9 @@ STUDENT_ENTRY_POINTS = "lerobot_mtdagger.students"
 
 SUITE_ENTRY_POINTS = "lerobot_mtdagger.suites"
 """The entry-point group of installed suites (``--suite.name`` -> ``"module:factory"``)."""
+
+EXPERT_ENTRY_POINTS = "lerobot_mtdagger.experts"
+"""The entry-point group of installed expert types (``--expert.type`` -> ``"module:factory"``)."""
 
 
 def register_installed(
