@@ -2,7 +2,7 @@
 
 The runner trains its student through one seam (``steps.phase_ops``): a training batch at given
 frames, the loss of one step, the per-task imitation loss and the optimiser. ``mtdagger`` has its
-fast implementation in ``steps.py``; ``LeRobotOps`` here implements it for any LeRobot
+fast implementation in ``mtdagger.py`` (``MTDAggerOps``); ``LeRobotOps`` here implements it for any LeRobot
 ``PreTrainedPolicy`` of ``options.lerobot_students()`` from what LeRobot's policies declare
 (``LeRobotStudent`` is their ``runner.student.Student``, registered as ``act``, and
 ``DiffusionStudent`` as ``diffusion``):

@@ -5,10 +5,11 @@ Each step samples ``batch_size`` frames of the training frames with replacement 
 optimiser step on the student's loss: for ``mtdagger`` an AdamW step on ``policy.imitation_loss``
 with the gradient norm clipped to ``config.optimizer_grad_clip_norm`` (the first step of each
 interval calls the full ``policy.forward``, same loss and gradient, and logs its per-task losses at
-debug level); for a LeRobot student (``students.lerobot.LeRobotOps``) its ``forward`` loss with its config's
-optimiser and scheduler presets. Tasks are indices mapped once, and the losses stay on the device:
-they are read back only every ``log_interval`` steps and after the last one, where they are checked
-for NaN/inf and reported.
+debug level; ``students.mtdagger.MTDAggerOps``); for a LeRobot student
+(``students.lerobot.LeRobotOps``) its ``forward`` loss with its config's optimiser and scheduler
+presets. Tasks are indices mapped once, and the losses stay on the device: they are read back only
+every ``log_interval`` steps and after the last one, where they are checked for NaN/inf and
+reported.
 """
 
 from __future__ import annotations

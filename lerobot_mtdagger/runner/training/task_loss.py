@@ -1,7 +1,8 @@
-"""The per-task imitation loss that performance gain and the plateau stop measure, and the gain.
+"""Performance gain: what a phase's training did to each task's imitation loss.
 
-Algorithm 1, "Train Policy": each task's imitation loss is recorded at the start and at the end of
-the phase, on the training data itself or on a held-out split of episodes; the gain is
+Algorithm 1, "Train Policy": each task's imitation loss (the student's ``task_losses``; for
+``mtdagger``, ``students.mtdagger.per_task_loss``) is recorded at the start and at the end of the
+phase, on the training data itself or on a held-out split of episodes; the gain is
 ``max(0, L_start - L_end)`` per task.
 """
 
