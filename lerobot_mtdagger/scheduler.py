@@ -33,6 +33,8 @@ from typing import Any, ClassVar
 import draccus
 import numpy as np
 
+from lerobot_mtdagger.learning_curve import CurvePrior, FittedCurves, fit_logistic_curves, greedy_split
+
 ArrayLike = Sequence[float] | np.ndarray
 
 
@@ -378,8 +380,73 @@ SUCCESS = "success"
 GAIN = "gain"
 """Measurement: the per-task imitation-loss drop of the round's training."""
 
+DEMOS = "demos"
+"""Measurement: the expert demos per task behind each success measurement (a learning-curve history)."""
+
 DEFAULT_N_MIN = 1
 """The paper's minimum episodes per task per round on MetaWorld (a run's preset may set another)."""
+
+
+@dataclass(frozen=True)
+class CurveHistory:
+    """Success measurements with the expert demos behind them, one row per measured round.
+
+    Attributes:
+        demos: Expert demos per task behind each measurement, shape (rounds, num_tasks).
+        success: Measured success rate (NaN where a task had no episode), shape (rounds, num_tasks).
+        episodes: Episodes behind each rate, shape (rounds, num_tasks).
+    """
+
+    demos: np.ndarray
+    success: np.ndarray
+    episodes: np.ndarray
+
+    @classmethod
+    def empty(cls, num_tasks: int) -> CurveHistory:
+        """No measurement yet."""
+        return cls(*(np.zeros((0, num_tasks)) for _ in range(3)))
+
+    @property
+    def rounds(self) -> int:
+        """Number of measured rounds."""
+        return int(self.demos.shape[0])
+
+    def appended(self, demos: np.ndarray, success: np.ndarray, episodes: np.ndarray) -> CurveHistory:
+        """A new history with one more measured round."""
+        return CurveHistory(
+            np.vstack([self.demos, demos]),
+            np.vstack([self.success, success]),
+            np.vstack([self.episodes, episodes]),
+        )
+
+    def to_dict(self) -> dict[str, list[list[float | None]]]:
+        """JSON-ready rows (NaN success rates become None)."""
+        success = [[None if math.isnan(v) else v for v in row] for row in self.success.tolist()]
+        return {"demos": self.demos.tolist(), "success": success, "episodes": self.episodes.tolist()}
+
+    @classmethod
+    def from_dict(cls, record: Mapping[str, Any], num_tasks: int) -> CurveHistory:
+        """Reads ``to_dict`` output.
+
+        Raises:
+            ValueError: If the rows do not have one value per task.
+        """
+        arrays = []
+        for key in ("demos", "success", "episodes"):
+            rows = [[math.nan if v is None else float(v) for v in row] for row in record[key]]
+            array = (
+                np.array(rows, dtype=np.float64).reshape(len(rows), -1) if rows else np.zeros((0, num_tasks))
+            )
+            if array.shape[1] != num_tasks:
+                raise ValueError(
+                    f"history.{key} has {array.shape[1]} values per round, expected {num_tasks}."
+                )
+            arrays.append(array)
+        return cls(*arrays)
+
+
+NORMALIZATIONS = ("rank", "none")
+"""How a metric becomes softmax scores: the paper's ranks in [0, 1], or the metric itself."""
 
 
 @dataclass(frozen=True)
@@ -390,11 +457,15 @@ class SchedulerState:
         kalman_p: Kalman-filtered success probability per task (``p0`` before any measurement).
         raw_success: Latest raw measured success rate per task (``p0`` for a task never measured).
         gain: Latest performance gain ``max(0, L_start - L_end)`` per task (0 before any training).
+        history: Every success measurement with the demos behind it (methods that read ``DEMOS``).
+        demos_so_far: Expert demos per task collected so far (None: not given).
     """
 
     kalman_p: np.ndarray
     raw_success: np.ndarray
     gain: np.ndarray
+    history: CurveHistory | None = None
+    demos_so_far: np.ndarray | None = None
 
     @property
     def num_tasks(self) -> int:
@@ -429,6 +500,9 @@ class SchedulerConfig(draccus.ChoiceRegistry):
         P0: Initial Kalman variance.
         Q: Kalman process noise per round.
         R0: Kalman measurement noise scale; a round of n rollouts has noise R0 / (n + 1).
+        normalization: How the metric becomes softmax scores: ``rank`` (the paper's: ranks in [0, 1],
+            the same tilt whatever the spread of the tasks) or ``none`` (the metric itself, so a wider
+            spread of difficulty gives a wider split; the metric's units then set the tilt with T).
     """
 
     measurements: ClassVar[tuple[str, ...]] = ()
@@ -439,9 +513,14 @@ class SchedulerConfig(draccus.ChoiceRegistry):
     P0: float = 0.25
     Q: float = 0.03
     R0: float = 0.5
+    normalization: str = "rank"
 
     def __post_init__(self) -> None:
         _require_positive(self.temperature, "scheduler.temperature")
+        if self.normalization not in NORMALIZATIONS:
+            raise ValueError(
+                f"scheduler.normalization must be one of {list(NORMALIZATIONS)}, got {self.normalization!r}."
+            )
         if self.n_min is not None:
             _require_integer(self.n_min, "scheduler.n_min", 0)
         # The Kalman filter checks p0, P0, Q and R0 with named errors.
@@ -466,9 +545,38 @@ class SchedulerConfig(draccus.ChoiceRegistry):
         """The method's metric per task (higher = more episodes), shape (num_tasks,)."""
         raise NotImplementedError(f"{type(self).__name__} must implement metric(state).")
 
-    def hyperparameters(self) -> dict[str, float | int]:
-        """The fields as a plain dict (``make_scheduler`` keyword arguments), n_min resolved."""
-        return {**dataclasses.asdict(self), "n_min": self.min_episodes}
+    def split(self, state: SchedulerState, metric: np.ndarray, budget: int) -> tuple[np.ndarray, ...]:
+        """Scores, probabilities and episodes per task: normalised metric, softmax, ``allocate``.
+
+        A method that splits otherwise (for example by expected gain per demo) overrides this.
+
+        Returns:
+            ``(score, probability, counts)``, each of shape (num_tasks,).
+        """
+        if self.normalization == "rank":
+            score = rank_normalize(metric)
+        else:
+            score = _as_vector(metric, "metric")
+            _require_finite(score, "metric")
+        probability = softmax(score, self.temperature)
+        counts = allocate_probabilities(probability, budget, self.min_episodes, score)
+        return score, probability, counts
+
+    def hyperparameters(self) -> dict[str, Any]:
+        """The fields as a plain dict (``make_scheduler`` keyword arguments), n_min resolved.
+
+        ``normalization`` is left out at its default, so that the records of runs that never set it
+        read as before.
+        """
+        values = {**dataclasses.asdict(self), "n_min": self.min_episodes}
+        if values["normalization"] == "rank":
+            del values["normalization"]
+        return values
+
+    def options(self) -> dict[str, Any]:
+        """The hyperparameters beyond the shared ones (an ``Allocation`` stores them to rebuild this)."""
+        shared = {"temperature", "n_min", "p0", "P0", "Q", "R0"}
+        return {k: v for k, v in self.hyperparameters().items() if k not in shared}
 
 
 @SchedulerConfig.register_subclass("uniform")
@@ -517,6 +625,87 @@ class GainSchedulerConfig(SchedulerConfig):
     def metric(self, state: SchedulerState) -> np.ndarray:
         """The clipped loss drop of the last training phase."""
         return state.gain.copy()
+
+
+@SchedulerConfig.register_subclass("learnability")
+@dataclass
+class LearnabilitySchedulerConfig(SchedulerConfig):
+    """Learnability ``p_hat (1 - p_hat)``: most episodes to tasks near even odds (curriculum baseline).
+
+    The score of prioritised level replay and of "learnability" curricula (Tzannetos et al. 2023):
+    a task already solved or not yet learnable at all gets little.
+    """
+
+    measurements: ClassVar[tuple[str, ...]] = (SUCCESS,)
+
+    def metric(self, state: SchedulerState) -> np.ndarray:
+        """``p_hat (1 - p_hat)`` of the Kalman-filtered success."""
+        return state.kalman_p * (1.0 - state.kalman_p)
+
+
+@SchedulerConfig.register_subclass("curve")
+@dataclass
+class CurveSchedulerConfig(SchedulerConfig):
+    """Learning curves fitted online: the round's demos go where success is expected to rise most.
+
+    Each task's success against its own expert demos is fitted from every measurement so far
+    (``learning_curve.fit_logistic_curves``: a logistic in log demos, one intercept per task shrunk
+    toward the others', one slope), then the budget is split greedily by expected gain in success
+    per demo (``learning_curve.greedy_split``) after ``n_min`` each. ``temperature`` and
+    ``normalization`` play no part. Needs the demos behind each measurement (``DEMOS``): before
+    the first measurement the split is even.
+
+    Attributes:
+        prior_scale: Scale of a task's intercept around the common one (logits, > 0).
+        slope_mean: Prior mean of the shared slope on log demos.
+        slope_scale: Prior scale of that slope (> 0).
+    """
+
+    measurements: ClassVar[tuple[str, ...]] = (SUCCESS, DEMOS)
+
+    prior_scale: float = 1.5
+    slope_mean: float = 1.0
+    slope_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _require_positive(self.prior_scale, "scheduler.prior_scale")
+        _require_positive(self.slope_scale, "scheduler.slope_scale")
+        if not math.isfinite(self.slope_mean):
+            raise ValueError(f"scheduler.slope_mean must be finite, got {self.slope_mean}.")
+
+    def fitted(self, state: SchedulerState) -> FittedCurves | None:
+        """The curves fitted to the state's history (None before any measurement)."""
+        if state.history is None or state.history.rounds == 0:
+            return None
+        prior = CurvePrior(self.prior_scale, self.slope_mean, self.slope_scale)
+        history = state.history
+        return fit_logistic_curves(history.demos, history.success, history.episodes, prior)
+
+    def metric(self, state: SchedulerState) -> np.ndarray:
+        """The fitted success at each task's demos so far (``p0`` before any measurement)."""
+        curves = self.fitted(state)
+        if curves is None:
+            return np.full(state.num_tasks, self.p0)
+        return curves.success(_current_demos(state))
+
+    def split(self, state: SchedulerState, metric: np.ndarray, budget: int) -> tuple[np.ndarray, ...]:
+        """Greedy by expected gain per demo; score = that gain at the start, probability = share."""
+        budget = _require_integer(budget, "budget", self.min_episodes * state.num_tasks)
+        curves = self.fitted(state)
+        if curves is None:
+            even = np.full(state.num_tasks, 1.0 / state.num_tasks)
+            return np.zeros(state.num_tasks), even, allocate_probabilities(even, budget, self.min_episodes)
+        demos = _current_demos(state)[:, None] + np.arange(budget + 1)[None, :]
+        counts, rate = greedy_split(curves.success(demos), budget, self.min_episodes)
+        return rate, counts / max(budget, 1), counts
+
+
+def _current_demos(state: SchedulerState) -> np.ndarray:
+    """Demos per task now: ``demos_so_far``, else those behind the last measurement."""
+    if state.demos_so_far is not None:
+        return np.asarray(state.demos_so_far, dtype=np.float64)
+    return state.history.demos[-1]
 
 
 def scheduling_methods() -> tuple[str, ...]:
@@ -572,6 +761,12 @@ class Allocation:
         episodes_per_task: The allocation.
         kalman: Hyperparameters of the Kalman filter ({"p0", "P0", "Q", "R0"}).
         notes: Human-readable remarks (for example "no rollouts measured yet: the prior decides").
+        options: The method's hyperparameters beyond the shared ones (``SchedulerConfig.options``).
+        history: The learning-curve history (``CurveHistory.to_dict``) of a method that reads ``DEMOS``.
+        demos_so_far: Expert demos per task when the allocation was made (methods that read ``DEMOS``).
+
+    The last three are left out of ``to_dict`` when empty, so that records of methods without them
+    read as before.
     """
 
     method: str
@@ -590,10 +785,16 @@ class Allocation:
     episodes_per_task: list[int]
     kalman: dict[str, float]
     notes: list[str] = dataclasses.field(default_factory=list)
+    options: dict[str, Any] = dataclasses.field(default_factory=dict)
+    history: dict[str, Any] | None = None
+    demos_so_far: list[float] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Returns the record as JSON-ready builtins (NaN success rates become None)."""
         record = dataclasses.asdict(self)
+        for name in OPTIONAL_ALLOCATION_FIELDS:
+            if not record[name]:
+                del record[name]
         if record["success_rate"] is not None:
             record["success_rate"] = [None if math.isnan(v) else v for v in record["success_rate"]]
         return record
@@ -606,7 +807,7 @@ class Allocation:
             ValueError: If a required key is missing.
         """
         names = [f.name for f in dataclasses.fields(cls)]
-        missing = [n for n in names if n not in record and n != "notes"]
+        missing = [n for n in names if n not in record and n not in ("notes", *OPTIONAL_ALLOCATION_FIELDS)]
         if missing:
             raise ValueError(f"Allocation record is missing keys {missing}.")
         values = {n: record[n] for n in names if n in record}
@@ -621,8 +822,12 @@ class Allocation:
             ValueError: If the method is not registered.
         """
         return scheduler_config_class(self.method)(
-            temperature=self.temperature, n_min=self.n_min, **self.kalman
+            temperature=self.temperature, n_min=self.n_min, **self.kalman, **self.options
         )
+
+
+OPTIONAL_ALLOCATION_FIELDS = ("options", "history", "demos_so_far")
+"""``Allocation`` fields a record leaves out when empty (records written before they existed lack them)."""
 
 
 def _allocation_notes(config: SchedulerConfig, measured: set[str]) -> list[str]:
@@ -633,16 +838,6 @@ def _allocation_notes(config: SchedulerConfig, measured: set[str]) -> list[str]:
     if GAIN in config.measurements and GAIN not in measured:
         notes.append("no training gain measured yet: uniform allocation")
     return notes
-
-
-def _score_and_allocate(
-    config: SchedulerConfig, metric: np.ndarray, budget: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Rank-normalised scores, softmax probabilities and episode counts of a metric."""
-    score = rank_normalize(metric)
-    probability = softmax(score, config.temperature)
-    counts = allocate_probabilities(probability, budget, config.min_episodes, score)
-    return score, probability, counts
 
 
 class Scheduler:
@@ -681,6 +876,8 @@ class Scheduler:
         self.last_gain: np.ndarray | None = None
         self.kalman_prior = self.kalman.snapshot()
         self.num_updates = 0
+        self.history = CurveHistory.empty(self.num_tasks)
+        self.demos_so_far: np.ndarray | None = None
 
     def update(
         self,
@@ -688,6 +885,8 @@ class Scheduler:
         success_rate: ArrayLike | None = None,
         episodes: ArrayLike | None = None,
         gain: ArrayLike | None = None,
+        demos: ArrayLike | None = None,
+        demos_so_far: ArrayLike | None = None,
     ) -> None:
         """Feeds one round's measurements.
 
@@ -697,6 +896,9 @@ class Scheduler:
             episodes: Rollouts per task behind ``success_rate``.
             gain: Per-task loss drop ``L_start - L_end`` of the round's training; negative values
                 are clipped to 0 (``max(0, .)``).
+            demos: Expert demos per task of the policy behind ``success_rate`` (required with it by a
+                method that reads ``DEMOS``; kept in the learning-curve history).
+            demos_so_far: Expert demos per task collected so far (the next allocation adds to them).
 
         Raises:
             ValueError: On a bad measurement; the scheduler is left unchanged.
@@ -707,8 +909,11 @@ class Scheduler:
         if gain is not None:
             checked_gain = _as_vector(gain, "gain", self.num_tasks)
             _require_finite(checked_gain, "gain")
+        checked_demos = self._checked_demos(demos, demos_so_far, success_rate is not None)
         if success_rate is not None:
             rate, counts = check_measurements(success_rate, episodes, self.num_tasks)
+            if checked_demos[0] is not None:
+                self.history = self.history.appended(checked_demos[0], rate, counts)
             self.kalman_prior = self.kalman.snapshot()
             self.kalman.update(rate, counts)
             self.raw_success = np.where(counts > 0, rate, self.raw_success)
@@ -716,13 +921,43 @@ class Scheduler:
         if checked_gain is not None:
             self.gain = np.maximum(checked_gain, 0.0)
             self.last_gain = self.gain.copy()
+        if checked_demos[1] is not None:
+            self.demos_so_far = checked_demos[1]
         self.num_updates += 1
+
+    def _checked_demos(
+        self, demos: ArrayLike | None, demos_so_far: ArrayLike | None, has_success: bool
+    ) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """``(demos, demos_so_far)`` as checked vectors (None where not given or not read)."""
+        reads_demos = DEMOS in self.config.measurements
+        if reads_demos and has_success and demos is None:
+            raise ValueError(
+                f"The {self.method!r} scheduler fits learning curves: pass demos= (the expert demos per "
+                "task behind success_rate) with every success measurement."
+            )
+        if demos is not None and not has_success:
+            raise ValueError("demos describes a success measurement: pass it with success_rate and episodes.")
+        checked = []
+        for name, values in (("demos", demos), ("demos_so_far", demos_so_far)):
+            if values is None or not reads_demos:
+                checked.append(None)
+                continue
+            array = _as_vector(values, name, self.num_tasks)
+            _require_finite(array, name)
+            if np.any(array < 0):
+                raise ValueError(f"{name} must be demo counts >= 0, got {array.tolist()}.")
+            checked.append(array)
+        return checked[0], checked[1]
 
     @property
     def state(self) -> SchedulerState:
         """The current inputs of the metric."""
         return SchedulerState(
-            kalman_p=self.kalman.p.copy(), raw_success=self.raw_success.copy(), gain=self.gain.copy()
+            kalman_p=self.kalman.p.copy(),
+            raw_success=self.raw_success.copy(),
+            gain=self.gain.copy(),
+            history=self.history,
+            demos_so_far=None if self.demos_so_far is None else self.demos_so_far.copy(),
         )
 
     @property
@@ -745,7 +980,8 @@ class Scheduler:
             ValueError: If ``budget`` is not an integer >= n_min * num_tasks.
         """
         metric = self.metric()
-        score, probability, counts = _score_and_allocate(self.config, metric, budget)
+        score, probability, counts = self.config.split(self.state, metric, budget)
+        reads_demos = DEMOS in self.config.measurements
         return Allocation(
             method=self.method,
             budget=int(budget),
@@ -763,6 +999,11 @@ class Scheduler:
             episodes_per_task=counts.tolist(),
             kalman={"p0": self.config.p0, "P0": self.config.P0, "Q": self.config.Q, "R0": self.config.R0},
             notes=_allocation_notes(self.config, self.measured),
+            options=self.config.options(),
+            history=self.history.to_dict() if reads_demos and self.history.rounds else None,
+            demos_so_far=None
+            if not reads_demos or self.demos_so_far is None
+            else [float(n) for n in self.demos_so_far],
         )
 
     def state_dict(self) -> dict[str, Any]:
@@ -773,7 +1014,7 @@ class Scheduler:
                 return None
             return [None if math.isnan(v) else v for v in array.tolist()]
 
-        return {
+        state = {
             "format_version": STATE_FORMAT_VERSION,
             "method": self.method,
             "num_tasks": self.num_tasks,
@@ -787,6 +1028,10 @@ class Scheduler:
             "last_gain": optional(self.last_gain),
             "num_updates": self.num_updates,
         }
+        if DEMOS in self.config.measurements:
+            state["history"] = self.history.to_dict()
+            state["demos_so_far"] = None if self.demos_so_far is None else self.demos_so_far.tolist()
+        return state
 
     def load_state_dict(self, state: Mapping[str, Any]) -> None:
         """Restores a state written by ``state_dict``.
@@ -822,6 +1067,10 @@ class Scheduler:
         self.last_episodes = optional(state["last_episodes"])
         self.last_gain = optional(state["last_gain"])
         self.num_updates = int(state["num_updates"])
+        if state.get("history") is not None:
+            self.history = CurveHistory.from_dict(state["history"], self.num_tasks)
+        so_far = state.get("demos_so_far")
+        self.demos_so_far = None if so_far is None else _as_vector(so_far, "demos_so_far", self.num_tasks)
 
 
 def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int | None) -> Scheduler:
@@ -874,10 +1123,16 @@ def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
         else np.maximum(np.asarray(stored.gain, dtype=np.float64), 0.0)
     )
     state = SchedulerState(
-        kalman_p=kalman.p.copy(), raw_success=np.asarray(stored.raw_success, dtype=np.float64), gain=gain
+        kalman_p=kalman.p.copy(),
+        raw_success=np.asarray(stored.raw_success, dtype=np.float64),
+        gain=gain,
+        history=None if stored.history is None else CurveHistory.from_dict(stored.history, num_tasks),
+        demos_so_far=None
+        if stored.demos_so_far is None
+        else np.asarray(stored.demos_so_far, dtype=np.float64),
     )
     metric = np.asarray(config.metric(state), dtype=np.float64)
-    score, probability, counts = _score_and_allocate(config, metric, stored.budget)
+    score, probability, counts = config.split(state, metric, stored.budget)
     return dataclasses.replace(
         stored,
         kalman_posterior=kalman.snapshot(),

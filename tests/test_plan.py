@@ -324,3 +324,31 @@ def test_a_hub_repo_id_is_read_from_lerobots_cache_with_its_revision(tmp_path, m
     assert "neither a folder nor a Hub repo id" in _refused(
         tmp_path, capsys, "--datasets=[not-a-repo]", "--budget=5"
     )
+
+
+def test_the_curve_scheduler_plans_from_the_demos_each_session_adds(tmp_path, capsys):
+    first_data = record(tmp_path / "session-1", SESSION_1)
+    second_data = record(tmp_path / "session-2", SESSION_2)
+    options = ["--scheduler.type=curve", "--budget=20"]
+    status, first = plan(tmp_path, "plan-1", f"--datasets=[{first_data}]", *options, "--initial_demos=3")
+    assert status == 0 and first["demos"] == [3.0, 3.0]
+    counts = first["allocation"]["episodes_per_task"]
+    assert sum(counts) == 20 and first["allocation"]["history"]["demos"] == [[3.0, 3.0]]
+    previous = tmp_path / "plan-1.json"
+    status, second = plan(
+        tmp_path, "plan-2", f"--datasets=[{second_data}]", *options, f"--previous={previous}"
+    )
+    assert status == 0
+    assert second["demos"] == [3.0 + counts[0], 3.0 + counts[1]]
+    assert second["allocation"]["history"]["success"] == [[1.0, 1 / 3], [0.5, 1.0]]
+    assert main(["plan", f"--verify={tmp_path / 'plan-2.json'}"]) == 0
+    capsys.readouterr()
+
+
+def test_the_curve_scheduler_needs_the_first_sessions_demos(tmp_path, capsys):
+    data = record(tmp_path / "session-1", SESSION_1)
+    status, written = plan(
+        tmp_path, "plan-1", f"--datasets=[{data}]", "--scheduler.type=curve", "--budget=20"
+    )
+    assert status == 2 and written is None
+    assert "give --initial_demos" in capsys.readouterr().err

@@ -334,7 +334,8 @@ def test_state_dict_round_trips_through_json_exactly(method):
     for _ in range(3):
         episodes = rng.integers(0, 4, 5)
         rate = np.where(episodes > 0, rng.integers(0, 4, 5) / np.maximum(episodes, 1), np.nan).clip(0, 1)
-        scheduler.update(success_rate=rate, episodes=episodes, gain=rng.normal(size=5))
+        demos = rng.integers(1, 10, 5)
+        scheduler.update(success_rate=rate, episodes=episodes, gain=rng.normal(size=5), demos=demos)
     state = scheduler.state_dict()
     restored = make_scheduler(method, 5)
     restored.load_state_dict(json.loads(json.dumps(state)))
@@ -346,7 +347,9 @@ def test_state_dict_round_trips_through_json_exactly(method):
     assert record(restored) == record(scheduler)
     # Both continue identically.
     for s in (scheduler, restored):
-        s.update(success_rate=[0.0, 1.0, 0.5, 0.25, 1.0], episodes=[4, 4, 2, 4, 1], gain=[0.1] * 5)
+        s.update(
+            success_rate=[0.0, 1.0, 0.5, 0.25, 1.0], episodes=[4, 4, 2, 4, 1], gain=[0.1] * 5, demos=[9] * 5
+        )
     assert record(restored) == record(scheduler)
 
 
@@ -360,7 +363,13 @@ def test_load_state_dict_refuses_another_method():
 def test_allocation_record_is_json_ready_and_recomputable(method):
     scheduler = make_scheduler(method, 4)
     scheduler.update(gain=[0.3, 0.1, 0.0, 0.2])
-    scheduler.update(success_rate=[0.0, math.nan, 1.0, 0.5], episodes=[2, 0, 3, 2], gain=[0.3, 0.1, 0.0, 0.2])
+    scheduler.update(
+        success_rate=[0.0, math.nan, 1.0, 0.5],
+        episodes=[2, 0, 3, 2],
+        gain=[0.3, 0.1, 0.0, 0.2],
+        demos=[3, 3, 3, 3],
+        demos_so_far=[5, 4, 6, 5],
+    )
     record = json.loads(json.dumps(scheduler.allocate(16).to_dict(), allow_nan=False))
     assert record["success_rate"][1] is None
     assert allocation_mismatches(record) == []

@@ -35,6 +35,7 @@ from lerobot_mtdagger.planning.episodes import (
     read_dataset,
 )
 from lerobot_mtdagger.scheduler import (
+    DEMOS,
     GAIN,
     NeedSchedulerConfig,
     Scheduler,
@@ -70,13 +71,17 @@ class PlanConfig:
             no success. Datasets it does not name are read from their columns.
         intervention_key: The column marking frames a person controlled (episodes with any are not
             counted as the policy's); a dataset without it has only policy episodes.
-        scheduler: ``--scheduler.type=need|need_raw|gain|uniform`` and its hyperparameters (as ``run``).
+        scheduler: ``--scheduler.type=need|need_raw|gain|uniform|learnability|curve`` and its
+            hyperparameters (as ``run``).
         policy_path: The policy trained since the last session (a LeRobot pretrained folder): with
             ``previous_policy_path``, each task's performance gain, ``max(0, L_previous - L_policy)``
             over ``loss_datasets`` (``planning/loss.py``); needed by ``--scheduler.type=gain``.
         previous_policy_path: The policy before that training (the one that collected the session).
         loss_datasets: The training datasets the losses are measured on (empty: ``datasets``).
         verify: A plan file to check instead: recomputed from its recorded inputs.
+        initial_demos: Expert demos per task the first session's policy was trained on (first plan of a
+            scheduler that fits learning curves, ``--scheduler.type=curve``; later plans add each plan's
+            episodes to it).
     """
 
     datasets: list[str] = field(default_factory=list)
@@ -94,6 +99,7 @@ class PlanConfig:
     previous_policy_path: Path | None = None
     loss_datasets: list[str] = field(default_factory=list)
     verify: Path | None = None
+    initial_demos: int | None = None
 
     def __post_init__(self) -> None:
         if self.verify is not None:
@@ -127,6 +133,13 @@ class PlanConfig:
             raise ValueError(
                 "The performance gain compares two policies: give --policy_path (trained since the last "
                 "session) and --previous_policy_path (the one before), or neither."
+            )
+        if self.initial_demos is not None and self.initial_demos < 0:
+            raise ValueError(f"--initial_demos must be >= 0 expert demos per task, got {self.initial_demos}.")
+        if DEMOS in self.scheduler.measurements and self.previous is None and self.initial_demos is None:
+            raise ValueError(
+                f"--scheduler.type={self.scheduler.type} fits each task's learning curve: give "
+                "--initial_demos (the expert demos per task the policy of this first session was trained on)."
             )
         if GAIN in self.scheduler.measurements and self.policy_path is None:
             raise ValueError(
@@ -337,10 +350,18 @@ def make_plan(config: PlanConfig) -> dict:
     state_before = scheduler.state_dict()
     measured = measure(read, tasks)
     gain_record = measure_gain(config, tasks)
+    demos = session_demos(config, len(tasks), previous)
+    if demos is None and DEMOS in scheduler.config.measurements:
+        raise UserError(
+            f"The previous plan {config.previous} records no expert demos per task, which "
+            f"--scheduler.type={scheduler.method} needs: start a new plan (no --previous) with "
+            "--initial_demos."
+        )
     scheduler.update(
         success_rate=measured.success_rate,
         episodes=measured.policy_episodes,
         gain=None if gain_record is None else gain_record["gain"],
+        **_demos_measurement(demos),
     )
     seconds = task_seconds(config, measured)
     budget = episode_budget(config, scheduler, seconds)
@@ -376,7 +397,25 @@ def make_plan(config: PlanConfig) -> dict:
         "state": scheduler.state_dict(),
         "budget": {"episodes": budget, "minutes": float(sum(minutes)), "minutes_per_task": minutes},
         "allocation": allocation.to_dict(),
-    }
+    } | ({} if demos is None else {"demos": demos})
+
+
+def session_demos(config: PlanConfig, num_tasks: int, previous: dict | None) -> list[float] | None:
+    """Expert demos per task behind this session's policy (None where they are not known).
+
+    ``--initial_demos`` on a first plan, else the previous plan's demos plus the episodes it allocated.
+    """
+    if previous is None:
+        return None if config.initial_demos is None else [float(config.initial_demos)] * num_tasks
+    before = previous.get("demos")
+    if before is None:
+        return None
+    return [float(d + n) for d, n in zip(before, previous["allocation"]["episodes_per_task"], strict=True)]
+
+
+def _demos_measurement(demos: list[float] | None) -> dict[str, list[float]]:
+    """The scheduler's ``demos``/``demos_so_far`` arguments (none when the demos are unknown)."""
+    return {} if demos is None else {"demos": demos, "demos_so_far": demos}
 
 
 def plan_table(plan: dict) -> str:
@@ -519,7 +558,12 @@ def _allocation_problems(plan: dict) -> list[str]:
             problems.append(
                 f"gain: recorded {plan['gain']['gain']} != the drop of the recorded losses {gain}"
             )
-    scheduler.update(success_rate=measured.success_rate, episodes=measured.policy_episodes, gain=gain)
+    scheduler.update(
+        success_rate=measured.success_rate,
+        episodes=measured.policy_episodes,
+        gain=gain,
+        **_demos_measurement(plan.get("demos")),
+    )
     again = scheduler.allocate(int(plan["budget"]["episodes"])).to_dict()
     if again["episodes_per_task"] != plan["allocation"]["episodes_per_task"]:
         problems.append(

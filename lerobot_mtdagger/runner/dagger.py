@@ -131,7 +131,10 @@ def schedule_round(ctx: RunContext, round_index: int) -> tuple[Scheduler, Alloca
         measurements["gain"] = phase.gain
     if previous.learner_success is not None and round_index - 1 > 0:
         rates = [np.nan if r is None else r for r in previous.learner_success]
-        measurements |= {"success_rate": rates, "episodes": previous.learner_episodes}
+        # Round k-1's rollouts ran the policy of phase k-2: trained on the demos before round k-1's.
+        behind = np.subtract(previous.demos_so_far, previous.episodes_per_task).tolist()
+        measurements |= {"success_rate": rates, "episodes": previous.learner_episodes, "demos": behind}
+    measurements["demos_so_far"] = list(previous.demos_so_far)
     scheduler.update(**measurements)
     allocation = scheduler.allocate(ctx.config.dagger.budget_for(len(ctx.task_names)))
     if round_index == 1:
