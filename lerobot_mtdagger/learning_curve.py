@@ -31,34 +31,35 @@ class CurvePrior:
 
     Attributes:
         prior_scale: Standard deviation of a task's intercept around the common one (logits).
-        slope_mean: Prior mean of the shared slope on log demos.
-        slope_scale: Prior standard deviation of that slope.
+        slope_mean: Prior mean of the tasks' common slope on log demos.
+        slope_scale: Prior standard deviation of that common slope.
+        task_slope_scale: Standard deviation of a task's slope around the common one (small: one
+            slope for all tasks).
     """
 
     prior_scale: float = 1.5
     slope_mean: float = 1.0
     slope_scale: float = 1.0
+    task_slope_scale: float = 0.1
 
 
 @dataclass(frozen=True)
 class FittedCurves:
-    """The fitted curves: ``sigmoid(intercept[i] + slope * log n)``.
+    """The fitted curves: ``sigmoid(intercept[i] + slope[i] * log n)``.
 
     Attributes:
         intercept: One logit intercept per task, shape (num_tasks,).
-        slope: The shared slope on log demos.
-        common: The tasks' common intercept.
+        slope: One slope on log demos per task, shape (num_tasks,).
     """
 
     intercept: np.ndarray
-    slope: float
-    common: float
+    slope: np.ndarray
 
     def success(self, demos: np.ndarray) -> np.ndarray:
-        """Predicted success at ``demos`` (broadcast against the tasks on the first axis)."""
+        """Predicted success at ``demos``, shape (num_tasks,) or (num_tasks, K)."""
         demos = np.maximum(np.asarray(demos, dtype=np.float64), 1.0)
-        intercept = self.intercept.reshape((-1,) + (1,) * (demos.ndim - 1)) if demos.ndim else self.intercept
-        return _sigmoid(intercept + self.slope * np.log(demos))
+        shape = (-1,) + (1,) * (demos.ndim - 1)
+        return _sigmoid(self.intercept.reshape(shape) + self.slope.reshape(shape) * np.log(demos))
 
 
 def _sigmoid(x: np.ndarray) -> np.ndarray:
@@ -68,7 +69,10 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 def fit_logistic_curves(
     demos: np.ndarray, success: np.ndarray, episodes: np.ndarray, prior: CurvePrior
 ) -> FittedCurves:
-    """Fits the shared-slope logistic curves to a history of measurements.
+    """Fits the logistic curves, shrunk toward the tasks' common curve, to a history of measurements.
+
+    Unknowns: each task's intercept and slope, and the common intercept and slope they are shrunk
+    toward (``2 * num_tasks + 2``); damped Newton ascent of the penalised binomial log-likelihood.
 
     Args:
         demos: Expert demos per task behind each measurement, shape (rounds, num_tasks).
@@ -80,36 +84,102 @@ def fit_logistic_curves(
         The penalised maximum-likelihood curves.
     """
     demos, success, episodes = (np.asarray(a, dtype=np.float64) for a in (demos, success, episodes))
+    data = _Data(
+        np.log(np.maximum(demos, 1.0)),
+        np.where(episodes > 0, episodes, 0.0),
+        np.where(episodes > 0, np.nan_to_num(success), 0.0),
+    )
     num_tasks = demos.shape[1]
-    x = np.log(np.maximum(demos, 1.0))
-    weight = np.where(episodes > 0, episodes, 0.0)
-    rate = np.where(episodes > 0, np.nan_to_num(success), 0.0)
-    tau2, slope2 = prior.prior_scale**2, prior.slope_scale**2
-    intercept = np.zeros(num_tasks)
-    slope, common = prior.slope_mean, 0.0
+    theta = np.concatenate(
+        [np.zeros(num_tasks), np.full(num_tasks, prior.slope_mean), [0.0, prior.slope_mean]]
+    )
+    value = _objective(theta, data, prior)
     for _ in range(NEWTON_STEPS):
-        p = _sigmoid(intercept[None, :] + slope * x)
-        residual = weight * (rate - p)  # (R, N)
-        curvature = weight * p * (1.0 - p)
-        gradient = np.concatenate(
-            [
-                residual.sum(0) - (intercept - common) / tau2,
-                [(residual * x).sum() - (slope - prior.slope_mean) / slope2],
-                [(intercept - common).sum() / tau2 - common / 100.0],
-            ]
-        )
-        hessian = np.zeros((num_tasks + 2, num_tasks + 2))
-        hessian[np.arange(num_tasks), np.arange(num_tasks)] = curvature.sum(0) + 1.0 / tau2
-        cross = (curvature * x).sum(0)
-        hessian[:num_tasks, num_tasks] = hessian[num_tasks, :num_tasks] = cross
-        hessian[:num_tasks, num_tasks + 1] = hessian[num_tasks + 1, :num_tasks] = -1.0 / tau2
-        hessian[num_tasks, num_tasks] = (curvature * x * x).sum() + 1.0 / slope2
-        hessian[num_tasks + 1, num_tasks + 1] = num_tasks / tau2 + 1.0 / 100.0
-        step = np.linalg.solve(hessian, gradient)
-        intercept, slope, common = intercept + step[:num_tasks], slope + step[num_tasks], common + step[-1]
-        if np.abs(step).max() < 1e-8:
+        step = _newton_step(theta, data, prior)
+        # Backtracking: a full Newton step can overshoot where a task's rate is 0 or 1.
+        for _ in range(30):
+            candidate = theta + step
+            new_value = _objective(candidate, data, prior)
+            if new_value >= value - 1e-12:
+                break
+            step = step / 2.0
+        theta, previous, value = candidate, value, new_value
+        if np.abs(step).max() < 1e-8 or abs(value - previous) < 1e-10:
             break
-    return FittedCurves(intercept, float(slope), float(common))
+    return FittedCurves(theta[:num_tasks].copy(), theta[num_tasks : 2 * num_tasks].copy())
+
+
+@dataclass(frozen=True)
+class _Data:
+    x: np.ndarray  # log demos, (R, N)
+    weight: np.ndarray  # episodes, (R, N)
+    rate: np.ndarray  # success rates, (R, N)
+
+
+def _split(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
+    num_tasks = (theta.size - 2) // 2
+    return theta[:num_tasks], theta[num_tasks : 2 * num_tasks], float(theta[-2]), float(theta[-1])
+
+
+def _objective(theta: np.ndarray, data: _Data, prior: CurvePrior) -> float:
+    """Penalised log-likelihood (to maximise)."""
+    intercept, slope, common, common_slope = _split(theta)
+    logits = intercept[None, :] + slope[None, :] * data.x
+    log_p, log_q = -np.logaddexp(0.0, -logits), -np.logaddexp(0.0, logits)
+    fit = float((data.weight * (data.rate * log_p + (1.0 - data.rate) * log_q)).sum())
+    penalty = (
+        ((intercept - common) ** 2).sum() / prior.prior_scale**2
+        + ((slope - common_slope) ** 2).sum() / prior.task_slope_scale**2
+        + (common_slope - prior.slope_mean) ** 2 / prior.slope_scale**2
+        + common**2 / 100.0
+    )
+    return fit - 0.5 * penalty
+
+
+def _newton_step(theta: np.ndarray, data: _Data, prior: CurvePrior) -> np.ndarray:
+    """The Newton step of the penalised log-likelihood at ``theta``, in O(num_tasks).
+
+    The negative Hessian is block-diagonal over tasks (each task's intercept and slope) bordered by
+    the two common parameters; the step solves it by the Schur complement of those two.
+    """
+    intercept, slope, common, common_slope = _split(theta)
+    tau2, sigma2, slope2 = prior.prior_scale**2, prior.task_slope_scale**2, prior.slope_scale**2
+    p = _sigmoid(intercept[None, :] + slope[None, :] * data.x)
+    residual = data.weight * (data.rate - p)  # (R, N)
+    curvature = data.weight * p * (1.0 - p)
+    grad_a = residual.sum(0) - (intercept - common) / tau2
+    grad_b = (residual * data.x).sum(0) - (slope - common_slope) / sigma2
+    grad_h = np.array(
+        [
+            (intercept - common).sum() / tau2 - common / 100.0,
+            (slope - common_slope).sum() / sigma2 - (common_slope - prior.slope_mean) / slope2,
+        ]
+    )
+    h_aa = curvature.sum(0) + 1.0 / tau2
+    h_bb = (curvature * data.x**2).sum(0) + 1.0 / sigma2
+    h_ab = (curvature * data.x).sum(0)
+    det = h_aa * h_bb - h_ab**2
+
+    def solve_blocks(g_a: np.ndarray, g_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return (h_bb * g_a - h_ab * g_b) / det, (h_aa * g_b - h_ab * g_a) / det
+
+    # Border: intercepts couple to the common intercept (-1/tau2), slopes to the common slope (-1/sigma2).
+    zeros, n = np.zeros_like(h_aa), h_aa.size
+    mu_a, mu_b = solve_blocks(np.full(n, -1.0 / tau2), zeros)
+    beta_a, beta_b = solve_blocks(zeros, np.full(n, -1.0 / sigma2))
+    g_a, g_b = solve_blocks(grad_a, grad_b)
+    schur = np.array([[n / tau2 + 1.0 / 100.0, 0.0], [0.0, n / sigma2 + 1.0 / slope2]])
+    schur -= np.array(
+        [
+            [(mu_a * -1.0 / tau2).sum(), (beta_a * -1.0 / tau2).sum()],
+            [(mu_b * -1.0 / sigma2).sum(), (beta_b * -1.0 / sigma2).sum()],
+        ]
+    )
+    rhs = grad_h - np.array([(g_a * -1.0 / tau2).sum(), (g_b * -1.0 / sigma2).sum()])
+    step_h = np.linalg.solve(schur, rhs)
+    step_a = g_a - (mu_a * step_h[0] + beta_a * step_h[1])
+    step_b = g_b - (mu_b * step_h[0] + beta_b * step_h[1])
+    return np.concatenate([step_a, step_b, step_h])
 
 
 def greedy_split(curve: np.ndarray, budget: int, n_min: int) -> tuple[np.ndarray, np.ndarray]:

@@ -649,16 +649,17 @@ class CurveSchedulerConfig(SchedulerConfig):
     """Learning curves fitted online: the round's demos go where success is expected to rise most.
 
     Each task's success against its own expert demos is fitted from every measurement so far
-    (``learning_curve.fit_logistic_curves``: a logistic in log demos, one intercept per task shrunk
-    toward the others', one slope), then the budget is split greedily by expected gain in success
-    per demo (``learning_curve.greedy_split``) after ``n_min`` each. ``temperature`` and
+    (``learning_curve.fit_logistic_curves``: a logistic in log demos, each task's intercept and slope
+    shrunk toward the tasks' common ones), then the budget is split greedily by expected gain in
+    success per demo (``learning_curve.greedy_split``) after ``n_min`` each. ``temperature`` and
     ``normalization`` play no part. Needs the demos behind each measurement (``DEMOS``): before
     the first measurement the split is even.
 
     Attributes:
         prior_scale: Scale of a task's intercept around the common one (logits, > 0).
-        slope_mean: Prior mean of the shared slope on log demos.
+        slope_mean: Prior mean of the tasks' common slope on log demos.
         slope_scale: Prior scale of that slope (> 0).
+        task_slope_scale: Scale of a task's slope around the common one (> 0; small: one slope).
     """
 
     measurements: ClassVar[tuple[str, ...]] = (SUCCESS, DEMOS)
@@ -666,21 +667,32 @@ class CurveSchedulerConfig(SchedulerConfig):
     prior_scale: float = 1.5
     slope_mean: float = 1.0
     slope_scale: float = 1.0
+    task_slope_scale: float = 0.1
 
     def __post_init__(self) -> None:
         super().__post_init__()
         _require_positive(self.prior_scale, "scheduler.prior_scale")
         _require_positive(self.slope_scale, "scheduler.slope_scale")
+        _require_positive(self.task_slope_scale, "scheduler.task_slope_scale")
         if not math.isfinite(self.slope_mean):
             raise ValueError(f"scheduler.slope_mean must be finite, got {self.slope_mean}.")
 
     def fitted(self, state: SchedulerState) -> FittedCurves | None:
-        """The curves fitted to the state's history (None before any measurement)."""
+        """The curves fitted to the state's history (None before any measurement).
+
+        The last fit is kept: ``metric`` and ``split`` of one allocation fit once.
+        """
         if state.history is None or state.history.rounds == 0:
             return None
-        prior = CurvePrior(self.prior_scale, self.slope_mean, self.slope_scale)
         history = state.history
-        return fit_logistic_curves(history.demos, history.success, history.episodes, prior)
+        key = (history.demos.tobytes(), history.success.tobytes(), history.episodes.tobytes())
+        cached = getattr(self, "_last_fit", None)
+        if cached is not None and cached[0] == key:
+            return cached[1]
+        prior = CurvePrior(self.prior_scale, self.slope_mean, self.slope_scale, self.task_slope_scale)
+        curves = fit_logistic_curves(history.demos, history.success, history.episodes, prior)
+        self._last_fit = (key, curves)
+        return curves
 
     def metric(self, state: SchedulerState) -> np.ndarray:
         """The fitted success at each task's demos so far (``p0`` before any measurement)."""

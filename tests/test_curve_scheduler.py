@@ -122,7 +122,12 @@ def test_curve_scheduler_needs_the_demos_behind_each_measurement():
 
 def test_curve_allocation_is_recomputed_and_a_tampered_history_is_caught():
     record = json.loads(json.dumps(_curve_scheduler_after(3).allocate(15).to_dict()))
-    assert record["options"] == {"prior_scale": 1.5, "slope_mean": 1.0, "slope_scale": 1.0}
+    assert record["options"] == {
+        "prior_scale": 1.5,
+        "slope_mean": 1.0,
+        "slope_scale": 1.0,
+        "task_slope_scale": 0.1,
+    }
     assert allocation_mismatches(record) == []
     record["history"]["success"][-1][2] = 1.0
     assert allocation_mismatches(record) != []
