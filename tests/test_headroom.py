@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.headroom import (
+from lerobot_mtdagger.analysis.headroom import (
     TaskPoint,
     best_splits,
     fit_curves,

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.headroom import TaskPoint, fit_curves, points_from_rows
-from lerobot_mtdagger.replay import (
+from lerobot_mtdagger.analysis.headroom import TaskPoint, fit_curves, points_from_rows
+from lerobot_mtdagger.analysis.replay import (
     ONLINE_ORACLE,
     STATIC_ORACLE,
     UNIFORM,

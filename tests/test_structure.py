@@ -277,16 +277,19 @@ WING_RANKS = {
     "lerobot_mtdagger.datasets": 2,
     "lerobot_mtdagger.policies": 2,
     "lerobot_mtdagger.scheduler": 1,
+    "lerobot_mtdagger.learning_curve": 1,
     "lerobot_mtdagger.utils": 0,
 }
 """Imports run one way: cli and commands -> analysis -> students -> runner -> envs and experts -> datasets
 and policies -> scheduler -> utils (the runner finds a student by name, ``runner.student``). Within a
-rank, cli may use commands, experts may use envs and datasets may use policies (not the reverse)."""
+rank, cli may use commands, experts may use envs, datasets may use policies and the scheduler its
+learning curves (not the reverse)."""
 
 SAME_RANK_ALLOWED = {
     ("lerobot_mtdagger.cli", "lerobot_mtdagger.commands"),
     ("lerobot_mtdagger.experts", "lerobot_mtdagger.envs"),
     ("lerobot_mtdagger.datasets", "lerobot_mtdagger.policies"),
+    ("lerobot_mtdagger.scheduler", "lerobot_mtdagger.learning_curve"),
 }
 
 

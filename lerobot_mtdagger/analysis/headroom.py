@@ -10,7 +10,7 @@ perfect scheduler could save.
 Curves are estimated from measured points (one per task, budget and seed): success rates at the
 same demos are pooled (weighted by their evaluation episodes), made non-decreasing by weighted
 isotonic regression, and interpolated linearly between measured budgets. No curve is extended past
-its measured range here (the replay bench, ``replay.py``, says how it extrapolates).
+its measured range here (the replay bench, ``analysis/replay.py``, says how it extrapolates).
 
 With several seeds the in-sample headroom is optimistic (the best split also fits the curves'
 noise). The honest estimate chooses the split on the other seeds' curves and scores it, against
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lerobot_mtdagger.studies.stats import mean_interval
+from lerobot_mtdagger.analysis.stats import mean_interval
 from lerobot_mtdagger.utils.errors import UserError
 
 

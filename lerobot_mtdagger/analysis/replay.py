@@ -10,7 +10,7 @@ phases after round 0 (the budgets a study's primary reads).
 
 Beside the registered schedulers it runs two oracles that know every curve: the online oracle
 allocates round by round by the true gain per demo (``learning_curve.greedy_split``), the static
-oracle takes, at each budget, the best split of all demos so far (``headroom.best_splits``: not
+oracle takes, at each budget, the best split of all demos so far (``analysis.headroom.best_splits``: not
 reachable round by round, the ceiling of any split). A scheduler's share of the headroom is
 ``(scheduler - uniform) / (online oracle - uniform)``.
 
@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lerobot_mtdagger.headroom import LearningCurves, best_splits
+from lerobot_mtdagger.analysis.headroom import LearningCurves, best_splits
 from lerobot_mtdagger.learning_curve import greedy_split
 from lerobot_mtdagger.scheduler import GAIN, make_scheduler, scheduler_config_class
 from lerobot_mtdagger.utils.errors import UserError
@@ -149,7 +149,7 @@ def _last_measured_slope(curves: LearningCurves) -> np.ndarray:
 
 def synthetic_curves(num_tasks: int, easiest: float, hardest: float, setting: ReplaySetting) -> ReplayCurves:
     """The ``demo`` command's synthetic tasks (``1 - exp(-n / d)``, ``d`` spread geometrically)."""
-    from lerobot_mtdagger.studies.simulate import SyntheticTasks
+    from lerobot_mtdagger.analysis.simulate import SyntheticTasks
 
     difficulty = SyntheticTasks.spread(num_tasks, easiest, hardest).difficulty
     demos = np.arange(setting.initial_demos, setting.max_demos + 1)
