@@ -24,6 +24,9 @@ Commands:
     plan: the next collection session's episodes per task from LeRobot datasets of the policy's
         episodes (``--datasets``, ``--budget`` or ``--budget_minutes``, ``--output``, ``--previous``);
         ``--verify=PLAN`` recomputes a plan from its recorded inputs (``planning/plan.py``).
+    replay: the schedulers replayed against measured per-task learning curves (``--records``,
+        ``--methods``, ``--rounds``, ``--replicates``): the share of the headroom each captures and the
+        seeds a study needs to see it, before the study is run (``analysis/replay.py``).
     demo: run the performance-aware scheduler on synthetic tasks and print each round's allocation
         (no simulator, no policy; shows how the methods split a budget).
 """
@@ -44,6 +47,7 @@ from lerobot_mtdagger.commands.eval import EvalConfig, eval_command
 from lerobot_mtdagger.commands.merge import MergeConfig, merge_command
 from lerobot_mtdagger.commands.plan import PlanConfig, plan_command
 from lerobot_mtdagger.commands.push import PushConfig, push_command
+from lerobot_mtdagger.commands.replay import ReplayConfig, replay_command
 from lerobot_mtdagger.commands.report import ReportConfig, report_command
 from lerobot_mtdagger.commands.run import RunConfig, run_experiment
 from lerobot_mtdagger.commands.shift import ShiftConfig, shift_command
@@ -62,6 +66,7 @@ COMMANDS: dict[str, tuple[type, Callable]] = {
     "push": (PushConfig, push_command),
     "report": (ReportConfig, report_command),
     "plan": (PlanConfig, plan_command),
+    "replay": (ReplayConfig, replay_command),
     "demo": (DemoConfig, run_demo),
 }
 

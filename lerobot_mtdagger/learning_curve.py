@@ -198,23 +198,50 @@ def greedy_split(curve: np.ndarray, budget: int, n_min: int) -> tuple[np.ndarray
     num_tasks = curve.shape[0]
     counts = np.full(num_tasks, n_min, dtype=np.int64)
     remaining = budget - n_min * num_tasks
-    first_rate = _best_rates(curve, counts, max(remaining, 1))[0]
+    every = np.arange(num_tasks)
+    rate, steps = _best_rates(curve, counts, max(remaining, 1), every)
+    first_rate = rate.copy()
     while remaining > 0:
-        rate, steps = _best_rates(curve, counts, remaining)
         task = int(np.argmax(rate))  # ties: the lowest task index
         give = int(steps[task])
         if rate[task] <= 0:  # flat everywhere: spread what is left evenly
             task, give = int(np.argmin(counts)), 1
+        else:
+            give = max(give, _run_above(curve[task], int(counts[task]), remaining, _runner_up(rate, task)))
         counts[task] += give
         remaining -= give
+        if remaining > 0:
+            # Only the task just given and those whose best stretch no longer fits need a new rate.
+            stale = steps > remaining
+            stale[task] = True
+            rows = np.flatnonzero(stale)
+            rate[rows], steps[rows] = _best_rates(curve, counts, remaining, rows)
     return counts, first_rate
 
 
-def _best_rates(curve: np.ndarray, counts: np.ndarray, remaining: int) -> tuple[np.ndarray, np.ndarray]:
-    """Each task's best average gain per demo over its next 1..remaining demos, and that many."""
+def _best_rates(
+    curve: np.ndarray, counts: np.ndarray, remaining: int, rows: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The best average gain per demo of tasks ``rows`` over their next 1..remaining demos, and how many."""
     steps = np.arange(1, remaining + 1)
-    rows = np.arange(curve.shape[0])[:, None]
-    ahead = np.minimum(counts[:, None] + steps[None, :], curve.shape[1] - 1)
-    gain = (curve[rows, ahead] - curve[rows, counts[:, None]]) / steps[None, :]
+    start = counts[rows]
+    ahead = np.minimum(start[:, None] + steps[None, :], curve.shape[1] - 1)
+    gain = (curve[rows[:, None], ahead] - curve[rows, start][:, None]) / steps[None, :]
     best = np.argmax(gain, axis=1)
-    return gain[rows[:, 0], best], steps[best]
+    return gain[np.arange(rows.size), best], steps[best]
+
+
+def _runner_up(rate: np.ndarray, task: int) -> float:
+    """The best rate among the other tasks (-inf when there is none)."""
+    own, rate[task] = rate[task], -np.inf
+    best = float(rate.max())
+    rate[task] = own
+    return best
+
+
+def _run_above(curve_row: np.ndarray, start: int, remaining: int, level: float) -> int:
+    """How many next demos of one task each add at least ``level`` (what one-by-one greedy would give)."""
+    stop = min(start + remaining, curve_row.size - 1)
+    marginal = np.diff(curve_row[start : stop + 1])
+    below = np.flatnonzero(marginal < level)
+    return int(below[0]) if below.size else int(marginal.size)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -18,7 +20,7 @@ from lerobot_mtdagger.analysis.replay import (
     synthetic_curves,
 )
 from lerobot_mtdagger.utils.errors import UserError
-from tests.test_headroom import _paper_regime_rows
+from tests.test_headroom import PAPER_REGIME, _paper_regime_rows
 
 
 def _by_label(summaries):
@@ -125,3 +127,54 @@ def test_seeds_for_a_half_width_of_half_the_effect():
     # Half-width t(0.975, n - 1) * 0.01 / sqrt(n) <= 0.01: 6 seeds give 1.05, 7 give 0.92.
     assert seeds_for_half_width(0.02, 0.01) == 7
     assert seeds_for_half_width(0.001, 0.05, most=30) is None
+
+
+def test_the_replay_command_prints_the_comparison_and_writes_it(tmp_path, capsys):
+    from lerobot_mtdagger.cli import main
+
+    out = tmp_path / "replay.json"
+    options = [
+        "--synthetic_tasks=6",
+        "--replicates=20",
+        "--rounds=3",
+        "--methods=[need,curve]",
+        f"--output={out}",
+    ]
+    assert main(["replay", *options]) == 0
+    printed = capsys.readouterr().out
+    assert "| need |" in printed and "| oracle (online) |" in printed and "power:" in printed
+    saved = json.loads(out.read_text())
+    assert [arm["label"] for arm in saved["arms"]] == [
+        "uniform",
+        "need",
+        "curve",
+        ONLINE_ORACLE,
+        STATIC_ORACLE,
+    ]
+    assert saved["setting"]["budget_per_round"] == 18
+
+
+def test_the_replay_command_reads_a_studys_saved_records(capsys):
+    from lerobot_mtdagger.cli import main
+
+    records = PAPER_REGIME / "cosine-seed0" / "runs-records.tar.gz"
+    assert main(["replay", f"--records=[{records}]", "--replicates=5", "--methods=[need]"]) == 0
+    assert "43 tasks' curves from bc runs (seeds 0), measured 3-30 demos per task" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "options, match",
+    [
+        ([], "Give one source of curves"),
+        (["--synthetic_tasks=4", "--methods=[gain]"], "cannot replay it"),
+        (["--synthetic_tasks=4", "--rounds=0"], "--rounds must be >= 1"),
+        (["--synthetic_tasks=4", "--levels=[1.5]"], "--levels must be success levels"),
+    ],
+)
+def test_the_replay_command_refuses_bad_input_in_one_line(tmp_path, capsys, options, match):
+    from lerobot_mtdagger.cli import main
+
+    assert main(["replay", *options, f"--output={tmp_path / 'out.json'}"]) == 2
+    err = capsys.readouterr().err
+    assert match in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out.json").exists()

@@ -35,7 +35,7 @@ import numpy as np
 
 from lerobot_mtdagger.analysis.headroom import LearningCurves, best_splits
 from lerobot_mtdagger.learning_curve import greedy_split
-from lerobot_mtdagger.scheduler import GAIN, make_scheduler, scheduler_config_class
+from lerobot_mtdagger.scheduler import GAIN, make_scheduler, scheduler_config_class, scheduling_methods
 from lerobot_mtdagger.utils.errors import UserError
 
 logger = logging.getLogger(__name__)
@@ -460,3 +460,12 @@ def seeds_for_half_width(effect: float, sd: float, most: int = 100) -> int | Non
         if scipy_stats.t.ppf(0.975, seeds - 1) * sd / np.sqrt(seeds) <= abs(effect) / 2:
             return seeds
     return None
+
+
+def default_arms() -> list[ArmSpec]:
+    """Every registered scheduler that a success curve can drive (all but those reading the loss)."""
+    return [
+        ArmSpec(method)
+        for method in scheduling_methods()
+        if method != UNIFORM and GAIN not in scheduler_config_class(method).measurements
+    ]
