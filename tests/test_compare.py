@@ -44,6 +44,7 @@ FIGURES = [
     "metrics_vs_success.png",
     "hardest_tasks.png",
     "kalman_ablation.png",
+    "headroom.png",
 ]
 
 
@@ -215,8 +216,15 @@ def test_report_writes_every_figure_and_the_paired_differences(compared, capsys)
     assert "## The hardest tasks against the others" in summary and "## Stability" in summary
     assert "| need | need_raw | 3.0 |" in summary  # the Kalman filter's own effect, paired
     assert "| need | uniform | 5.0 | " in summary.split("## The hardest tasks")[1]
-    assert "bc (1 demos/task)" in capsys.readouterr().out  # the table keeps BC budgets apart
+    printed = capsys.readouterr().out
+    assert "bc (1 demos/task)" in printed  # the table keeps BC budgets apart
     assert "Interim" not in summary  # every run finished
+    # The headroom of BC's curves (and round 0), in the summary, its file and on the console.
+    assert "## Headroom: the best split of the same demos against an even split" in summary
+    headroom = json.loads((report / "headroom.json").read_text())
+    assert [b["demos_per_task"] for b in headroom["budgets"]] == [1, 3, 5] and headroom["seeds"] == [0, 1]
+    assert all(b["gain"] >= 0 and "held_out_gain" in b for b in headroom["budgets"])
+    assert "| demos per task | even split | best split | gain |" in printed
 
 
 def test_report_on_a_study_in_progress_reports_what_is_committed_and_lists_the_rest(

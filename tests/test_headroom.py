@@ -129,3 +129,14 @@ def test_the_paper_regime_headroom_is_about_what_the_records_showed():
         h.demos_per_task: h for h in held_out_headroom(task_points, curves.task_names, [6, 12, 18, 24])
     }
     assert all(-0.03 <= h.mean <= 0.03 and h.low < 0 < h.high for h in held_out.values())
+
+
+def test_a_report_whose_runs_cannot_give_curves_says_why_in_one_line(tmp_path):
+    from lerobot_mtdagger.analysis.headroom_report import HEADROOM_FILE, write_headroom
+
+    row = {"method": "bc", "bc": True, "seed": 0, "round": 0, "demos_per_task": [5, 5]}
+    lines, figure = write_headroom(
+        [row | {"eval_success": [0.5, 0.7], "eval_episodes_per_task": 10}], ["a", "b"], tmp_path
+    )
+    assert figure is None and not (tmp_path / HEADROOM_FILE).exists()
+    assert "Not computed: Task 'a' was measured at 1 budget(s)" in lines[2]

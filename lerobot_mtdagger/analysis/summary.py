@@ -33,6 +33,7 @@ from lerobot_mtdagger.analysis.figures import (
     runs_by_method,
     seed_reach,
 )
+from lerobot_mtdagger.analysis.headroom_report import write_headroom
 from lerobot_mtdagger.analysis.results import PHASE_TIMINGS
 from lerobot_mtdagger.analysis.stats import Interval, format_difference, mean_interval, paired_difference
 from lerobot_mtdagger.utils.errors import UserError
@@ -267,6 +268,7 @@ def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[
         lines += [f"## {title}", "", f"![{title}]({path.name})", ""]
     lines += [f"Pearson r, metric vs final success: {notes['correlations']}.", ""]
     lines += [f"Hardest tasks: {notes['hardest']}.", ""]
+    lines += notes.get("headroom", [])
     lines += ["## Paired differences of average success (method - baseline), 95% t interval over seeds", ""]
     lines += ["`*`: the interval excludes 0.", ""]
     pairs = comparison_pairs(rows)
@@ -360,7 +362,11 @@ def write_report(
             y_key="unseen_success_mean",
             title="Success on unseen tasks (no task index: shared embedding)",
         )
+    headroom, headroom_figure = write_headroom(rows, task_names, folder)
+    if headroom_figure is not None:
+        figures["Headroom: the best split against an even split"] = headroom_figure
     notes = {
+        "headroom": headroom,
         "correlations": {k: round(v, 3) for k, v in correlations.items()},
         "hardest": [task_names[t] for t in hardest],
         "hardest_indices": list(hardest),

@@ -222,4 +222,16 @@ def _write_figures(
     from lerobot_mtdagger.analysis.summary import write_report
 
     path = write_report(rows, task_names, config.output_dir, levels=config.levels, unfinished=unfinished)
+    _print_headroom(config.output_dir)
     print(f"figures and summary: {path}")
+
+
+def _print_headroom(folder: Path) -> None:
+    """Prints the headroom table ``write_report`` saved (nothing when the runs could not give one)."""
+    import json
+
+    from lerobot_mtdagger.analysis.headroom_report import HEADROOM_FILE, headroom_lines
+
+    saved = folder / HEADROOM_FILE
+    if saved.is_file():
+        print("\n".join(headroom_lines(json.loads(saved.read_text()))))
