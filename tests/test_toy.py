@@ -560,3 +560,29 @@ def test_an_experiment_started_without_provenance_columns_keeps_its_schema(tmp_p
     experiment.commit_round(0, staged, minimal_record(0, [1, 0, 0]))
     assert INTERVENTION not in experiment.round_features(suite.features)
     assert INTERVENTION in ExperimentDir(tmp_path / "new").round_features(suite.features)
+
+
+def test_eval_phases_evaluates_only_the_phases_named_and_allocates_as_before(tmp_path, capsys):
+    from lerobot_mtdagger.cli import main
+
+    lines = run(toy_config(tmp_path / "some", "--rollout.eval_phases=[0,2]"))
+    every = run(toy_config(tmp_path / "every"))
+    some, all_phases = ExperimentDir(tmp_path / "some"), ExperimentDir(tmp_path / "every")
+    evaluated = [some.read_phase_record(k).eval is not None for k in range(3)]
+    assert evaluated == [True, False, True] and "eval success n/a" in lines[1]
+    assert [some.read_round_record(k).episodes_per_task for k in range(3)] == [
+        all_phases.read_round_record(k).episodes_per_task for k in range(3)
+    ]
+    assert every[2].split("|")[1] == lines[2].split("|")[1]  # demos per task
+    assert verify_experiment(some) == (3, 3, [])
+    # Recorded with the run: a resume with other phases is refused; report reads the evaluated ones.
+    with pytest.raises(UserError, match=r"rollout.eval_phases"):
+        run(toy_config(tmp_path / "some", "--rollout.eval_phases=[2]", "--resume=true"))
+    assert (
+        main(["report", f"--experiments=[{tmp_path / 'some'}]", f"--output_dir={tmp_path / 'report'}"]) == 0
+    )
+    table = capsys.readouterr().out
+    assert "| need | 0 |" in table and "| need | 2 |" in table and "| need | 1 |" not in table
+    assert main(["run", *TOY_RUN, "--rollout.eval_phases=[-1]", f"--output_dir={tmp_path / 'bad'}"]) == 2
+    assert "rollout.eval_phases must list phase indices >= 0" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()

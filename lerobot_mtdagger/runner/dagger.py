@@ -286,9 +286,11 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     trained_at = time.perf_counter()
     staging = ctx.experiment.staging_policy_root(round_index)
     trained.save(staging)
-    evaluations = evaluate_student(
-        ctx, ctx.config.student.make_runner(trained.policy, trained.preprocessor, trained.postprocessor)
-    )
+    evaluations = (None, None)
+    if ctx.config.rollout.evaluates(round_index):
+        evaluations = evaluate_student(
+            ctx, ctx.config.student.make_runner(trained.policy, trained.preprocessor, trained.postprocessor)
+        )
     timing = {
         "load_s": loaded - start + trained.prepare_s,
         "train_s": trained.train_s,

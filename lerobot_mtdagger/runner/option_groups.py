@@ -177,12 +177,16 @@ class RolloutEpisodes:
             to succeed from the same reset seed (the expert runs that episode first, unrecorded; no
             cut where it fails). None: no such cut. ``max_steps`` still applies.
         steps_after_success: Steps recorded after the first success before an episode ends.
+        eval_phases: The phases whose policy is evaluated (0: round 0's BC); None: every phase. A
+            study whose analysis reads only some budgets evaluates those alone (evaluation is most of
+            a study's cost); the scheduler does not read evaluations, so allocations are unchanged.
     """
 
     eval_episodes: int | None = None
     max_steps: int | None = None
     expert_multiple: float | None = None
     steps_after_success: int = 10
+    eval_phases: list[int] | None = None
 
 
 @dataclass
@@ -199,7 +203,17 @@ class RolloutConfig(WorkerOptions, RolloutEpisodes):
             if getattr(self, name) < 0:
                 raise ValueError(f"rollout.{name} must be >= 0, got {getattr(self, name)}.")
         _require_positive(self, "rollout", ("max_steps", "expert_multiple"))
+        if self.eval_phases is not None and any(
+            isinstance(k, bool) or not isinstance(k, int) or k < 0 for k in self.eval_phases
+        ):
+            raise ValueError(
+                f"rollout.eval_phases must list phase indices >= 0 (0: round 0's BC), got {self.eval_phases}."
+            )
         self.check_workers("rollout.")
+
+    def evaluates(self, phase: int) -> bool:
+        """Whether phase ``phase``'s policy is evaluated."""
+        return self.eval_episodes != 0 and (self.eval_phases is None or phase in self.eval_phases)
 
 
 @dataclass
