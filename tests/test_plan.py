@@ -334,6 +334,7 @@ def test_the_curve_scheduler_plans_from_the_demos_each_session_adds(tmp_path, ca
     assert status == 0 and first["demos"] == [3.0, 3.0]
     counts = first["allocation"]["episodes_per_task"]
     assert sum(counts) == 20 and first["allocation"]["history"]["demos"] == [[3.0, 3.0]]
+    assert "headroom: not yet" in capsys.readouterr().out  # one session: no curve yet
     previous = tmp_path / "plan-1.json"
     status, second = plan(
         tmp_path, "plan-2", f"--datasets=[{second_data}]", *options, f"--previous={previous}"
@@ -341,6 +342,7 @@ def test_the_curve_scheduler_plans_from_the_demos_each_session_adds(tmp_path, ca
     assert status == 0
     assert second["demos"] == [3.0 + counts[0], 3.0 + counts[1]]
     assert second["allocation"]["history"]["success"] == [[1.0, 1 / 3], [0.5, 1.0]]
+    assert "headroom at" in capsys.readouterr().out  # two sessions: a curve per task
     assert main(["plan", f"--verify={tmp_path / 'plan-2.json'}"]) == 0
     capsys.readouterr()
 
