@@ -185,6 +185,11 @@ def _newton_step(theta: np.ndarray, data: _Data, prior: CurvePrior) -> np.ndarra
 def greedy_split(curve: np.ndarray, budget: int, n_min: int) -> tuple[np.ndarray, np.ndarray]:
     """Splits ``budget`` demos where each task's curve rises most per demo.
 
+    Every task first gets ``n_min``; then the demos go, one by one, to the largest next gain per demo
+    of each task's least concave majorant (so a curve that is flat before it rises is valued by its
+    best average rise, not passed over). On concave curves this is the exact optimum of the mean
+    success; demos that no curve values any more are spread evenly.
+
     Args:
         curve: Success of task i after ``j`` more demos, shape (num_tasks, budget + 1); ``curve[:, 0]``
             is each task's success now.
@@ -193,55 +198,41 @@ def greedy_split(curve: np.ndarray, budget: int, n_min: int) -> tuple[np.ndarray
 
     Returns:
         ``(counts, rate)``: demos per task (int64, summing to ``budget``) and each task's best gain
-        per demo at the start (after its ``n_min``), shape (num_tasks,).
+        per demo after its ``n_min``, shape (num_tasks,).
     """
     num_tasks = curve.shape[0]
     counts = np.full(num_tasks, n_min, dtype=np.int64)
     remaining = budget - n_min * num_tasks
-    every = np.arange(num_tasks)
-    rate, steps = _best_rates(curve, counts, max(remaining, 1), every)
-    first_rate = rate.copy()
-    while remaining > 0:
-        task = int(np.argmax(rate))  # ties: the lowest task index
-        give = int(steps[task])
-        if rate[task] <= 0:  # flat everywhere: spread what is left evenly
-            task, give = int(np.argmin(counts)), 1
-        else:
-            give = max(give, _run_above(curve[task], int(counts[task]), remaining, _runner_up(rate, task)))
-        counts[task] += give
-        remaining -= give
-        if remaining > 0:
-            # Only the task just given and those whose best stretch no longer fits need a new rate.
-            stale = steps > remaining
-            stale[task] = True
-            rows = np.flatnonzero(stale)
-            rate[rows], steps[rows] = _best_rates(curve, counts, remaining, rows)
-    return counts, first_rate
+    slopes = _majorant_slopes(np.diff(curve[:, n_min:], axis=1))  # (num_tasks, budget - n_min)
+    rate = slopes[:, 0] if slopes.shape[1] else np.zeros(num_tasks)
+    if remaining > 0 and slopes.shape[1]:
+        order = np.argsort(-slopes, axis=None, kind="stable")[:remaining]
+        order = order[slopes.ravel()[order] > 0]
+        counts += np.bincount(order // slopes.shape[1], minlength=num_tasks)
+        remaining -= order.size
+    counts += remaining // num_tasks
+    for task in np.argsort(counts, kind="stable")[: remaining % num_tasks]:
+        counts[task] += 1
+    return counts, rate
 
 
-def _best_rates(
-    curve: np.ndarray, counts: np.ndarray, remaining: int, rows: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """The best average gain per demo of tasks ``rows`` over their next 1..remaining demos, and how many."""
-    steps = np.arange(1, remaining + 1)
-    start = counts[rows]
-    ahead = np.minimum(start[:, None] + steps[None, :], curve.shape[1] - 1)
-    gain = (curve[rows[:, None], ahead] - curve[rows, start][:, None]) / steps[None, :]
-    best = np.argmax(gain, axis=1)
-    return gain[np.arange(rows.size), best], steps[best]
+def _majorant_slopes(marginals: np.ndarray) -> np.ndarray:
+    """Each row's slopes of the least concave majorant of its cumulative sum (non-increasing rows).
 
-
-def _runner_up(rate: np.ndarray, task: int) -> float:
-    """The best rate among the other tasks (-inf when there is none)."""
-    own, rate[task] = rate[task], -np.inf
-    best = float(rate.max())
-    rate[task] = own
-    return best
-
-
-def _run_above(curve_row: np.ndarray, start: int, remaining: int, level: float) -> int:
-    """How many next demos of one task each add at least ``level`` (what one-by-one greedy would give)."""
-    stop = min(start + remaining, curve_row.size - 1)
-    marginal = np.diff(curve_row[start : stop + 1])
-    below = np.flatnonzero(marginal < level)
-    return int(below[0]) if below.size else int(marginal.size)
+    The antitonic regression of the row's gains (pool adjacent violators); rows already
+    non-increasing are returned as they are.
+    """
+    slopes = marginals.copy()
+    rising = np.flatnonzero(np.any(np.diff(marginals, axis=1) > 1e-15, axis=1))
+    for row in rising:
+        blocks: list[list[float]] = []  # [mean, count]
+        for value in marginals[row].tolist():
+            blocks.append([value, 1])
+            while len(blocks) > 1 and blocks[-2][0] < blocks[-1][0]:
+                mean_b, count_b = blocks.pop()
+                mean_a, count_a = blocks.pop()
+                blocks.append(
+                    [(mean_a * count_a + mean_b * count_b) / (count_a + count_b), count_a + count_b]
+                )
+        slopes[row] = np.concatenate([np.full(int(count), mean) for mean, count in blocks])
+    return slopes
