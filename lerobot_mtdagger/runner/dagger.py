@@ -44,7 +44,7 @@ import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from tqdm import tqdm
@@ -72,6 +72,9 @@ from lerobot_mtdagger.runner.run_setup import (
     unseen_task_suite,
 )
 from lerobot_mtdagger.runner.training.train import RoundCache, check_heldout, student_config, train_on_rounds
+
+if TYPE_CHECKING:
+    from lerobot_mtdagger.runner.training.train import TrainedPhase
 from lerobot_mtdagger.scheduler import Allocation, Scheduler, allocate_probabilities
 from lerobot_mtdagger.utils.quiet import quiet_third_party
 from lerobot_mtdagger.utils.seeds import COLLECT_STREAM
@@ -286,11 +289,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     trained_at = time.perf_counter()
     staging = ctx.experiment.staging_policy_root(round_index)
     trained.save(staging)
-    evaluations = (None, None)
-    if ctx.config.rollout.evaluates(round_index):
-        evaluations = evaluate_student(
-            ctx, ctx.config.student.make_runner(trained.policy, trained.preprocessor, trained.postprocessor)
-        )
+    evaluations = evaluate_student(ctx, trained, round_index)
     timing = {
         "load_s": loaded - start + trained.prepare_s,
         "train_s": trained.train_s,
@@ -305,8 +304,16 @@ def train_round(ctx: RunContext, round_index: int) -> None:
     ctx.experiment.commit_phase(round_index, staging, record)
 
 
-def evaluate_student(ctx: RunContext, runner: PolicyRunner) -> tuple[dict | None, dict | None]:
-    """``EvalResult.to_dict()`` on the training tasks and on the unseen ones (None: not evaluated)."""
+def evaluate_student(
+    ctx: RunContext, trained: TrainedPhase, round_index: int
+) -> tuple[dict | None, dict | None]:
+    """``EvalResult.to_dict()`` on the training tasks and on the unseen ones (None: not evaluated).
+
+    A phase that ``--rollout.eval_phases`` leaves out is not evaluated at all.
+    """
+    if not ctx.config.rollout.evaluates(round_index):
+        return None, None
+    runner = ctx.config.student.make_runner(trained.policy, trained.preprocessor, trained.postprocessor)
     results = [evaluate_phase(ctx, runner, ctx.workers), None]
     if ctx.heldout_suite is not None:
         # Workers of their own, only while they evaluate: each holds its drawers' envs and renderers.
