@@ -42,6 +42,8 @@ logger = logging.getLogger(__name__)
 
 EXTRAPOLATIONS = ("flat", "slope")
 UNIFORM, ONLINE_ORACLE, STATIC_ORACLE = "uniform", "oracle (online)", "oracle (static)"
+STATIC_ORACLE_SHARE = 4.0
+"""The static oracle gives a task at most this many times the last phase's even demos (its DP's width)."""
 
 
 @dataclass(frozen=True)
@@ -299,13 +301,16 @@ def replay_uniform(curves: ReplayCurves, setting: ReplaySetting) -> ArmOutcome:
 
 
 def replay_static_oracle(curves: ReplayCurves, setting: ReplaySetting) -> ArmOutcome:
-    """At each phase, the best split of all demos so far (the ceiling; not reachable round by round)."""
+    """At each phase, the best split of all demos so far (the ceiling; not reachable round by round).
+
+    A task gets at most ``STATIC_ORACLE_SHARE`` times the even split's demos at the last phase (and,
+    with flat extrapolation, nothing past its measured demos, where more are worth nothing).
+    """
     start = time.perf_counter()
-    cap = min(
-        curves.measured_high if curves.measured_high > curves.low else curves.low + 1, setting.max_demos
-    )
-    if setting.extrapolation == "slope":
-        cap = min(2 * cap, setting.max_demos)
+    even_last = setting.initial_demos + setting.rounds * setting.budget_per_round / curves.num_tasks
+    cap = min(int(STATIC_ORACLE_SHARE * even_last), setting.max_demos)
+    if setting.extrapolation == "flat":
+        cap = min(cap, max(curves.measured_high, curves.low + 1))
     grid = LearningCurves(
         tuple(str(i) for i in range(curves.num_tasks)),
         curves.low,
