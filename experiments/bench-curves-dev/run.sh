@@ -11,7 +11,8 @@
 # noisy labels; --preset=metaworld-state; cosine learning rate, BC trained as long as the DAgger
 # policy at the same budget; 10 evaluation episodes per task). Arm: bc at 45 and 60 demos per task.
 # Cost: measured on the first run (BC at 30 there: about 14 min of one core); expected about 20-30
-# min per run, 4 runs, one core. Resumable: `compare` skips finished runs.
+# min per run, 4 runs; SEEDS=100 and SEEDS=101 run on one core each. Resumable: `compare` skips
+# finished runs.
 # From a frozen worktree of the code (the run code is that of 738e42a):
 #   git worktree add --detach ../study-bench 738e42a
 #   cd ../study-bench && nohup bash ../main/experiments/bench-curves-dev/run.sh > ../main/outputs/bench-curves-dev.log 2>&1 &
@@ -26,7 +27,7 @@ SETTING=(--methods='[bc]' --bc_budgets='[45,60]' --jobs=1 --preset=metaworld-sta
   --dagger.rounds=9 --suite.tasks="[$tasks]" --expert.noise_by_task="$map" --expert.noise_correlation=0.9
   --expert.noise_seed=100 --expert.labels=noisy --rollout.eval_episodes=10 --progress=false
   --training.lr_schedule=cosine)
-for seed in 100 101; do
+for seed in ${SEEDS:-100 101}; do
   log "cosine BC at 45 and 60 demos per task, seed $seed"
   "$CLI" compare "${SETTING[@]}" --seeds="[$seed]" --output_dir="$OUT/cosine-seed$seed"
 done
