@@ -274,7 +274,7 @@ def test_a_flat_config_migrates_into_the_groups():
     expected |= {"training.lr_schedule", "training.seed", "training.progress_every_s"}
     expected |= {"expert.noise", "expert.noise_correlation", "expert.noise_seed", "expert.labels"}
     expected |= {"expert.path", "expert.type", "expert.min_success", "expert.success_episodes"}
-    expected |= {"expert.noise_by_task"}
+    expected |= {"expert.noise_by_task", "rollout.eval_phases"}
     assert added == expected, added
     assert all(today[path] == RunConfig.option_defaults()[path] for path in added)
 

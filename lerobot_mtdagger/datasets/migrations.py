@@ -208,12 +208,6 @@ MIGRATIONS: tuple[Migration, ...] = (
         former_values={"training.steps_rule": "fixed", "training.epochs": 100.0},
         resume_hint=pixels_preset_hint,
     ),
-    Migration(
-        name="eval-phases",
-        since="2026-12-04",
-        summary="--rollout.eval_phases evaluates only the phases an analysis reads; before: every phase.",
-        former_values={"rollout.eval_phases": None},
-    ),
 )
 """Every change to what stored runs hold or mean, oldest first."""
 

@@ -177,9 +177,10 @@ class RolloutEpisodes:
             to succeed from the same reset seed (the expert runs that episode first, unrecorded; no
             cut where it fails). None: no such cut. ``max_steps`` still applies.
         steps_after_success: Steps recorded after the first success before an episode ends.
-        eval_phases: The phases whose policy is evaluated (0: round 0's BC); None: every phase. A
-            study whose analysis reads only some budgets evaluates those alone (evaluation is most of
-            a study's cost); the scheduler does not read evaluations, so allocations are unchanged.
+        eval_phases: The phases whose policy is evaluated (0: round 0's, the only phase of a BC run);
+            None: every phase. A study whose analysis reads only some budgets evaluates those alone
+            (evaluation is most of a study's cost); the scheduler does not read evaluations, so
+            allocations are unchanged.
     """
 
     eval_episodes: int | None = None
