@@ -1,16 +1,16 @@
 """Per-task learning curves fitted online, and the split that follows their expected gain per demo.
 
 The model of the learning-curve scheduler: task i's success after ``n`` expert demos is
-``sigmoid(a_i + b * log n)``, one intercept per task and a slope shared by all tasks. While a task
-has few measurements its intercept is shrunk toward the tasks' common intercept ``mu`` (a normal
-prior of scale ``prior_scale``), and the slope toward ``slope_mean`` (scale ``slope_scale``), so
-that the first rounds, where every task sits at the same demos, still give a curve. The fit is
-the penalised maximum of the binomial likelihood (Newton's method; ``num_tasks + 2`` unknowns).
+``sigmoid(a_i + b_i * log n)``. Each task's intercept and slope are shrunk toward the tasks' common
+ones (normal priors of scale ``prior_scale`` and ``task_slope_scale``; the common slope toward
+``slope_mean``, scale ``slope_scale``), so that the first rounds, where every task sits at the same
+demos, still give a curve. The fit is the penalised maximum of the binomial likelihood: damped Newton
+over ``2 * num_tasks + 2`` unknowns, each step solved in O(num_tasks).
 
 ``greedy_split`` hands a budget out where the expected gain in success per demo is largest: every
-task first gets ``n_min``, then repeatedly the task whose curve rises most per demo over its next
-``k`` demos (the best ``k``, so that a curve that is flat before it rises is not passed over) gets
-those ``k``. On concave curves this is the exact optimum of the mean success.
+task first gets ``n_min``, then the demos go to the largest next gains of each task's least concave
+majorant (so a curve that is flat before it rises is valued by its best average rise). On concave
+curves this is the exact optimum of the mean success.
 
 Pure numpy.
 """
