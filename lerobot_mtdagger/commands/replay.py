@@ -12,7 +12,7 @@ import json
 import logging
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
 from lerobot_mtdagger.utils.errors import UserError
@@ -115,17 +115,9 @@ def _curves_and_setting(config: ReplayConfig):
     num_tasks = config.synthetic_tasks
     rows, task_names = ([], []) if num_tasks else _rows(config)
     num_tasks = num_tasks or len(task_names)
-    setting = ReplaySetting(
-        initial_demos=config.initial_demos,
-        rounds=config.rounds,
-        budget_per_round=config.budget_per_round or 3 * num_tasks,
-        eval_episodes=config.eval_episodes,
-        n_min=config.n_min,
-        lag=config.lag,
-        extrapolation=config.extrapolation,
-        replicates=config.replicates,
-        seed=config.seed,
-    )
+    # The command's options of the same names are the setting's; 0 budget means 3 per task.
+    options = {f.name: getattr(config, f.name) for f in fields(ReplaySetting)}
+    setting = ReplaySetting(**options | {"budget_per_round": config.budget_per_round or 3 * num_tasks})
     if config.synthetic_tasks:
         source = (
             f"{num_tasks} synthetic tasks, 1 - exp(-n / d), d from {config.easiest:g} to {config.hardest:g}"
