@@ -46,8 +46,14 @@ METHODS='--methods=[need,need_raw,need:normalization=none,need:temperature=0.25,
 BENCH=(--replicates=2000 --eval_episodes=20 --lag=1 --extrapolation=flat "$METHODS")
 if [ ! -s "$OUT/replay-paper.json" ]; then
   dev="$EXP/paper-regime-training-dev/records/cosine-seed100,$EXP/paper-regime-training-dev/records/cosine-seed101"
-  more=$(ls -d "$EXP"/bench-curves-dev/records/cosine-seed10[01] 2> /dev/null | paste -sd, || true)
-  if [ -z "$more" ]; then log "../bench-curves-dev has no records yet: the paper candidate's curves stop at 30"; exit 1; fi
+  for seed in 100 101; do
+    for demos in 45 60; do
+      if [ ! -s "$EXP/bench-curves-dev/records/cosine-seed$seed/bc-${demos}demos-seed$seed/policies/round-000/training.json" ]; then
+        log "../bench-curves-dev has no finished BC at $demos demos for seed $seed yet: nothing is decided"; exit 1
+      fi
+    done
+  done
+  more="$EXP/bench-curves-dev/records/cosine-seed100,$EXP/bench-curves-dev/records/cosine-seed101"
   "$CLI" replay --records="[$dev,$more]" "${BENCH[@]}" --output="$OUT/replay-paper.json"
 fi
 if [ ! -s "$OUT/replay-pixels.json" ]; then
