@@ -219,20 +219,32 @@ def greedy_split(curve: np.ndarray, budget: int, n_min: int) -> tuple[np.ndarray
 def _majorant_slopes(marginals: np.ndarray) -> np.ndarray:
     """Each row's slopes of the least concave majorant of its cumulative sum (non-increasing rows).
 
-    The antitonic regression of the row's gains (pool adjacent violators); rows already
+    The antitonic regression of the row's gains (``isotonic`` of the negated gains); rows already
     non-increasing are returned as they are.
     """
     slopes = marginals.copy()
-    rising = np.flatnonzero(np.any(np.diff(marginals, axis=1) > 1e-15, axis=1))
-    for row in rising:
-        blocks: list[list[float]] = []  # [mean, count]
-        for value in marginals[row].tolist():
-            blocks.append([value, 1])
-            while len(blocks) > 1 and blocks[-2][0] < blocks[-1][0]:
-                mean_b, count_b = blocks.pop()
-                mean_a, count_a = blocks.pop()
-                blocks.append(
-                    [(mean_a * count_a + mean_b * count_b) / (count_a + count_b), count_a + count_b]
-                )
-        slopes[row] = np.concatenate([np.full(int(count), mean) for mean, count in blocks])
+    ones = np.ones(marginals.shape[1])
+    for row in np.flatnonzero(np.any(np.diff(marginals, axis=1) > 1e-15, axis=1)):
+        slopes[row] = -isotonic(-marginals[row], ones)
     return slopes
+
+
+def isotonic(values: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Weighted least-squares non-decreasing fit (pool adjacent violators).
+
+    Args:
+        values: Values in order of their abscissa, shape (K,).
+        weights: Positive weights, shape (K,).
+
+    Returns:
+        The fitted non-decreasing values, shape (K,).
+    """
+    blocks: list[list[float]] = []  # [weighted mean, weight, count]
+    for value, weight in zip(values.tolist(), weights.tolist(), strict=True):
+        blocks.append([value, weight, 1])
+        while len(blocks) > 1 and blocks[-2][0] > blocks[-1][0]:
+            mean_b, weight_b, count_b = blocks.pop()
+            mean_a, weight_a, count_a = blocks.pop()
+            total = weight_a + weight_b
+            blocks.append([(mean_a * weight_a + mean_b * weight_b) / total, total, count_a + count_b])
+    return np.concatenate([np.full(count, mean) for mean, _, count in blocks])

@@ -14,9 +14,9 @@ from lerobot_mtdagger.analysis.headroom import (
     fit_curves,
     headroom_at,
     held_out_headroom,
-    isotonic,
     points_from_rows,
 )
+from lerobot_mtdagger.learning_curve import isotonic
 from lerobot_mtdagger.utils.errors import UserError
 
 PAPER_REGIME = Path(__file__).parents[1] / "experiments" / "paper-regime-eval" / "records"

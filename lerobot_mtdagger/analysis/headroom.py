@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lerobot_mtdagger.analysis.stats import mean_interval
+from lerobot_mtdagger.learning_curve import isotonic
 from lerobot_mtdagger.utils.errors import UserError
 
 
@@ -50,27 +51,6 @@ class TaskPoint:
     demos: int
     success: float
     episodes: int
-
-
-def isotonic(values: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """Weighted least-squares non-decreasing fit (pool adjacent violators).
-
-    Args:
-        values: Values in order of their abscissa, shape (K,).
-        weights: Positive weights, shape (K,).
-
-    Returns:
-        The fitted non-decreasing values, shape (K,).
-    """
-    blocks: list[list[float]] = []  # [weighted mean, weight, count]
-    for value, weight in zip(values.tolist(), weights.tolist(), strict=True):
-        blocks.append([value, weight, 1])
-        while len(blocks) > 1 and blocks[-2][0] > blocks[-1][0]:
-            mean_b, weight_b, count_b = blocks.pop()
-            mean_a, weight_a, count_a = blocks.pop()
-            total = weight_a + weight_b
-            blocks.append([(mean_a * weight_a + mean_b * weight_b) / total, total, count_a + count_b])
-    return np.concatenate([np.full(count, mean) for mean, _, count in blocks])
 
 
 @dataclass(frozen=True)

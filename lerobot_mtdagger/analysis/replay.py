@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lerobot_mtdagger.analysis.headroom import LearningCurves, best_splits
+from lerobot_mtdagger.analysis.stats import Interval, mean_interval
 from lerobot_mtdagger.learning_curve import greedy_split
 from lerobot_mtdagger.scheduler import GAIN, make_scheduler, scheduler_config_class, scheduling_methods
 from lerobot_mtdagger.utils.errors import UserError
@@ -346,7 +347,7 @@ class ArmSummary:
     Attributes:
         label: The arm.
         mean_success: Mean success over the budgets, mean over replicates.
-        vs_uniform: ``(mean, low, high)`` of the arm - uniform (95%, over replicates).
+        vs_uniform: ``(mean, low, high)`` of the arm - uniform (95% t interval over replicates).
         share: ``(mean, low, high)`` share of the online oracle's headroom (bootstrap 95%).
         replicate_sd: Standard deviation over replicates of arm - uniform, evaluation noise included
             (a study's seeds add training noise on top).
@@ -388,7 +389,7 @@ def summarise(
             ArmSummary(
                 outcome.label,
                 float(values.mean()),
-                _normal_interval(difference),
+                _interval(mean_interval(difference)),
                 _share_of_headroom(values, uniform, oracle, resample),
                 float(np.sqrt(difference.var(ddof=1) + noise**2)) if setting.replicates > 1 else float("nan"),
                 {level: _demos_to_reach(budgets, path, level) for level in levels},
@@ -396,6 +397,10 @@ def summarise(
             )
         )
     return summaries
+
+
+def _interval(interval: Interval) -> tuple[float, float, float]:
+    return interval.mean, interval.low, interval.high
 
 
 def _share_of_headroom(
@@ -410,12 +415,6 @@ def _share_of_headroom(
     )
     low, high = np.percentile(shares, [2.5, 97.5]).tolist()
     return float((values.mean() - uniform.mean()) / headroom), low, high
-
-
-def _normal_interval(values: np.ndarray) -> tuple[float, float, float]:
-    mean = float(values.mean())
-    half = 1.96 * float(values.std(ddof=1)) / np.sqrt(values.size) if values.size > 1 else float("nan")
-    return mean, mean - half, mean + half
 
 
 def _evaluation_noise_sd(outcome: ArmOutcome, uniform: ArmOutcome, curves, setting: ReplaySetting) -> float:
