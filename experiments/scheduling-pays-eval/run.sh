@@ -21,6 +21,13 @@
 #    paper 2.6 core-hours, pixels 7.0. Of the qualifying settings the one with the largest predicted
 #    effect is run; if none qualifies the study is not run, and that is its result ("not testable
 #    here" for the question "does the best scheduler beat uniform where scheduling has room to pay?").
+#    Expected effect, from the bench before this file was fixed (development curves, 300-500 replicates,
+#    docs/scheduler.md): paper regime with curves flat past 30, need_raw - uniform +0.015 (30% of the
+#    oracle's +0.048; 24 seeds needed at SD 0.017, 11 affordable); with seed 100 measured to 45, need
+#    +0.031 (42% of +0.074; 8 seeds needed, 11 affordable); MT10 pixels need_raw +0.009 (32% of +0.028;
+#    32 seeds needed at the bench's SD 0.0131, 4 affordable). So the study runs only if the full curves
+#    to 60 lift the best share to 50%; at 8 seeds a +0.031 effect has a half-width of about 0.014 and the
+#    primary can decide it, while a +0.015 effect could not be decided by any affordable count.
 # 2. Power: seeds = the count of rule 1 (5 upward); a cap that binds would label the study underpowered
 #    here before any run (rule 1 runs nothing then).
 # 3. Arms, trained alike (--training.lr_schedule=cosine, uniform frame sampling, the preset's steps
