@@ -72,6 +72,9 @@ if [ ! -s "$OUT/decision.txt" ]; then
   mv "$OUT/decision.tmp" "$OUT/decision.txt"
 fi
 cat "$OUT/decision.txt"
+# Added after the design was fixed (it reads the same replays and decides nothing): the bench's need -
+# uniform beside what the evaluation-seed studies of the same settings measured (the README's check).
+PYTHONPATH=${PYTHONPATH:-} "$PY" "$HERE/bench_check.py" "$OUT" > "$OUT/bench_check.md"
 setting=$(sed -n 's/^setting: //p' "$OUT/decision.txt")
 if [ "$setting" = "none" ]; then
   log "no setting qualifies by rule 1: the study is not run (decision.txt says why)"
