@@ -1,0 +1,191 @@
+"""Saving runs' records for a study: copied out of ``outputs/`` and compacted into byte-stable archives.
+
+A run's records are its small JSON files (``config.json``, each round's ``meta/info.json``, each
+phase's ``training.json``): its numbers without frames or weights. ``lerobot-mtdagger records``
+writes them; ``saved_records`` (beside this module) reads them back for ``report --records``.
+
+- ``save_runs(runs, dest)``: every run under ``runs`` into ``dest/<run>/``, each replaced whole.
+- ``compact(root)``: each folder of saved runs into one ``runs-records.tar.gz``, the same bytes for the
+  same files; the folders are removed only once the archive lists every file they held.
+- ``save_compares(outputs, dest)``: a study's compare folders, each into ``dest/<folder>/`` as an archive
+  beside its ``results.csv``, runs archived earlier and no longer in ``outputs/`` kept.
+"""
+
+from __future__ import annotations
+
+import gzip
+import io
+import logging
+import shutil
+import tarfile
+import tempfile
+from pathlib import Path
+
+from lerobot_mtdagger.analysis.saved_records import ARCHIVE_NAME
+from lerobot_mtdagger.datasets.experiment_files import CONFIG_FILE
+from lerobot_mtdagger.utils.errors import UserError
+
+logger = logging.getLogger(__name__)
+
+RESULTS_TABLE = "results.csv"
+"""A compare folder's table of its runs."""
+
+
+def run_record_files(run: Path) -> dict[str, Path]:
+    """A run's record files, by their path in the saved copy (``rounds/<round>/info.json``, ...)."""
+    files = {CONFIG_FILE: run / CONFIG_FILE}
+    for round_dir in sorted(run.glob("rounds/round-*")):
+        info = round_dir / "meta" / "info.json"
+        if info.is_file():
+            files[f"rounds/{round_dir.name}/info.json"] = info
+    for phase_dir in sorted(run.glob("policies/round-*")):
+        training = phase_dir / "training.json"
+        if training.is_file():
+            files[f"policies/{phase_dir.name}/training.json"] = training
+    return files
+
+
+def save_runs(runs: Path, dest: Path) -> list[str]:
+    """Copies the records of every run under ``runs`` into ``dest/<run>/``.
+
+    A run's saved folder is replaced whole (a run restarted from nothing leaves none of its earlier
+    records); runs not under ``runs`` keep theirs. An unfinished run gives what it has.
+
+    Returns:
+        The names of the runs saved.
+
+    Raises:
+        UserError: If ``runs`` is not a folder of runs.
+    """
+    if not runs.is_dir():
+        raise UserError(f"records: {runs} is not a folder: give a folder of run folders (a compare's runs/).")
+    names = []
+    for run in sorted(p for p in runs.iterdir() if (p / CONFIG_FILE).is_file()):
+        target = dest / run.name
+        shutil.rmtree(target, ignore_errors=True)
+        for name, source in run_record_files(run).items():
+            (target / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(source, target / name)
+        names.append(run.name)
+    logger.info("Saved the records of %d runs from %s into %s", len(names), runs, dest)
+    return names
+
+
+def stable_archive(folder: Path, members: list[str]) -> bytes:
+    """A gzipped tar of ``members`` (paths under ``folder``): sorted, no times, owners or names.
+
+    The same files give the same bytes on every machine and day.
+    """
+    paths = sorted({m for member in members for m in _with_contents(folder, member)})
+    buffer = io.BytesIO()
+    with tarfile.open(fileobj=buffer, mode="w", format=tarfile.GNU_FORMAT) as tar:
+        for name in paths:
+            path = folder / name
+            info = tar.gettarinfo(str(path), arcname=name)
+            info.mtime, info.uid, info.gid, info.uname, info.gname = 0, 0, 0, "", ""
+            info.mode = 0o644 if path.is_file() else 0o755
+            if path.is_file():
+                with path.open("rb") as handle:
+                    tar.addfile(info, handle)
+            else:
+                tar.addfile(info)
+    packed = io.BytesIO()
+    with gzip.GzipFile(filename="", mode="wb", fileobj=packed, mtime=0) as archive:
+        archive.write(buffer.getvalue())
+    return packed.getvalue()
+
+
+def _with_contents(folder: Path, member: str) -> list[str]:
+    """``member`` and, for a folder, everything under it (relative to ``folder``)."""
+    path = folder / member
+    below = sorted(p.relative_to(folder).as_posix() for p in path.rglob("*")) if path.is_dir() else []
+    return [member, *below]
+
+
+def compact_folder(folder: Path) -> Path:
+    """Packs every subfolder of ``folder`` into ``folder/runs-records.tar.gz`` and removes them.
+
+    Raises:
+        UserError: If the archive exists already (nothing is overwritten), or if it does not list every
+            file of the subfolders (nothing is removed).
+    """
+    archive = folder / ARCHIVE_NAME
+    if archive.exists():
+        raise UserError(f"records: {archive} exists: not overwritten (move it away to compact again).")
+    subfolders = sorted(p.name for p in folder.iterdir() if p.is_dir())
+    staged = archive.with_name(ARCHIVE_NAME + ".tmp")
+    staged.write_bytes(stable_archive(folder, subfolders))
+    want = sorted(
+        p.relative_to(folder).as_posix() for s in subfolders for p in (folder / s).rglob("*") if p.is_file()
+    )
+    with tarfile.open(staged) as tar:
+        have = sorted(m.name for m in tar.getmembers() if m.isfile())
+    if want != have:
+        raise UserError(f"records: {staged} does not list every file of {folder}: nothing removed.")
+    staged.replace(archive)
+    for name in subfolders:
+        shutil.rmtree(folder / name)
+    logger.info("%s: %d files", archive, len(want))
+    return archive
+
+
+def _holds_runs(folder: Path) -> bool:
+    """Whether ``folder`` has a subfolder with a run's ``config.json``."""
+    return any((p / CONFIG_FILE).is_file() for p in folder.iterdir() if p.is_dir())
+
+
+def compact(root: Path) -> list[Path]:
+    """Compacts a study's records: ``root`` itself if it holds runs, else each subfolder that does.
+
+    Returns:
+        The archives written (none when nothing holds runs' records).
+    """
+    if not root.is_dir():
+        raise UserError(f"records: {root} is not a folder: give a study's records folder.")
+    if _holds_runs(root):
+        return [compact_folder(root)]
+    return [compact_folder(sub) for sub in sorted(root.iterdir()) if sub.is_dir() and _holds_runs(sub)]
+
+
+def save_compares(outputs: Path, dest: Path) -> list[str]:
+    """Saves each compare folder under ``outputs`` into ``dest/<folder>/``: its archive and table.
+
+    Runs an earlier save archived that ``outputs`` no longer holds stay in the archive; a run
+    ``outputs`` holds replaces its archived records whole. When the archive then holds runs the
+    compare folder did not run, its ``results.csv`` would not show them: it is not saved (an earlier
+    one is removed), and ``report --records=<dest/folder>`` makes the table of every archived run.
+
+    Returns:
+        One line per compare folder saved, saying what was kept.
+    """
+    if not outputs.is_dir():
+        raise UserError(f"records: {outputs} is not a folder: give a study's outputs folder (outputs/STUDY).")
+    lines = []
+    for compare in sorted(p for p in outputs.iterdir() if (p / "runs").is_dir()):
+        lines.append(_save_compare(compare, dest / compare.name))
+    return lines
+
+
+def _save_compare(compare: Path, dest: Path) -> str:
+    """Saves one compare folder (see :func:`save_compares`) and says what it kept."""
+    archive = dest / ARCHIVE_NAME
+    with tempfile.TemporaryDirectory(prefix="mtdagger-save-") as stage_name:
+        stage = Path(stage_name)
+        if archive.is_file():
+            with tarfile.open(archive) as tar:
+                tar.extractall(stage, filter="data")
+        save_runs(compare / "runs", stage)
+        runs = sorted(p.name for p in stage.iterdir() if (p / CONFIG_FILE).is_file())
+        kept = [name for name in runs if not (compare / "runs" / name / CONFIG_FILE).is_file()]
+        dest.mkdir(parents=True, exist_ok=True)
+        archive.write_bytes(stable_archive(stage, runs))
+    table = dest / RESULTS_TABLE
+    if kept:
+        table.unlink(missing_ok=True)
+        return (
+            f"{dest}: kept the archived runs {' '.join(kept)} (not in {compare}); {RESULTS_TABLE} not saved: "
+            f"lerobot-mtdagger report --records={dest} makes the table of every run"
+        )
+    if (compare / RESULTS_TABLE).is_file():
+        shutil.copyfile(compare / RESULTS_TABLE, table)
+    return f"{dest}: {len(runs)} runs"
