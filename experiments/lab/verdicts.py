@@ -244,7 +244,12 @@ CELLS: tuple[Cell, ...] = (
         (Evidence(0.033, -0.035, 0.102),),
         part="vs BC",
     ),
-    Cell(1, "room", "best scheduler - uniform; decided by the study's setting rule (its README)"),
+    Cell(
+        1,
+        "room",
+        "no setting two cores can run leaves a scheduler half of its headroom: by its pre-specified rule "
+        "the study ran nothing (best share 41%, paper regime; 32%, MT10 pixels)",
+    ),
     # Claim 2: the report's hardest-task rows, or the study's own fixed subset.
     Cell(
         2,
