@@ -828,13 +828,19 @@ def _append_data_file(
 
 
 def merge_rounds(
-    experiment: ExperimentDir, rounds: Sequence[int], output: Path, repo_id: str = "local/merged"
+    experiment: ExperimentDir,
+    rounds: Sequence[int],
+    output: Path,
+    repo_id: str = "local/merged",
+    unverified: Sequence[str] = (),
 ) -> Path:
     """Merges round datasets into ONE LeRobotDataset with LeRobot's own aggregation.
 
     Task indices are preserved: every round holds the full vocabulary in the same order. The merged
     dataset gets a ``mtdagger`` record listing the merged rounds' records (``meta/mtdagger.json``,
-    mirrored in meta/info.json).
+    mirrored in meta/info.json). ``unverified``: the verification problems the caller chose to read past
+    (``merge --unverified=true``), listed in that record under ``unverified``; without them a round whose
+    files changed after commit is refused.
 
     The merge is written beside ``output`` and renamed onto it when complete, so a merge that stops
     half-way leaves no ``output`` (and a re-run starts clean).
@@ -849,7 +855,7 @@ def merge_rounds(
         raise UserError(f"Merge target {output} exists; choose another --output or delete it.")
     records = [experiment.read_round_record(k) for k in rounds]
     problems = [problem for record in records for problem in experiment.round_file_problems(record)]
-    if problems:
+    if problems and not unverified:
         raise CorruptExperimentError(f"Cannot merge: {'; '.join(problems)}. Restore the files first.")
     staging = output.parent / f".{output.name}.merging"
     if staging.exists():
@@ -867,6 +873,8 @@ def merge_rounds(
         "merged_rounds": list(rounds),
         "rounds": [record.to_dict() for record in records],
     }
+    if unverified:
+        merged["unverified"] = list(unverified)
     write_record_files(staging, merged)
     os.replace(staging, output)
     return output
