@@ -282,3 +282,16 @@ def test_an_experiment_made_before_ledgers_is_told_apart_and_read(tmp_path, caps
     assert main(["report", f"--experiments=[{old}]"]) == 0
     assert main(["eval", f"--policy_path={old / 'policies' / 'round-001'}", *EVAL]) == 0
     assert not (old / LEDGER_FILE).exists()  # reading starts no ledger
+
+
+# -------------------------------------------------------------------------------------------------
+# Resume of a finished run
+# -------------------------------------------------------------------------------------------------
+
+
+def test_resuming_a_finished_run_leaves_its_folder_byte_identical(run, capsys):
+    before = folder_bytes(run)
+    capsys.readouterr()
+    assert main(["run", *TOY, f"--output_dir={run}", "--resume=true"]) == 0
+    assert capsys.readouterr().out.count("round ") >= 2  # it still prints the summary lines
+    assert folder_bytes(run) == before

@@ -280,12 +280,13 @@ class ExperimentDir:
                 shutil.rmtree(building)
 
     @contextlib.contextmanager
-    def writer_lock(self) -> Iterator[None]:
+    def writer_lock(self, record_pid: bool = True) -> Iterator[None]:
         """Holds the folder's writer lock: one run writes into an experiment at a time.
 
         The lock is an OS lock (``flock``) on ``<root>/.lock``, released when the process exits,
         however it exits (a run killed with SIGKILL leaves no stale lock). The file holds the pid
-        of the writer, for the message a second writer gets.
+        of the writer, for the message a second writer gets; a resume of a finished run, which
+        writes nothing, leaves it as it is (``record_pid=False``).
 
         Raises:
             ExperimentLockedError: At once, if another process holds the lock, naming it.
@@ -301,8 +302,9 @@ class ExperimentDir:
                     f"{self.root} is being written by another run (pid {holder}); wait for it to finish "
                     f"or stop it, then pass --resume=true."
                 ) from None
-            os.ftruncate(descriptor, 0)
-            os.pwrite(descriptor, str(os.getpid()).encode(), 0)
+            if record_pid:
+                os.ftruncate(descriptor, 0)
+                os.pwrite(descriptor, str(os.getpid()).encode(), 0)
             yield
         finally:
             os.close(descriptor)  # closing releases the lock

@@ -103,7 +103,7 @@ class RunContext:
     @property
     def last_round(self) -> int:
         """Index of the last round of the experiment."""
-        return 0 if self.config.is_bc else self.config.dagger.rounds
+        return last_round(self.config)
 
 
 # -------------------------------------------------------------------------------------------------
@@ -348,10 +348,10 @@ def evaluate_phase(ctx: RunContext, runner: PolicyRunner, workers: EnvWorkers) -
 # -------------------------------------------------------------------------------------------------
 
 
-def summary_line(ctx: RunContext, round_index: int) -> str:
+def summary_line(experiment: ExperimentDir, round_index: int) -> str:
     """One line per round: demos so far, average success, allocation, time spent."""
-    record = ctx.experiment.read_round_record(round_index)
-    phase = ctx.experiment.read_phase_record(round_index)
+    record = experiment.read_round_record(round_index)
+    phase = experiment.read_phase_record(round_index)
     success = "n/a" if phase.eval_mean is None else f"{phase.eval_mean:.3f}"
     if phase.heldout_eval is not None:
         success += f" | unseen {phase.heldout_eval['mean']:.3f}"
@@ -400,7 +400,8 @@ def run(
     if not config.resume:
         extra = {EXPERT_CHECK_FILE: check.to_dict()} if check is not None else None
         experiment.initialise(config.to_dict(), extra)
-    with experiment.writer_lock():
+    finished = config.resume and is_finished(experiment, last_round(config))
+    with experiment.writer_lock(record_pid=not finished):  # a finished run's folder is left as it is
         if config.resume:
             experiment.check_committed_files()  # refuses foreign, corrupt or changed rounds and policies
             experiment.update_ledger()  # a record committed just before a cut-off, and older experiments
@@ -408,7 +409,32 @@ def run(
             experiment.extend_rounds(config.dagger.rounds)  # a DAgger run resumed with more rounds
         if on_start is not None:
             on_start()
+        if finished:
+            return _finished_summary(experiment, last_round(config), on_summary)
         return _run_locked(config, suite, experiment, on_summary)
+
+
+def last_round(config: RunConfig) -> int:
+    """Index of the last round of a run (0 for BC, whose one round holds every demo)."""
+    return 0 if config.is_bc else config.dagger.rounds
+
+
+def is_finished(experiment: ExperimentDir, last: int) -> bool:
+    """Whether every round and phase up to ``last`` is committed (a resume then has nothing to do)."""
+    wanted = set(range(last + 1))
+    return wanted <= set(experiment.committed_rounds()) and wanted <= set(experiment.committed_phases())
+
+
+def _finished_summary(
+    experiment: ExperimentDir, last: int, on_summary: Callable[[str], None] | None
+) -> list[str]:
+    """The summary lines of a finished run, read from its records; nothing is written to its folder."""
+    lines = [summary_line(experiment, round_index) for round_index in range(last + 1)]
+    for line in lines:
+        logger.info(line)
+        if on_summary is not None:
+            on_summary(line)
+    return lines
 
 
 def _run_locked(
@@ -430,7 +456,7 @@ def _run_locked(
                     collect_round(ctx, round_index)
                 if round_index not in phases_done:
                     train_round(ctx, round_index)
-                lines.append(summary_line(ctx, round_index))
+                lines.append(summary_line(experiment, round_index))
                 logger.info(lines[-1])
                 if on_summary is not None:
                     on_summary(lines[-1])
