@@ -59,7 +59,7 @@ from lerobot_mtdagger.datasets.experiment_files import (
 )
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.datasets.ledger import LEDGER_FILE, Ledger
-from lerobot_mtdagger.datasets.migrations import migrate_run_config, resume_hint
+from lerobot_mtdagger.datasets.migrations import migrate_run_config, pre_ledger_note, resume_hint
 from lerobot_mtdagger.datasets.records import (
     FORMAT_VERSION,
     RECORD_KEY,
@@ -684,10 +684,7 @@ class ExperimentDir:
         records = self.committed_record_files()
         if not records or Ledger(self.root).exists() or any(committed_into_ledger(p) for p in records):
             return None
-        return (
-            f"{self.root} was made before experiments had a ledger ({LEDGER_FILE}): its records are checked "
-            "against their files only; a resume starts its ledger"
-        )
+        return pre_ledger_note(self.root, LEDGER_FILE)
 
     def read_phase_record(self, round_index: int) -> PhaseRecord:
         """The training record of a committed phase.
