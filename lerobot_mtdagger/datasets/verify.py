@@ -205,13 +205,15 @@ def _load_problems(folder: Path) -> list[str]:
 
 
 def verify_experiment(
-    experiment: ExperimentDir, added_defaults: Mapping[str, Any] | None = None, load_policies: bool = True
+    experiment: ExperimentDir, added_defaults: Mapping[str, Any] | None = None, reading: bool = False
 ) -> tuple[int, int, list[str]]:
     """Verifies every committed round and policy of an experiment.
 
     ``added_defaults`` (``RunConfig.option_defaults``) gives options the run's config predates their
     default, so that its rounds' records are compared with it as a resume compares a config. Readers
-    (``check_before_reading``) pass ``load_policies=False``: every check but loading each policy.
+    (``check_before_reading``) pass ``reading=True``: every check but loading each policy, and the ledger
+    as a resume takes it (the last rounds deleted to be redone, a record committed by a run cut off, or
+    still running, just before it reached the ledger).
 
     Returns:
         The numbers of rounds and of policies verified, and every problem found.
@@ -225,7 +227,7 @@ def verify_experiment(
     except UserError as error:
         return 0, 0, [str(error)]
     phases = experiment.committed_phases()
-    problems = [problem for k in phases for problem in verify_policy(experiment, k, load_policies)]
+    problems = [problem for k in phases for problem in verify_policy(experiment, k, load=not reading)]
     readable_phases = {k for k in phases if _readable_phase(experiment, k)}
     previous = None
     for round_index in rounds:
@@ -234,7 +236,7 @@ def verify_experiment(
         previous = record
     if previous is not None:
         problems += kept_task_mismatches(experiment, previous)
-    problems += experiment.ledger_problems()
+    problems += experiment.ledger_problems(resuming=reading)
     return len(rounds), len(phases), problems
 
 
@@ -290,7 +292,7 @@ def check_before_reading(
         NotAnExperimentError: If the folder holds no experiment.
         CorruptExperimentError: In one line naming the first problems, ``verify`` and the fix.
     """
-    _, _, problems = verify_experiment(experiment, added_defaults, load_policies=False)
+    _, _, problems = verify_experiment(experiment, added_defaults, reading=True)
     note = experiment.ledger_note()
     if note is not None:
         logger.info(note)
