@@ -14,7 +14,8 @@ By default it leaves out what never changes a result: the options a resume may c
 (``RESULT_NEUTRAL_OPTIONS``: ``resume``, ``progress``, ``output_dir``, worker counts and backend,
 ``preset``, ``policy.device``) and, in ``training.json``, ``timings`` and ``environment`` (where it
 ran). ``--strict`` compares those too; ``--ignore-config KEY ...`` leaves out more options (dotted
-paths, e.g. ones renamed on purpose).
+paths, e.g. ones renamed on purpose). A record's ``ledger`` flag (whether it was committed into a
+ledger) is never compared.
 """
 
 from __future__ import annotations
@@ -33,6 +34,9 @@ from lerobot_mtdagger.datasets.migrations import migrate_run_config
 
 PROVENANCE_FIELDS = {"timings", "environment"}
 """``training.json`` fields that say how and where a phase ran, not what it gave."""
+
+STORAGE_FIELDS = {"ledger"}
+"""Record fields that say how a record is stored (committed into a ledger), never compared."""
 
 
 def round_record(root: Path) -> dict:
@@ -58,7 +62,7 @@ def compare_dicts(old: dict, new: dict, where: str, skip: set[str]) -> list[str]
 def compare_round(old: Path, new: Path, ignore_config: set[str]) -> list[str]:
     """Differences of one round's record and data."""
     records = [round_record(p) for p in (old, new)]
-    problems = compare_dicts(records[0], records[1], old.name, {"config"})
+    problems = compare_dicts(records[0], records[1], old.name, {"config", *STORAGE_FIELDS})
     # Configs compared option by option, in today's layout (a flat stored config is migrated).
     configs = [flatten(migrate_run_config(r["config"])) for r in records]
     problems += compare_dicts(configs[0], configs[1], f"{old.name}.config", ignore_config)
@@ -97,7 +101,7 @@ def main() -> int:
     )
     args = parser.parse_args()
     ignore = set(args.ignore_config) | (set() if args.strict else {*RESULT_NEUTRAL_OPTIONS})
-    phase_skip = {"timings"} if args.strict else PROVENANCE_FIELDS
+    phase_skip = ({"timings"} if args.strict else PROVENANCE_FIELDS) | STORAGE_FIELDS
     problems = []
     rounds = [sorted(p.name for p in (root / "rounds").glob("round-*")) for root in (args.old, args.new)]
     phases = [sorted(p.name for p in (root / "policies").glob("round-*")) for root in (args.old, args.new)]

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from types import SimpleNamespace
 
+import pyarrow.parquet as pq
 import pytest
 import requests
 from huggingface_hub.errors import LocalTokenNotFoundError
@@ -203,10 +204,11 @@ def test_stale_files_of_an_earlier_round_vanish_but_user_files_stay(experiment_d
     copy = tmp_path / "experiment"
     shutil.copytree(experiment_dir, copy)
     stale = ["data/chunk-001/file-000.parquet", "meta/episodes/chunk-001/file-000.parquet"]
-    for name in stale:  # round 0 (of this copy) has files that round 1 does not have
+    for name in stale:  # round 0 (of this copy) has files that round 1 does not have (no frames)
         path = ExperimentDir(copy).round_root(0) / name
         path.parent.mkdir(parents=True)
-        shutil.copy(ExperimentDir(copy).round_root(0) / "data/chunk-000/file-000.parquet", path)
+        frames = pq.read_table(ExperimentDir(copy).round_root(0) / "data/chunk-000/file-000.parquet")
+        pq.write_table(frames.slice(0, 0), path)
     files = folder_digests(ExperimentDir(copy).round_root(0), exclude=RECORD_FILES)
     edit_round_record(ExperimentDir(copy).round_root(0), lambda record: record.update(files=files))
     fake_api.create_repo(DATASET_REPO, repo_type="dataset")

@@ -116,9 +116,9 @@ def test_eval_refuses_a_changed_policy_of_an_experiment_unless_told(run, capsys,
     capsys.readouterr()
     assert main(args) == 2
     error = capsys.readouterr().err
-    assert "changed after it was committed" in error and "--allow_changed_policy=true" in error
-    assert main([*args, "--allow_changed_policy=true"]) == 0
-    assert "warning: evaluating" in capsys.readouterr().out
+    assert "policies/round-001/training.json changed after commit" in error and "--unverified=true" in error
+    assert main([*args, "--allow_changed_policy=true"]) == 0  # the former spelling of --unverified
+    assert "Reading unverified records" in capsys.readouterr().err
 
 
 def test_the_last_rounds_deleted_to_be_redone_leave_the_ledger_on_resume(run, capsys):

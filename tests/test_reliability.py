@@ -183,6 +183,14 @@ def remove_record_files(root: Path) -> None:
     for sidecar in (root / "rounds").glob("round-*/meta/mtdagger.json"):
         sidecar.unlink()
     (root / "ledger.json").unlink()
+    for info in (root / "rounds").glob("round-*/meta/info.json"):  # records of then carry no ledger flag
+        values = json.loads(info.read_text())
+        values["mtdagger"].pop("ledger")
+        info.write_text(json.dumps(values))
+    for training in (root / "policies").glob("round-*/training.json"):
+        values = json.loads(training.read_text())
+        values.pop("ledger")
+        training.write_text(json.dumps(values))
 
 
 def test_rounds_written_before_the_record_file_existed_still_read_and_verify(finished, tmp_path):
@@ -396,6 +404,7 @@ def bad_inputs(finished: Path, tmp_path: Path) -> dict[str, tuple[list[str], str
     policy = ExperimentDir(finished).policy_root(1)
     truncated = tmp_path / "truncated-policy"
     shutil.copytree(policy, truncated)
+    (truncated / "training.json").unlink()  # no checksums: LeRobot's loader meets the truncated file
     truncate(truncated / "model.safetensors")
     return {
         "eval of a missing path": (["eval", f"--policy_path={tmp_path / 'nowhere'}"], "does not exist"),

@@ -21,7 +21,7 @@ from __future__ import annotations
 import csv
 import json
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -175,6 +175,7 @@ def write_results(
     task_names: Sequence[str],
     configs: Mapping[str, dict],
     unfinished: Sequence[str] = (),
+    verification: Sequence[str] = (),
 ) -> tuple[Path, Path]:
     """Writes ``results.csv``, ``results.json`` and ``results_meta.json`` into ``folder``.
 
@@ -184,6 +185,8 @@ def write_results(
         task_names: The suite's task names in task-index order (the per-task columns' order).
         configs: The config each method's runs share (``check_comparable``).
         unfinished: One line per unfinished run of a study in progress (``RunProgress.describe``).
+        verification: One line per run left out for failing verification, or read from unverified
+            records (``report --unverified=true``); saved only when there is one.
 
     Returns:
         The paths of ``results.csv`` and ``results.json``.
@@ -197,6 +200,8 @@ def write_results(
     json_path, csv_path = folder / RESULTS_FILE, folder / "results.csv"
     json_path.write_text(json.dumps(list(rows), indent=1))
     meta = {"task_names": list(task_names), "unfinished": list(unfinished), "configs": dict(configs)}
+    if verification:
+        meta["verification"] = list(verification)
     (folder / META_FILE).write_text(json.dumps(meta, indent=1))
     with csv_path.open("w", newline="") as handle:
         # Tables joined from several reports may mix rows written before a column existed.
@@ -217,6 +222,7 @@ class SavedTable:
         unfinished: One line per run that was unfinished when the table was written.
         configs: The config each method's runs share; None for a table written before they were saved.
         source: Where it was read from (for messages).
+        verification: One line per run left out for failing verification or read unverified.
     """
 
     rows: list[dict[str, Any]]
@@ -224,6 +230,7 @@ class SavedTable:
     unfinished: list[str]
     configs: dict[str, dict] | None
     source: str
+    verification: list[str] = field(default_factory=list)
 
 
 def read_results(path: Path) -> SavedTable:
@@ -269,6 +276,7 @@ def read_results(path: Path) -> SavedTable:
         unfinished=[str(line) for line in meta.get("unfinished", [])],
         configs=meta.get("configs"),
         source=str(json_path),
+        verification=[str(line) for line in meta.get("verification", [])],
     )
 
 
@@ -312,6 +320,7 @@ def merge_tables(tables: Sequence[SavedTable]) -> SavedTable:
         unfinished=[line for table in tables for line in table.unfinished],
         configs=configs,
         source=" + ".join(table.source for table in tables),
+        verification=[line for table in tables for line in table.verification],
     )
 
 

@@ -261,9 +261,22 @@ def interim_lines(unfinished: Sequence[str]) -> list[str]:
     return lines + [f"- {line}" for line in unfinished] + [""]
 
 
+def verification_lines(verification: Sequence[str]) -> list[str]:
+    """The runs a report left out for failing verification or read from unverified records (none: [])."""
+    if not verification:
+        return []
+    lines = [
+        f"**Records not verified: {len(verification)} run(s)** left out for failing verification, or read "
+        "from unverified records (`--unverified=true`):",
+        "",
+    ]
+    return lines + [f"- {line}" for line in verification] + [""]
+
+
 def summary_markdown(rows: Sequence[Row], figures: dict[str, Path], notes: dict[str, Any], levels) -> str:
     """The report: figures embedded, paired differences and demo ratios per pair of methods."""
     lines = ["# Method comparison", "", caption(rows) + ".", "", *interim_lines(notes.get("unfinished", ()))]
+    lines += verification_lines(notes.get("verification", ()))
     for title, path in figures.items():
         lines += [f"## {title}", "", f"![{title}]({path.name})", ""]
     lines += [f"Pearson r, metric vs final success: {notes['correlations']}.", ""]
@@ -298,6 +311,7 @@ def write_report(
     folder: Path,
     levels=LEVELS,
     unfinished: Sequence[str] = (),
+    verification: Sequence[str] = (),
 ) -> Path:
     """Writes every figure and ``report.md`` into ``folder``; returns the markdown path.
 
@@ -308,6 +322,8 @@ def write_report(
         levels: Success levels of the reach tables and figures.
         unfinished: One line per unfinished run (``RunProgress.describe``); the report then says it
             is interim and lists them.
+        verification: One line per run left out for failing verification or read from unverified
+            records; the report lists them.
 
     Raises:
         ValueError: If there is no row.
@@ -371,6 +387,7 @@ def write_report(
         "hardest": [task_names[t] for t in hardest],
         "hardest_indices": list(hardest),
         "unfinished": list(unfinished),
+        "verification": list(verification),
     }
     path = folder / "report.md"
     path.write_text(summary_markdown(rows, figures, notes, levels))

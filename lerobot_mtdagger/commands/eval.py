@@ -76,12 +76,15 @@ class EvalConfig(WorkerOptions, EvalTarget):
             what a run's unseen-drawer evaluation does), ``nearest`` with the task input of the
             training task most like it (the drawers: the same handle type, the nearest handle size
             and height; ``docs/drawers.md``).
-        allow_changed_policy: Evaluate a policy folder of an experiment even if its files differ from
-            the checksums committed with it (said in the output); by default such a folder is refused.
+        unverified: Evaluate a policy whose files differ from the checksums its ``training.json``
+            carries, or a policy of an experiment that fails verification, as it is (with a warning; the
+            output lists the problems under ``unverified``); by default it is refused before loading.
+        allow_changed_policy: The former spelling of ``unverified``.
     """
 
     trust_checkpoint: bool = False
     unseen_rule: str = "shared"
+    unverified: bool = False
     allow_changed_policy: bool = False
 
     def __post_init__(self) -> None:
@@ -99,43 +102,37 @@ class EvalConfig(WorkerOptions, EvalTarget):
         self.suite.check()
 
 
-def check_committed_policy(folder: Path, allow_changed: bool) -> None:
-    """Refuses a policy folder of an experiment whose files changed after commit (unless allowed).
+def check_policy(config: EvalConfig) -> list[str]:
+    """Checks the policy folder before it is loaded (``datasets.verify.check_policy_folder``).
 
-    A folder ``<experiment>/policies/round-XXX`` is checked against the checksums in its
-    ``training.json`` and the experiment's ledger; any other folder (or a Hub id) is not.
+    A folder is checked against the checksums its ``training.json`` carries wherever it lives, and with
+    its experiment when it is one's; a Hub id is loaded by LeRobot unchecked (said at info level).
+
+    Returns:
+        The problems read past with ``--unverified=true`` (else empty).
 
     Raises:
-        UserError: Naming the changed files and ``--allow_changed_policy=true``.
+        CorruptExperimentError: In one line naming what changed and the fix.
     """
-    from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE, TRAINING_FILE, ExperimentDir
+    from lerobot_mtdagger.datasets.verify import check_policy_folder
+    from lerobot_mtdagger.runner.configs import RunConfig
 
-    experiment_root = folder.parent.parent
-    if folder.parent.name != "policies" or not (experiment_root / CONFIG_FILE).is_file():
-        return
-    if not (folder / TRAINING_FILE).is_file() or not folder.name.startswith("round-"):
-        return
-    experiment = ExperimentDir(experiment_root)
-    record = experiment.read_phase_record(int(folder.name.split("-")[1]))
-    record_path = str(folder / TRAINING_FILE)
-    problems = experiment.phase_file_problems(record)
-    problems += [p for p in experiment.ledger_problems(resuming=True) if record_path in p]
-    if not problems:
-        return
-    if not allow_changed:
-        raise UserError(
-            f"{folder} changed after it was committed ({'; '.join(problems)}): restore it, or pass "
-            "--allow_changed_policy=true to evaluate it as it is."
-        )
-    print(f"warning: evaluating {folder} although it changed after commit: {'; '.join(problems)}")
+    folder = Path(config.policy_path)
+    if not folder.is_dir():
+        logger.info("%s is not a local folder: its files are not checked against checksums", folder)
+        return []
+    unverified = config.unverified or config.allow_changed_policy
+    return check_policy_folder(folder, unverified, RunConfig.option_defaults())
 
 
 def suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
-    """The suite the config names and its pretrained policy, checked to take the suite's observations."""
+    """The suite the config names and its pretrained policy, checked to take the suite's observations.
+
+    The policy folder's files are checked first (``check_policy``) by the command.
+    """
     from lerobot_mtdagger.envs import suite_from_config
     from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
 
-    check_committed_policy(Path(config.policy_path), config.allow_changed_policy)
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
     suite_config = dataclasses.replace(config.suite, **observation_options(runner, config.suite))
     if list(suite_config.tasks) == [HELDOUT_TASKS]:
@@ -190,6 +187,7 @@ def eval_command(config: EvalConfig) -> dict:
     """Evaluates a pretrained policy per task with the pure policy acting."""
     from lerobot_mtdagger.runner.rollout.evaluate import evaluate
 
+    unverified = check_policy(config)
     suite, runner = suite_and_policy(config)
     with config.env_workers(suite) as workers:
         result, _ = evaluate(workers, runner, config.episodes, config.seed)
@@ -203,6 +201,8 @@ def eval_command(config: EvalConfig) -> dict:
     values = result.to_dict() | {"unseen_rule": config.unseen_rule}
     if runner.task_aliases:
         values["acted_as"] = dict(runner.task_aliases)
+    if unverified:
+        values["unverified"] = unverified
     if config.output is not None:
         config.output.write_text(json.dumps(values, indent=2))
     return values

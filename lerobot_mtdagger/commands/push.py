@@ -13,5 +13,6 @@ __all__ = ["PushConfig", "push_command"]
 def push_command(config: PushConfig) -> dict[str, dict[str, str]]:
     """Pushes an experiment's rounds (and policies) to the Hub (``datasets/hub.py``)."""
     from lerobot_mtdagger.datasets.hub import push_command as push
+    from lerobot_mtdagger.runner.configs import RunConfig
 
-    return push(config)
+    return push(config, RunConfig.option_defaults())

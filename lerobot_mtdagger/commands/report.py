@@ -8,6 +8,7 @@ a summary with paired differences.
 from __future__ import annotations
 
 import logging
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -42,6 +43,9 @@ class ReportConfig:
             study's ``runs-records.tar.gz`` (or a folder holding them: ``analysis.saved_records``), reported
             beside ``experiments`` and ``compare_dir`` as their runs are: a study whose ``outputs/`` was
             lost keeps its finished runs. Their frames per task are known only on average.
+        unverified: Report runs that fail verification (a changed record or file, a missing ledger) as
+            they are, with a warning, and say so in ``report.md``; by default each is left out, named
+            with the reason, and the report goes on with the rest.
     """
 
     experiments: list[Path] = field(default_factory=list)
@@ -52,6 +56,7 @@ class ReportConfig:
     levels: list[float] = field(default_factory=lambda: [0.5, 0.6, 0.7, 0.8])
     variants: dict[str, Path] = field(default_factory=dict)
     records: list[Path] = field(default_factory=list)
+    unverified: bool = False
 
     def __post_init__(self) -> None:
         if self.results:
@@ -157,7 +162,8 @@ def report_command(config: ReportConfig) -> str:
     from lerobot_mtdagger.analysis.curves import curves_table
     from lerobot_mtdagger.analysis.results import check_comparable, learning_curves, run_progress
 
-    all_roots, labels = config.experiment_dirs, config.labels  # each lists the run folders once
+    all_roots, verification = verified_runs(config.experiment_dirs, config.unverified)
+    labels = {run: name for run, name in config.labels.items() if run in all_roots}
     configs = check_comparable(all_roots, labels)
     progress = [run_progress(root) for root in all_roots]
     unfinished = [run.describe() for run in progress if not run.finished] + config.runs_not_started
@@ -184,9 +190,49 @@ def report_command(config: ReportConfig) -> str:
         for row in rows:
             row["experiment"] = shown_name(Path(row["experiment"]))
         task_names = open_run(roots[0]).read_round_record(0).task_names
-        write_results(rows, config.output_dir, task_names, configs, unfinished)
-        _write_figures(rows, task_names, config, unfinished)
+        write_results(rows, config.output_dir, task_names, configs, unfinished, verification)
+        _write_figures(rows, task_names, config, unfinished, verification)
     return table
+
+
+def verified_runs(roots: list[Path], unverified: bool) -> tuple[list[Path], list[str]]:
+    """The runs to report, each run folder checked as every reader checks it (``check_before_reading``).
+
+    A run that fails is left out with a warning naming it and why (or, with ``unverified``, reported
+    from its records as they are). Saved records hold no frames or weights and are read as they are.
+
+    Returns:
+        The runs to report, and one line per run left out or read unverified.
+
+    Raises:
+        UserError: If every run fails verification.
+    """
+    from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir, is_saved_records
+    from lerobot_mtdagger.datasets.verify import check_before_reading
+    from lerobot_mtdagger.runner.configs import RunConfig
+    from lerobot_mtdagger.utils.errors import CorruptExperimentError, NotAnExperimentError
+
+    defaults = RunConfig.option_defaults()
+    kept, lines = [], []
+    for root in roots:
+        if is_saved_records(root):
+            kept.append(root)
+            continue
+        try:
+            problems = check_before_reading(ExperimentDir(root), unverified, defaults)
+        except NotAnExperimentError:  # not started yet: its progress says so
+            problems = []
+        except CorruptExperimentError as error:
+            lines.append(f"{root}: left out, {error}")
+            continue
+        kept.append(root)
+        if problems:
+            lines.append(f"{root}: read from unverified records ({'; '.join(problems)})")
+    if not kept:
+        raise UserError(f"None of the {len(roots)} run(s) can be reported: {' | '.join(lines)}")
+    for line in lines:
+        logger.warning("Report: %s", line)
+    return kept, lines
 
 
 def _report_saved_tables(config: ReportConfig) -> str:
@@ -201,9 +247,16 @@ def _report_saved_tables(config: ReportConfig) -> str:
     saved = merge_tables([read_results(path) for path in config.results])
     if len(config.results) > 1:
         assert saved.configs is not None  # merge_tables refuses tables without them
-        write_results(saved.rows, config.output_dir, saved.task_names, saved.configs, saved.unfinished)
+        write_results(
+            saved.rows,
+            config.output_dir,
+            saved.task_names,
+            saved.configs,
+            saved.unfinished,
+            saved.verification,
+        )
     table = _print_table(curves_table(curves_from_rows(saved.rows)), config)
-    _write_figures(saved.rows, saved.task_names, config, saved.unfinished)
+    _write_figures(saved.rows, saved.task_names, config, saved.unfinished, saved.verification)
     return table
 
 
@@ -216,12 +269,18 @@ def _print_table(table: str, config: ReportConfig) -> str:
 
 
 def _write_figures(
-    rows: list[dict], task_names: list[str], config: ReportConfig, unfinished: list[str]
+    rows: list[dict],
+    task_names: list[str],
+    config: ReportConfig,
+    unfinished: list[str],
+    verification: Sequence[str] = (),
 ) -> None:
     """Writes every figure and ``report.md`` into ``--output_dir`` and prints where."""
     from lerobot_mtdagger.analysis.summary import write_report
 
-    path = write_report(rows, task_names, config.output_dir, levels=config.levels, unfinished=unfinished)
+    path = write_report(
+        rows, task_names, config.output_dir, config.levels, unfinished=unfinished, verification=verification
+    )
     _print_headroom(config.output_dir)
     print(f"figures and summary: {path}")
 

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lerobot_mtdagger.commands.eval import EvalConfig, suite_and_policy
+from lerobot_mtdagger.commands.eval import EvalConfig, check_policy, suite_and_policy
 
 if TYPE_CHECKING:
     from lerobot_mtdagger.analysis.shift import ShiftResult
@@ -33,13 +33,15 @@ def shift_command(config: ShiftConfig) -> dict:
     """Measures a pretrained policy's covariate shift per task and prints it."""
     from lerobot_mtdagger.analysis.shift import measure_shift
 
+    unverified = check_policy(config)
     suite, runner = suite_and_policy(config)
     with config.env_workers(suite) as workers:
         result = measure_shift(workers, runner, config.episodes, config.seed)
     print(shift_table(result))
+    values = result.to_dict() | ({"unverified": unverified} if unverified else {})
     if config.output is not None:
-        config.output.write_text(json.dumps(result.to_dict(), indent=2))
-    return result.to_dict()
+        config.output.write_text(json.dumps(values, indent=2))
+    return values
 
 
 def shift_table(result: ShiftResult) -> str:

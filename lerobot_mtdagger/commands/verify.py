@@ -30,6 +30,9 @@ def verify_command(config: VerifyConfig) -> list[str]:
 
     experiment = ExperimentDir(config.experiment_dir)
     num_rounds, num_policies, problems = verify_experiment(experiment, RunConfig.option_defaults())
+    note = experiment.ledger_note()
+    if note is not None:
+        print(f"NOTE {note}")
     for problem in problems:
         print(f"PROBLEM {problem}")
     print(

@@ -58,8 +58,8 @@ from lerobot_mtdagger.datasets.experiment_files import (
     TRAINING_FILE,
 )
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
-from lerobot_mtdagger.datasets.ledger import Ledger
-from lerobot_mtdagger.datasets.migrations import migrate_run_config, resume_hint
+from lerobot_mtdagger.datasets.ledger import LEDGER_FILE, Ledger
+from lerobot_mtdagger.datasets.migrations import migrate_run_config, pre_ledger_note, resume_hint
 from lerobot_mtdagger.datasets.records import (
     FORMAT_VERSION,
     RECORD_KEY,
@@ -217,6 +217,21 @@ def round_record_from(record: Any, path: Path, info_path: Path) -> RoundRecord:
     return RoundRecord.from_dict(record, where=f"The round record in {info_path}")
 
 
+def committed_into_ledger(path: Path) -> bool:
+    """Whether a record file says it was committed into the experiment's ledger (unreadable: False).
+
+    ``path`` is a round's ``meta/mtdagger.json`` (or ``meta/info.json``, whose ``mtdagger`` key holds the
+    record in older rounds) or a phase's ``training.json``.
+    """
+    try:
+        values = json.loads(Path(path).read_text())
+    except (OSError, json.JSONDecodeError):
+        return False  # named by the record's own checks
+    if isinstance(values, dict) and path.name == Path(INFO_FILE).name:
+        values = values.get(RECORD_KEY)
+    return isinstance(values, dict) and values.get("ledger") is True
+
+
 class ExperimentDir:
     """The on-disk state of one experiment (see the module docstring for the layout)."""
 
@@ -265,12 +280,13 @@ class ExperimentDir:
                 shutil.rmtree(building)
 
     @contextlib.contextmanager
-    def writer_lock(self) -> Iterator[None]:
+    def writer_lock(self, record_pid: bool = True) -> Iterator[None]:
         """Holds the folder's writer lock: one run writes into an experiment at a time.
 
         The lock is an OS lock (``flock``) on ``<root>/.lock``, released when the process exits,
         however it exits (a run killed with SIGKILL leaves no stale lock). The file holds the pid
-        of the writer, for the message a second writer gets.
+        of the writer, for the message a second writer gets; a resume of a finished run, which
+        writes nothing, leaves it as it is (``record_pid=False``).
 
         Raises:
             ExperimentLockedError: At once, if another process holds the lock, naming it.
@@ -286,8 +302,9 @@ class ExperimentDir:
                     f"{self.root} is being written by another run (pid {holder}); wait for it to finish "
                     f"or stop it, then pass --resume=true."
                 ) from None
-            os.ftruncate(descriptor, 0)
-            os.pwrite(descriptor, str(os.getpid()).encode(), 0)
+            if record_pid:
+                os.ftruncate(descriptor, 0)
+                os.pwrite(descriptor, str(os.getpid()).encode(), 0)
             yield
         finally:
             os.close(descriptor)  # closing releases the lock
@@ -546,7 +563,9 @@ class ExperimentDir:
         staging = Path(dataset.root)
         sort_stats_file(staging)
         files = folder_digests(staging, exclude=RECORD_FILES)
-        committed = dataclasses.replace(record, format_version=FORMAT_VERSION, committed=True, files=files)
+        committed = dataclasses.replace(
+            record, format_version=FORMAT_VERSION, committed=True, files=files, ledger=True
+        )
         write_record_files(staging, committed.to_dict())
         os.replace(staging, final)
         self.update_ledger()
@@ -583,7 +602,9 @@ class ExperimentDir:
     def commit_phase(self, round_index: int, staging: Path, record: PhaseRecord) -> Path:
         """Writes the training record (with the folder's checksums) into a staged phase and commits it."""
         files = folder_digests(staging, exclude=(TRAINING_FILE,))
-        write_json_atomic(staging / TRAINING_FILE, dataclasses.replace(record, files=files).to_dict())
+        write_json_atomic(
+            staging / TRAINING_FILE, dataclasses.replace(record, files=files, ledger=True).to_dict()
+        )
         final = self.policy_root(round_index)
         if final.exists():
             raise FileExistsError(f"Training phase {round_index} is already committed at {final}.")
@@ -633,8 +654,37 @@ class ExperimentDir:
             resuming: Accept what a resume mends: the last records deleted to be redone, and records
                 committed by a run cut off before it reached the ledger.
         """
-        problems = Ledger(self.root).problems(self.committed_record_files(), deleted_tail_ok=resuming)
+        records = self.committed_record_files()
+        ledger = Ledger(self.root)
+        if not ledger.exists():
+            return self._missing_ledger_problems(records, resuming)
+        problems = ledger.problems(records, deleted_tail_ok=resuming)
         return [p for p in problems if "is committed but not in" not in p] if resuming else problems
+
+    def _missing_ledger_problems(self, records: Sequence[Path], resuming: bool) -> list[str]:
+        """A missing ledger, named when a record says it was committed into one (else none).
+
+        A resume accepts the one case a cut-off leaves: the experiment's first record, committed just
+        before the ledger was started (the resume starts it).
+        """
+        ledgered = [path for path in records if committed_into_ledger(path)]
+        if not ledgered or (resuming and ledgered == list(records[-1:]) and len(records) == 1):
+            return []
+        first = ledgered[0].relative_to(self.root).as_posix()
+        return [
+            f"{self.root / LEDGER_FILE} is missing (deleted or moved), though {len(ledgered)} committed "
+            f"record(s) were written into it (first: {first}): restore it from a copy of the experiment"
+        ]
+
+    def ledger_note(self) -> str | None:
+        """One line for an experiment made before ledgers (no ledger, no record written into one), else None.
+
+        Its records are checked against their files only; its first resume starts its ledger.
+        """
+        records = self.committed_record_files()
+        if not records or Ledger(self.root).exists() or any(committed_into_ledger(p) for p in records):
+            return None
+        return pre_ledger_note(self.root, LEDGER_FILE)
 
     def read_phase_record(self, round_index: int) -> PhaseRecord:
         """The training record of a committed phase.
@@ -777,13 +827,19 @@ def _append_data_file(
 
 
 def merge_rounds(
-    experiment: ExperimentDir, rounds: Sequence[int], output: Path, repo_id: str = "local/merged"
+    experiment: ExperimentDir,
+    rounds: Sequence[int],
+    output: Path,
+    repo_id: str = "local/merged",
+    unverified: Sequence[str] = (),
 ) -> Path:
     """Merges round datasets into ONE LeRobotDataset with LeRobot's own aggregation.
 
     Task indices are preserved: every round holds the full vocabulary in the same order. The merged
     dataset gets a ``mtdagger`` record listing the merged rounds' records (``meta/mtdagger.json``,
-    mirrored in meta/info.json).
+    mirrored in meta/info.json). ``unverified``: the verification problems the caller chose to read past
+    (``merge --unverified=true``), listed in that record under ``unverified``; without them a round whose
+    files changed after commit is refused.
 
     The merge is written beside ``output`` and renamed onto it when complete, so a merge that stops
     half-way leaves no ``output`` (and a re-run starts clean).
@@ -798,7 +854,7 @@ def merge_rounds(
         raise UserError(f"Merge target {output} exists; choose another --output or delete it.")
     records = [experiment.read_round_record(k) for k in rounds]
     problems = [problem for record in records for problem in experiment.round_file_problems(record)]
-    if problems:
+    if problems and not unverified:
         raise CorruptExperimentError(f"Cannot merge: {'; '.join(problems)}. Restore the files first.")
     staging = output.parent / f".{output.name}.merging"
     if staging.exists():
@@ -816,6 +872,8 @@ def merge_rounds(
         "merged_rounds": list(rounds),
         "rounds": [record.to_dict() for record in records],
     }
+    if unverified:
+        merged["unverified"] = list(unverified)
     write_record_files(staging, merged)
     os.replace(staging, output)
     return output

@@ -27,7 +27,7 @@ import logging
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -347,6 +347,7 @@ def push_experiment(
     *,
     private: bool = False,
     api: HfApi | None = None,
+    added_defaults: Mapping[str, Any] | None = None,
 ) -> dict[str, dict[str, str]]:
     """Pushes every committed round (and optionally every training phase) to the Hub, one tag per round.
 
@@ -362,17 +363,21 @@ def push_experiment(
         private: Whether repos created by this call are private (an existing repo's visibility is
             left as it is).
         api: The Hub client (default: a new ``HfApi()``, authenticated as usual, e.g. by ``HF_TOKEN``).
+        added_defaults: ``RunConfig.option_defaults``, for the verification (as ``verify`` passes it).
 
     Returns:
         ``{"dataset": {tag: commit_id}, "policy": {tag: commit_id}}`` (``policy`` empty when not pushed).
 
     Raises:
-        UserError: If ``experiment_dir`` is not an experiment, there is nothing to push, a committed
-            file changed, or the Hub cannot be reached with the token; nothing is sent then.
+        UserError: If ``experiment_dir`` is not an experiment, there is nothing to push, it fails
+            verification (``check_before_reading``: a changed file or record, a missing ledger), or the
+            Hub cannot be reached with the token; nothing is sent then.
     """
+    from lerobot_mtdagger.datasets.verify import check_before_reading
+
     experiment = ExperimentDir(Path(experiment_dir))
     rounds, phases = _pushable(experiment, with_policies=policy_repo_id is not None)
-    experiment.check_committed_files()  # never publish a round or policy changed after commit
+    check_before_reading(experiment, added_defaults=added_defaults)  # never publish unverified records
     api = api or HfApi()
     user = check_hub_access(api)
     logger.info("Pushing to the Hub as %s", user)
@@ -393,8 +398,14 @@ def push_experiment(
 # -------------------------------------------------------------------------------------------------
 
 
-def push_command(config: PushConfig) -> dict[str, dict[str, str]]:
+def push_command(
+    config: PushConfig, added_defaults: Mapping[str, Any] | None = None
+) -> dict[str, dict[str, str]]:
     """Pushes the experiment as configured; returns what was pushed (see ``push_experiment``)."""
     return push_experiment(
-        config.experiment_dir, config.repo_id, config.policy_repo_id, private=config.private
+        config.experiment_dir,
+        config.repo_id,
+        config.policy_repo_id,
+        private=config.private,
+        added_defaults=added_defaults,
     )

@@ -37,13 +37,17 @@ def folder_digests(folder: Path, exclude: Collection[str] = ()) -> dict[str, str
     return {name: file_sha256(path) for name, path in relative if name not in exclude}
 
 
-def digest_mismatches(folder: Path, recorded: Mapping[str, str], exclude: Collection[str] = ()) -> list[str]:
+def digest_mismatches(
+    folder: Path, recorded: Mapping[str, str], exclude: Collection[str] = (), added_ok: bool = False
+) -> list[str]:
     """Files of ``folder`` that differ from the digests recorded at commit.
 
     Args:
         folder: The committed folder.
         recorded: Relative path -> sha256, as recorded at commit.
         exclude: Relative paths that were not hashed.
+        added_ok: Leave files not recorded unnamed (a policy folder outside its experiment, where a Hub
+            download adds ``.gitattributes`` and ``.cache/``).
 
     Returns:
         One message per missing, changed or unexpected file, naming its path.
@@ -58,5 +62,6 @@ def digest_mismatches(folder: Path, recorded: Mapping[str, str], exclude: Collec
         for name, digest in recorded.items()
         if name in present and present[name] != digest
     ]
-    problems += [f"{folder / name} was added after commit" for name in present if name not in recorded]
+    if not added_ok:
+        problems += [f"{folder / name} was added after commit" for name in present if name not in recorded]
     return problems

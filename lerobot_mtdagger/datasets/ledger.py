@@ -12,10 +12,13 @@ commits::
       {"record": "policies/round-000/training.json", "sha256": "...", "previous": "<entry 0's hash>"},
       ...]}
 
-An edited record no longer matches its entry; an edited entry breaks the chain after it. ``verify``
-and every resume check it. An experiment made before the ledger existed has none (nothing is
-checked there); the first commit of a resumed one starts it with the records it holds then, as they
-are. A record committed by a run cut off before it reached the ledger is added by the next resume.
+An edited record no longer matches its entry; an edited entry breaks the chain after it; a ledger
+none of whose entries matches is another's (replaced). ``verify``, every resume and every reader
+(``datasets/verify.py``'s ``check_before_reading``) check it. Every record committed with a ledger says
+so (``ledger: true``), so a deleted ledger is named. An experiment made before the ledger existed has
+none and no record saying so (its records are checked against their files only); the first commit of a
+resumed one starts it with the records it holds then, as they are. A record committed by a run cut off
+before it reached the ledger is added by the next resume.
 """
 
 from __future__ import annotations
@@ -117,6 +120,7 @@ class Ledger:
         previous = None
         if deleted_tail_ok:
             entries = entries[: len(entries) - self.missing_tail(entries)]
+        matching = 0
         for position, entry in enumerate(entries):
             if entry.get("previous") != previous:
                 problems.append(f"{LEDGER_FILE}: entry {position} ({entry.get('record')}) breaks the chain")
@@ -126,6 +130,13 @@ class Ledger:
                 problems.append(f"{path} is in the ledger but missing (deleted after commit)")
             elif file_sha256(path) != entry.get("sha256"):
                 problems.append(f"{path} changed after commit (its sha256 differs from {LEDGER_FILE})")
+            else:
+                matching += 1
+        if entries and not matching:
+            return [
+                f"{self.path} was replaced: none of its {len(entries)} entries matches a record of this "
+                "experiment; restore the experiment's own ledger from a copy of it"
+            ]
         listed = {entry.get("record") for entry in entries}
         for record in records:
             name = Path(record).relative_to(self.root).as_posix()

@@ -19,6 +19,7 @@ from __future__ import annotations
 import copy
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 ConfigRewrite = Callable[[Mapping[str, Any]], dict[str, Any]]
@@ -166,6 +167,10 @@ def pixels_preset_hint(
     return f" (a run made before {since} with --preset=metaworld-pixels used {options}: add it)"
 
 
+LEDGER_RECORDS_SINCE = "2026-12-04"
+"""Since when every committed record says it was committed into the ledger (``ledger: true``)."""
+
+
 MIGRATIONS: tuple[Migration, ...] = (
     Migration(
         name="drawer-placement",
@@ -208,8 +213,30 @@ MIGRATIONS: tuple[Migration, ...] = (
         former_values={"training.steps_rule": "fixed", "training.epochs": 100.0},
         resume_hint=pixels_preset_hint,
     ),
+    Migration(
+        name="ledger-records",
+        since=LEDGER_RECORDS_SINCE,
+        summary=(
+            "Round and phase records say they were committed into the ledger (ledger: true), so a deleted "
+            "ledger is named; a run with no ledger and no such record is read as one made before ledgers "
+            "(pre_ledger_note)."
+        ),
+    ),
 )
 """Every change to what stored runs hold or mean, oldest first."""
+
+
+def pre_ledger_note(root: Path, ledger_file: str) -> str:
+    """What ``verify`` and every reader say of an experiment made before ledgers.
+
+    Such an experiment has no ledger and no record committed into one: it is read, its records checked
+    against their files only, and a resume starts its ledger.
+    """
+    return (
+        f"{root} was made before experiments had a ledger ({ledger_file}; or before "
+        f"{LEDGER_RECORDS_SINCE}, when records began to say they were committed into one): its records are "
+        "checked against their files only; a resume starts its ledger"
+    )
 
 
 def migrate_run_config(config: Mapping[str, Any]) -> dict[str, Any]:

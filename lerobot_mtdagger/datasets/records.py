@@ -188,6 +188,8 @@ class RoundRecord:
         learner_episodes: Episodes behind ``learner_success``.
         files: sha256 of every file of the round dataset but ``meta/info.json``, by relative path,
             written at commit (None in rounds committed before checksums were recorded).
+        ledger: True once committed into the experiment's ``ledger.json`` (``datasets/ledger.py``); False
+            in rounds committed before the ledger existed, so a missing ledger is told from one never made.
     """
 
     task_names: list[str]
@@ -223,6 +225,7 @@ class RoundRecord:
     learner_success: list[float | None] | None = None
     learner_episodes: list[int] | None = None
     files: dict[str, str] | None = None
+    ledger: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form, as stored in ``meta/info.json``."""
@@ -279,6 +282,8 @@ class PhaseRecord:
         resumed_after_steps: The steps after which a cut phase was resumed from its saved progress
             (``runner.training.phase_progress``), in order; empty: trained in one go; None in phases written
             before progress was saved. Its ``steps_s`` and ``train_s`` count every process's steps.
+        ledger: True once committed into the experiment's ``ledger.json``; False in phases committed
+            before the ledger existed.
     """
 
     round: int
@@ -302,6 +307,7 @@ class PhaseRecord:
     environment: dict[str, Any] | None = None
     passes_per_task: list[float | None] | None = None
     resumed_after_steps: list[int] | None = None
+    ledger: bool = False
 
     @property
     def eval_mean(self) -> float | None:

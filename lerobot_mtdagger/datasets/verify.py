@@ -13,6 +13,7 @@ phase's gain, the Kalman prior = the previous round's posterior. For each commit
 from __future__ import annotations
 
 import json
+import logging
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -22,10 +23,19 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from lerobot_mtdagger.datasets.checkpoints import load_policy
-from lerobot_mtdagger.datasets.experiment_dir import EXPERT_CHECK_FILE, ExperimentDir, round_name
+from lerobot_mtdagger.datasets.experiment_dir import (
+    EXPERT_CHECK_FILE,
+    ExperimentDir,
+    read_committed_json,
+    round_name,
+)
+from lerobot_mtdagger.datasets.experiment_files import CONFIG_FILE, POLICIES_DIR, ROUNDS_DIR, TRAINING_FILE
+from lerobot_mtdagger.datasets.integrity import digest_mismatches
 from lerobot_mtdagger.datasets.records import RoundRecord
 from lerobot_mtdagger.scheduler import allocation_mismatches
 from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
+
+logger = logging.getLogger(__name__)
 
 
 def stored_tasks(root: Path, num_tasks: int) -> tuple[list[str], list[int], int]:
@@ -159,10 +169,15 @@ def _chain_mismatches(
     return problems
 
 
-def verify_policy(experiment: ExperimentDir, round_index: int) -> list[str]:
+def verify_policy(experiment: ExperimentDir, round_index: int, load: bool = True) -> list[str]:
     """Checks one committed policy folder: its files against its record's checksums, and that it loads.
 
     Loading never runs code named by the checkpoint (``trust_checkpoint`` stays false).
+
+    Args:
+        experiment: The experiment folder.
+        round_index: The phase's round.
+        load: Also load the policy (``verify``); a reader that loads it itself skips this.
 
     Returns:
         One message per problem, prefixed by the policy's folder.
@@ -175,20 +190,30 @@ def verify_policy(experiment: ExperimentDir, round_index: int) -> list[str]:
     problems = experiment.phase_file_problems(record)
     if record.files is None:
         problems.append("no checksums recorded (committed by an older version): files not checked")
-    try:
-        load_policy(experiment.policy_root(round_index))
-    except (UserError, OSError, RuntimeError, json.JSONDecodeError) as error:
-        problems.append(f"does not load: {type(error).__name__}: {error}")
+    if load:
+        problems += _load_problems(experiment.policy_root(round_index))
     return [f"{prefix}: {problem}" for problem in problems]
 
 
+def _load_problems(folder: Path) -> list[str]:
+    """Whether a policy folder loads, without running code it names."""
+    try:
+        load_policy(folder)
+    except (UserError, OSError, RuntimeError, json.JSONDecodeError) as error:
+        return [f"does not load: {type(error).__name__}: {error}"]
+    return []
+
+
 def verify_experiment(
-    experiment: ExperimentDir, added_defaults: Mapping[str, Any] | None = None
+    experiment: ExperimentDir, added_defaults: Mapping[str, Any] | None = None, reading: bool = False
 ) -> tuple[int, int, list[str]]:
     """Verifies every committed round and policy of an experiment.
 
     ``added_defaults`` (``RunConfig.option_defaults``) gives options the run's config predates their
-    default, so that its rounds' records are compared with it as a resume compares a config.
+    default, so that its rounds' records are compared with it as a resume compares a config. Readers
+    (``check_before_reading``) pass ``reading=True``: every check but loading each policy, and the ledger
+    as a resume takes it (the last rounds deleted to be redone, a record committed by a run cut off, or
+    still running, just before it reached the ledger).
 
     Returns:
         The numbers of rounds and of policies verified, and every problem found.
@@ -202,7 +227,7 @@ def verify_experiment(
     except UserError as error:
         return 0, 0, [str(error)]
     phases = experiment.committed_phases()
-    problems = [problem for k in phases for problem in verify_policy(experiment, k)]
+    problems = [problem for k in phases for problem in verify_policy(experiment, k, load=not reading)]
     readable_phases = {k for k in phases if _readable_phase(experiment, k)}
     previous = None
     for round_index in rounds:
@@ -211,7 +236,7 @@ def verify_experiment(
         previous = record
     if previous is not None:
         problems += kept_task_mismatches(experiment, previous)
-    problems += experiment.ledger_problems()
+    problems += experiment.ledger_problems(resuming=reading)
     return len(rounds), len(phases), problems
 
 
@@ -236,3 +261,121 @@ def _readable_phase(experiment: ExperimentDir, round_index: int) -> bool:
     except UserError:
         return False
     return True
+
+
+UNVERIFIED_OPTION = "--unverified=true"
+"""The option of every reader that reads an experiment failing verification on purpose."""
+
+SHOWN_PROBLEMS = 3
+"""Problems named in a reader's one-line refusal (``verify`` lists them all)."""
+
+
+def check_before_reading(
+    experiment: ExperimentDir, unverified: bool = False, added_defaults: Mapping[str, Any] | None = None
+) -> list[str]:
+    """What every reader (``merge``, ``report``, ``push``, ``eval``, ``shift``, ``plan``) checks first.
+
+    The experiment is verified as ``verify`` does (``verify_experiment``, without loading its policies):
+    every committed round's and policy's files against their checksums, the data files' episodes and
+    frames, the records' chain, and the ledger (edited, missing or replaced). An experiment made before
+    ledgers is read, with an info line saying so.
+
+    Args:
+        experiment: The experiment to read.
+        unverified: Read it even if it fails (``--unverified=true``), with a logged warning.
+        added_defaults: ``RunConfig.option_defaults``, as ``verify`` passes it.
+
+    Returns:
+        The problems read past (empty unless ``unverified``), for the reader's output to name.
+
+    Raises:
+        NotAnExperimentError: If the folder holds no experiment.
+        CorruptExperimentError: In one line naming the first problems, ``verify`` and the fix.
+    """
+    _, _, problems = verify_experiment(experiment, added_defaults, reading=True)
+    note = experiment.ledger_note()
+    if note is not None:
+        logger.info(note)
+    fix = (
+        f"restore what is named (`lerobot-mtdagger verify --experiment_dir={experiment.root}` lists every "
+        "problem)"
+    )
+    return _refused_or_read(f"{experiment.root} fails verification", problems, fix, unverified)
+
+
+def _refused_or_read(what: str, problems: list[str], fix: str, unverified: bool) -> list[str]:
+    """Refuses ``problems`` in one line (``what (problems): fix, or --unverified=true``) or warns of them.
+
+    Returns:
+        ``problems`` (read past with ``unverified``).
+
+    Raises:
+        CorruptExperimentError: If there is a problem and ``unverified`` is false.
+    """
+    if not problems:
+        return []
+    shown = "; ".join(problems[:SHOWN_PROBLEMS])
+    more = len(problems) - SHOWN_PROBLEMS
+    shown += f"; and {more} more" if more > 0 else ""
+    if not unverified:
+        raise CorruptExperimentError(
+            f"{what} ({shown}): {fix}, or pass {UNVERIFIED_OPTION} to read it as it is."
+        )
+    logger.warning("Reading unverified records (%s): %s (%s)", UNVERIFIED_OPTION, what, shown)
+    return problems
+
+
+def experiment_of(folder: Path) -> ExperimentDir | None:
+    """The experiment a round dataset or policy folder (``<experiment>/rounds|policies/round-XXX``) is of.
+
+    None for a folder anywhere else (copied out, downloaded, a LeRobot dataset or policy).
+    """
+    folder = Path(folder)
+    inside = folder.parent.name in (ROUNDS_DIR, POLICIES_DIR) and folder.name.startswith("round-")
+    root = folder.parent.parent
+    return ExperimentDir(root) if inside and (root / CONFIG_FILE).is_file() else None
+
+
+def check_policy_folder(
+    folder: Path, unverified: bool = False, added_defaults: Mapping[str, Any] | None = None
+) -> list[str]:
+    """What ``eval``, ``shift`` and ``plan`` check of a policy folder before loading it, wherever it lives.
+
+    A folder of an experiment: the experiment, as ``check_before_reading``. Any other folder (copied out,
+    pushed and downloaded again): its files against the checksums its ``training.json`` carries (files
+    added beside them, such as a Hub download's ``.gitattributes``, are not its own and are left out). A
+    folder without checksums (a LeRobot policy, a Hub id) is read, with an info line saying so.
+
+    Returns:
+        The problems read past (empty unless ``unverified``).
+
+    Raises:
+        CorruptExperimentError: In one line naming the changed files and the fix.
+    """
+    folder = Path(folder)
+    experiment = experiment_of(folder)
+    if experiment is not None:
+        return check_before_reading(experiment, unverified, added_defaults)
+    recorded = carried_checksums(folder)
+    if recorded is None:
+        logger.info(
+            "%s carries no checksums (%s with files): its files are not checked", folder, TRAINING_FILE
+        )
+        return []
+    problems = digest_mismatches(folder, recorded, exclude=(TRAINING_FILE,), added_ok=True)
+    what = f"{folder} differs from the checksums its {TRAINING_FILE} carries"
+    return _refused_or_read(what, problems, "restore the policy folder", unverified)
+
+
+def carried_checksums(folder: Path) -> dict[str, str] | None:
+    """The file checksums a policy folder's ``training.json`` carries (None: no file, or none recorded).
+
+    Raises:
+        CorruptExperimentError: If ``training.json`` is there but unreadable.
+    """
+    path = Path(folder) / TRAINING_FILE
+    if not path.is_file():
+        return None
+    values = read_committed_json(path, "restore the policy folder")
+    files = values.get("files") if isinstance(values, dict) else None
+    return dict(files) if isinstance(files, dict) else None

@@ -82,6 +82,9 @@ class PlanConfig:
         initial_demos: Expert demos per task the first session's policy was trained on (first plan of a
             scheduler that fits learning curves, ``--scheduler.type=curve``; later plans add each plan's
             episodes to it).
+        unverified: Read rounds and policies of an experiment that fails verification, or a policy
+            folder that differs from the checksums its ``training.json`` carries, as they are (with a
+            warning; the plan lists the problems under ``unverified``); by default they are refused.
     """
 
     datasets: list[str] = field(default_factory=list)
@@ -100,6 +103,7 @@ class PlanConfig:
     loss_datasets: list[str] = field(default_factory=list)
     verify: Path | None = None
     initial_demos: int | None = None
+    unverified: bool = False
 
     def __post_init__(self) -> None:
         if self.verify is not None:
@@ -341,8 +345,42 @@ def continued_scheduler(config: PlanConfig, tasks: Sequence[str], previous: dict
     return scheduler
 
 
+def checked_inputs(config: PlanConfig) -> list[str]:
+    """Checks the experiment rounds and policy folders the plan reads, as every reader checks them.
+
+    A round dataset or policy folder of an experiment checks its experiment once
+    (``check_before_reading``); a policy folder elsewhere checks the checksums it carries
+    (``check_policy_folder``). Other datasets (LeRobot's, Hub ids) are read as they are.
+
+    Returns:
+        The problems read past with ``--unverified=true`` (else empty).
+
+    Raises:
+        CorruptExperimentError: In one line naming what changed and the fix.
+    """
+    from lerobot_mtdagger.datasets.verify import check_before_reading, check_policy_folder, experiment_of
+    from lerobot_mtdagger.runner.configs import RunConfig
+
+    defaults = RunConfig.option_defaults()
+    policies = [Path(p) for p in (config.policy_path, config.previous_policy_path) if p is not None]
+    datasets = [Path(source) for source in [*config.datasets, *config.loss_datasets]]
+    problems, seen = [], set()
+    for folder in [path for path in [*datasets, *policies] if path.is_dir()]:
+        experiment = experiment_of(folder)
+        key = (experiment.root if experiment is not None else folder).resolve()
+        if key in seen:
+            continue
+        seen.add(key)
+        if experiment is not None:
+            problems += check_before_reading(experiment, config.unverified, defaults)
+        elif folder in policies:
+            problems += check_policy_folder(folder, config.unverified, defaults)
+    return problems
+
+
 def make_plan(config: PlanConfig) -> dict:
     """Reads the datasets, updates the scheduler, allocates; returns the plan (not yet written)."""
+    unverified = checked_inputs(config)
     previous = read_plan(config.previous) if config.previous is not None else None
     read = read_all(config)
     tasks = plan_tasks(config, read, previous)
@@ -367,7 +405,7 @@ def make_plan(config: PlanConfig) -> dict:
     budget = episode_budget(config, scheduler, seconds)
     allocation = scheduler.allocate(budget)
     minutes = [n * s / 60.0 for n, s in zip(allocation.episodes_per_task, seconds, strict=True)]
-    return {
+    plan = {
         "format": PLAN_FORMAT,
         "version": PLAN_VERSION,
         "tasks": list(tasks),
@@ -398,6 +436,9 @@ def make_plan(config: PlanConfig) -> dict:
         "budget": {"episodes": budget, "minutes": float(sum(minutes)), "minutes_per_task": minutes},
         "allocation": allocation.to_dict(),
     } | ({} if demos is None else {"demos": demos})
+    if unverified:
+        plan["unverified"] = unverified
+    return plan
 
 
 def session_demos(config: PlanConfig, num_tasks: int, previous: dict | None) -> list[float] | None:

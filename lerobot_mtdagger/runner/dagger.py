@@ -71,6 +71,7 @@ from lerobot_mtdagger.runner.run_setup import (
     new_scheduler,
     unseen_task_suite,
 )
+from lerobot_mtdagger.runner.run_summary import finished_summary, is_finished, last_round, summary_line
 from lerobot_mtdagger.runner.training.train import RoundCache, check_heldout, student_config, train_on_rounds
 
 if TYPE_CHECKING:
@@ -103,7 +104,7 @@ class RunContext:
     @property
     def last_round(self) -> int:
         """Index of the last round of the experiment."""
-        return 0 if self.config.is_bc else self.config.dagger.rounds
+        return last_round(self.config)
 
 
 # -------------------------------------------------------------------------------------------------
@@ -348,25 +349,6 @@ def evaluate_phase(ctx: RunContext, runner: PolicyRunner, workers: EnvWorkers) -
 # -------------------------------------------------------------------------------------------------
 
 
-def summary_line(ctx: RunContext, round_index: int) -> str:
-    """One line per round: demos so far, average success, allocation, time spent."""
-    record = ctx.experiment.read_round_record(round_index)
-    phase = ctx.experiment.read_phase_record(round_index)
-    success = "n/a" if phase.eval_mean is None else f"{phase.eval_mean:.3f}"
-    if phase.heldout_eval is not None:
-        success += f" | unseen {phase.heldout_eval['mean']:.3f}"
-    demos = np.mean(record.demos_so_far)
-    timing = " ".join(f"{k}={v:.1f}" for k, v in phase.timings.items() if k not in PHASE_DETAIL_TIMINGS)
-    return (
-        f"round {round_index}: demos/task {demos:.1f} | eval success {success} | "
-        f"allocation {record.episodes_per_task} | beta {record.beta:.2f} | {timing}"
-    )
-
-
-PHASE_DETAIL_TIMINGS = ("steps_s", "task_loss_s")
-"""Parts of ``train_s`` kept in the phase's record (``training.json``) but not in the summary line."""
-
-
 def run(
     config: RunConfig,
     on_summary: Callable[[str], None] | None = None,
@@ -400,7 +382,8 @@ def run(
     if not config.resume:
         extra = {EXPERT_CHECK_FILE: check.to_dict()} if check is not None else None
         experiment.initialise(config.to_dict(), extra)
-    with experiment.writer_lock():
+    finished = config.resume and is_finished(experiment, last_round(config))
+    with experiment.writer_lock(record_pid=not finished):  # a finished run's folder is left as it is
         if config.resume:
             experiment.check_committed_files()  # refuses foreign, corrupt or changed rounds and policies
             experiment.update_ledger()  # a record committed just before a cut-off, and older experiments
@@ -408,6 +391,8 @@ def run(
             experiment.extend_rounds(config.dagger.rounds)  # a DAgger run resumed with more rounds
         if on_start is not None:
             on_start()
+        if finished:
+            return finished_summary(experiment, last_round(config), on_summary)
         return _run_locked(config, suite, experiment, on_summary)
 
 
@@ -430,7 +415,7 @@ def _run_locked(
                     collect_round(ctx, round_index)
                 if round_index not in phases_done:
                     train_round(ctx, round_index)
-                lines.append(summary_line(ctx, round_index))
+                lines.append(summary_line(experiment, round_index))
                 logger.info(lines[-1])
                 if on_summary is not None:
                     on_summary(lines[-1])
