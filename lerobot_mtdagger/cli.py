@@ -8,9 +8,8 @@ Commands:
         ``--scheduler.type``, ``--dagger.rounds``, ``--dagger.budget``, ``--output_dir``, ``--resume``,
         ...; see ``RunConfig``), or the one-round behaviour-cloning baseline with ``--mode=bc``.
     eval: success per task of a pretrained policy (``--policy_path``, ``--suite.name``, ``--episodes``).
-    shift: covariate shift of a pretrained policy: its action error on the states of its own rollouts
-        against on the expert's, per task (the options of ``eval``); tells whether DAgger's
-        relabelled rollouts have much to add over more demonstrations.
+    shift: covariate shift of a pretrained policy: its action error on its own rollouts' states against
+        on the expert's, per task (``eval``'s options): what DAgger's relabelled rollouts can add.
     verify: recompute every round's allocation from its record (``--experiment_dir``).
     merge: rounds 0..k as one LeRobotDataset (``--experiment_dir``, ``--output``).
     compare: every method over every seed, and BC at every budget, as runs in a process pool, then
@@ -19,16 +18,15 @@ Commands:
     report: eval success against expert demos per method, mean and std over seeds (``--experiments``
         or ``--compare_dir``); with ``--output_dir`` (default for a compare folder) also the figures
         and a summary with paired differences.
-    push: round datasets (tag ``round-{k:03d}`` each) and round policies to the Hub
-        (``--experiment_dir``, ``--repo_id``, ``--policy_repo_id``).
+    push: round datasets and policies to the Hub (``--experiment_dir``, ``--repo_id``, ``--policy_repo_id``).
     plan: the next collection session's episodes per task from LeRobot datasets of the policy's
         episodes (``--datasets``, ``--budget`` or ``--budget_minutes``, ``--output``, ``--previous``);
         ``--verify=PLAN`` recomputes a plan from its recorded inputs (``planning/plan.py``).
     replay: the schedulers replayed against measured per-task learning curves (``--records``,
         ``--methods``, ``--rounds``, ``--replicates``): the share of the headroom each captures and the
         seeds a study needs to see it, before the study is run (``analysis/replay.py``).
-    demo: run the performance-aware scheduler on synthetic tasks and print each round's allocation
-        (no simulator, no policy; shows how the methods split a budget).
+    records: save and compact a study's run records (``--action``, ``--source``, ``--dest``).
+    demo: the scheduler on synthetic tasks, each round's allocation (no simulator, no policy).
 """
 
 # The usage above is printed as it is (``_usage``). Each command's options and body live in its
@@ -47,6 +45,7 @@ from lerobot_mtdagger.commands.eval import EvalConfig, eval_command
 from lerobot_mtdagger.commands.merge import MergeConfig, merge_command
 from lerobot_mtdagger.commands.plan import PlanConfig, plan_command
 from lerobot_mtdagger.commands.push import PushConfig, push_command
+from lerobot_mtdagger.commands.records import RecordsConfig, records_command
 from lerobot_mtdagger.commands.replay import ReplayConfig, replay_command
 from lerobot_mtdagger.commands.report import ReportConfig, report_command
 from lerobot_mtdagger.commands.run import RunConfig, run_experiment
@@ -67,6 +66,7 @@ COMMANDS: dict[str, tuple[type, Callable]] = {
     "report": (ReportConfig, report_command),
     "plan": (PlanConfig, plan_command),
     "replay": (ReplayConfig, replay_command),
+    "records": (RecordsConfig, records_command),
     "demo": (DemoConfig, run_demo),
 }
 

@@ -101,3 +101,21 @@ def test_a_missing_folder_is_one_clear_refusal(tmp_path):
         save_runs(tmp_path / "nowhere", tmp_path / "dest")
     with pytest.raises(UserError, match="outputs/STUDY"):
         save_compares(tmp_path / "nowhere", tmp_path / "dest")
+
+
+def test_the_records_command_saves_and_compacts_and_refuses_in_one_line(tmp_path):
+    import subprocess
+    import sys
+
+    def records(*options):
+        command = [sys.executable, "-m", "lerobot_mtdagger.cli", "records", *options]
+        return subprocess.run(command, capture_output=True, text=True, check=False)
+
+    write_run(tmp_path / "runs", "need-seed0")
+    saved = records("--action=save", f"--source={tmp_path / 'runs'}", f"--dest={tmp_path / 'records'}")
+    assert saved.returncode == 0, saved.stderr
+    compacted = records("--action=compact", f"--source={tmp_path / 'records'}")
+    assert compacted.returncode == 0 and files_under(tmp_path / "records") == ["runs-records.tar.gz"]
+    refused = records("--action=save", f"--source={tmp_path / 'nowhere'}", "--dest=x")
+    assert refused.returncode == 2 and len(refused.stderr.strip().splitlines()) == 1
+    assert "give an existing folder" in refused.stderr
