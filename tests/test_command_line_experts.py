@@ -148,6 +148,21 @@ def test_an_expert_type_by_entry_point_or_registered_name(tmp_path, capsys):
     assert not (tmp_path / "bad").exists()
 
 
+@pytest.mark.parametrize(
+    ("type_name", "message"),
+    [
+        ("builtins:len", "is not a factory(suite, task)"),  # imports, but cannot take (suite, task)
+        ("builtins:slice", "gave a slice for the task"),  # a factory that gives no expert
+    ],
+)
+def test_an_expert_type_that_gives_no_expert_is_refused_in_one_line(tmp_path, capsys, type_name, message):
+    out = tmp_path / "out"
+    assert main(["run", *TOY, f"--expert.type={type_name}", f"--output_dir={out}"]) == 2
+    error = capsys.readouterr().err
+    assert message in error and "factory(suite, task)" in error, error
+    assert len(error.strip().splitlines()) == 1 and not out.exists()
+
+
 def test_path_and_type_together_are_refused(tmp_path, capsys):
     args = ["--expert.type=x:y", f"--expert.path={tmp_path}", f"--output_dir={tmp_path / 'out'}"]
     assert main(["run", *TOY, *args]) == 2

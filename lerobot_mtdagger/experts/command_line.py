@@ -19,6 +19,7 @@ line naming the fix.
 from __future__ import annotations
 
 import copy
+import inspect
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -163,5 +164,29 @@ def command_line_experts(suite: Any, path: str | None, type_name: str | None) ->
         return suite.with_experts(policy_experts(Path(path), suite))
     if type_name is not None:
         factory = expert_type_factory(type_name)
-        return suite.with_experts({task: factory(suite, task) for task in suite.task_names})
+        experts = {task: _expert_of(factory, type_name, suite, task) for task in suite.task_names}
+        return suite.with_experts(experts)
     return suite
+
+
+def _expert_of(factory: Callable[..., Any], type_name: str, suite: Any, task: str) -> Expert:
+    """The expert ``factory(suite, task)`` gives for ``task``, checked.
+
+    Raises:
+        UserError: If ``factory`` cannot be called as ``factory(suite, task)`` or gives no ``Expert``.
+    """
+    fix = "give --expert.type a factory(suite, task) that returns an object with reset() and act(state)"
+    try:
+        inspect.signature(factory).bind(suite, task)
+    except TypeError as error:
+        message = f"--expert.type={type_name} is not a factory(suite, task) ({error}); {fix}."
+        raise UserError(message) from None
+    except ValueError:
+        pass  # a callable without a readable signature (some built-ins): the call itself tells
+    expert = factory(suite, task)
+    if not isinstance(expert, Expert):
+        raise UserError(
+            f"--expert.type={type_name} gave a {type(expert).__name__} for the task {task!r}, not an expert; "
+            f"{fix}."
+        )
+    return expert
