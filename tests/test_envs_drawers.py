@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import warnings
 
 import numpy as np
 import pytest
@@ -398,6 +399,22 @@ def test_lerobot_env_plugin_builds_a_drawer():
         assert env.task_description == "drawer-kitchen"
     finally:
         env.close()
+
+
+def test_lerobot_s_env_check_finds_the_task_it_passes_to_the_policy():
+    """lerobot-eval warns on every run unless an env gives ``task_description`` and ``task`` (both lines)."""
+    import gymnasium as gym
+    from lerobot.envs.utils import check_env_attributes_and_types
+
+    suite = {"name": "drawers", "obs_mode": "state"}
+    envs = gym.vector.SyncVectorEnv([lambda: LeRobotSuiteEnv(suite=suite, task="drawer-kitchen")])
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            check_env_attributes_and_types(envs)
+        assert envs.envs[0].task == envs.envs[0].task_description == "drawer-kitchen"
+    finally:
+        envs.close()
 
 
 @pytest.mark.parametrize("placement", [None, "narrow"])

@@ -14,8 +14,8 @@ any other key). A point-cloud policy reads ``observation.pointcloud``, so evalua
 ``--rename_map='{"observation.environment_state": "observation.pointcloud"}'``: lerobot-eval hands the
 map to the policy's rename step, which runs before normalisation.
 
-The env reports the task string (its unique task name) as ``task_description``, which LeRobot passes
-to the policy as ``observation["task"]``; episodes terminate at the first success (MetaWorld's
+The env reports the task string (its unique task name) as ``task_description`` and ``task``, which
+LeRobot passes to the policy as ``observation["task"]``; episodes terminate at the first success (MetaWorld's
 success does not persist, and lerobot-eval reads ``is_success`` only at an episode's last step).
 """
 
@@ -63,6 +63,7 @@ class LeRobotSuiteEnv(gym.Env):
         self._suite = suite_from_config(config.task_suite)
         self._env = self._suite.make_env(task)
         self.task_description = task
+        self.task = task  # LeRobot 0.6 warns on every eval unless an env has both
         self.render_mode = render_mode
         self._max_episode_steps = self._env.max_episode_steps
         self.action_space = self._env.action_space
