@@ -13,15 +13,19 @@ from typing import Any
 
 
 def edit_round_record(round_root: Path, edit: Callable[[dict[str, Any]], None]) -> None:
-    """Applies ``edit`` to a committed round's record in ``meta/mtdagger.json`` and its info.json mirror."""
+    """Applies ``edit`` to a committed round's record in ``meta/mtdagger.json`` and its info.json mirror.
+
+    The mirror is edited where the round has one (rounds written on LeRobot 0.4).
+    """
     sidecar = round_root / "meta" / "mtdagger.json"
     record = json.loads(sidecar.read_text())
     edit(record)
     sidecar.write_text(json.dumps(record))
     info_path = round_root / "meta" / "info.json"
     info = json.loads(info_path.read_text())
-    info["mtdagger"] = record
-    info_path.write_text(json.dumps(info))
+    if "mtdagger" in info:
+        info["mtdagger"] = record
+        info_path.write_text(json.dumps(info))
     # the state the test makes is one a run could have committed: its ledger is made anew to match
     experiment_root = round_root.parent.parent
     if (experiment_root / "ledger.json").is_file():
@@ -29,6 +33,12 @@ def edit_round_record(round_root: Path, edit: Callable[[dict[str, Any]], None]) 
 
         (experiment_root / "ledger.json").unlink()
         ExperimentDir(experiment_root).update_ledger()
+
+
+def edit_info_mirror(info: dict[str, Any], edit: Callable[[dict[str, Any]], None]) -> None:
+    """Applies ``edit`` to a round's ``info.json`` values' record mirror, where it has one (LeRobot 0.4)."""
+    if "mtdagger" in info:
+        edit(info["mtdagger"])
 
 
 def child_pids(pid: int) -> list[int]:

@@ -22,6 +22,7 @@ from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.lerobot_compat import INFO_KEEPS_OTHER_KEYS
 from tests.conftest import lerobot_train
 from tests.helpers import edit_round_record, kill_9_and_check_workers_end, small_drawer_cloud_args
 
@@ -51,12 +52,27 @@ def experiment(tmp_path_factory) -> ExperimentDir:
     return ExperimentDir(root)
 
 
+def test_lerobot_loads_a_round_and_its_merge_without_a_warning(experiment, tmp_path, caplog):
+    """The record lives in meta/mtdagger.json; info.json mirrors it only where LeRobot keeps other keys."""
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    merged = merge_rounds(experiment, [0, 1, 2], tmp_path / "merged")
+    for root in (experiment.round_root(1), merged):
+        caplog.clear()
+        with caplog.at_level("WARNING"):
+            LeRobotDataset("local/round", root=root, video_backend="pyav")
+        assert not [r.getMessage() for r in caplog.records if "Unknown fields" in r.getMessage()], root
+        info = json.loads((root / "meta" / "info.json").read_text())
+        record = json.loads((root / "meta" / "mtdagger.json").read_text())
+        assert info["mtdagger"] == record if INFO_KEEPS_OTHER_KEYS else "mtdagger" not in info
+
+
 def test_every_round_is_committed_with_its_record(experiment):
     assert experiment.committed_rounds() == [0, 1, 2]
     assert experiment.committed_phases() == [0, 1, 2]
     for k in range(3):
         record = experiment.read_round_record(k)
-        stored = json.loads((experiment.round_root(k) / "meta" / "info.json").read_text())["mtdagger"]
+        stored = json.loads((experiment.round_root(k) / "meta" / "mtdagger.json").read_text())
         assert RoundRecord.from_dict(stored) == record and record.committed
         assert record.task_names == TASKS and record.round == k and record.method == "need"
         assert sum(record.episodes_per_task) == record.budget

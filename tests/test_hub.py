@@ -166,10 +166,6 @@ def fake_api(tmp_path) -> FakeHfApi:
     return FakeHfApi(tmp_path / "hub")
 
 
-def round_info(snapshot: Path) -> dict:
-    return json.loads((snapshot / "meta" / "info.json").read_text())
-
-
 def dir_digest(root: Path) -> dict[str, str]:
     return {path: hashlib.sha256(content).hexdigest() for path, content in tree_files(root).items()}
 
@@ -191,7 +187,7 @@ def test_each_round_is_a_tagged_commit_holding_exactly_that_round(experiment_dir
     assert fake_api.calls[:2] == ["whoami", "create_repo"]
     for k in (0, 1):
         snapshot = fake_api.snapshot(DATASET_REPO, f"round-{k:03d}")
-        assert round_info(snapshot)["mtdagger"]["round"] == k
+        assert json.loads((snapshot / "meta" / "mtdagger.json").read_text())["round"] == k
         expected = set(tree_files(experiment.round_root(k))) | {"README.md", ".gitattributes"}
         assert set(tree_files(snapshot)) == expected, "a revision holds exactly its round's files"
         assert not filecmp.dircmp(snapshot / "data", experiment.round_root(k) / "data").diff_files
@@ -370,10 +366,10 @@ def test_live_push_to_the_hub(experiment_dir, tmp_path):
     tags = {ref.name for ref in api.list_repo_refs(repo_id, repo_type="dataset").tags}
     assert {"round-000", "round-001"} <= tags
     for k in (0, 1):
-        info = api.hf_hub_download(
-            repo_id, "meta/info.json", repo_type="dataset", revision=f"round-{k:03d}", cache_dir=tmp_path
+        record = api.hf_hub_download(
+            repo_id, "meta/mtdagger.json", repo_type="dataset", revision=f"round-{k:03d}", cache_dir=tmp_path
         )
-        assert json.loads(Path(info).read_text())["mtdagger"]["round"] == k
+        assert json.loads(Path(record).read_text())["round"] == k
     if policy_repo_id:
         model_tags = {ref.name for ref in api.list_repo_refs(policy_repo_id).tags}
         assert set(pushed["policy"]) <= model_tags

@@ -13,6 +13,7 @@ import pytest
 
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets.ledger import LEDGER_FILE
+from tests.helpers import edit_info_mirror
 
 TOY = ["--suite.name=toy", "--dagger.rounds=1", "--dagger.initial_demos=2", "--dagger.budget_per_task=2"]
 TOY += ["--rollout.eval_episodes=2", "--training.steps_per_round=5", "--policy.batch_size=16"]
@@ -77,7 +78,7 @@ def test_a_round_record_edited_with_its_mirror_is_named(run, capsys):
 
     root = run / "rounds" / "round-001"
     _edit_json(root / "meta" / "mtdagger.json", halve)
-    _edit_json(root / "meta" / "info.json", lambda v: halve(v["mtdagger"]))
+    _edit_json(root / "meta" / "info.json", lambda v: edit_info_mirror(v, halve))
     status, out = _verify(capsys, run)
     assert status == 1 and "rounds/round-001/meta/mtdagger.json changed after commit" in out
 

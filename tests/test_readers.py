@@ -19,6 +19,7 @@ from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.ledger import LEDGER_FILE, entry_hash
 from lerobot_mtdagger.datasets.verify import check_before_reading
 from lerobot_mtdagger.utils.errors import CorruptExperimentError
+from tests.helpers import edit_info_mirror
 from tests.test_hub import FakeHfApi
 from tests.test_ledger import TOY
 
@@ -54,7 +55,7 @@ def edit_round_success(run: Path) -> None:
 
     root = run / "rounds" / "round-001"
     _edit_json(root / "meta" / "mtdagger.json", perfect)
-    _edit_json(root / "meta" / "info.json", lambda v: perfect(v["mtdagger"]))
+    _edit_json(root / "meta" / "info.json", lambda v: edit_info_mirror(v, perfect))
 
 
 def edit_phase_eval(run: Path) -> None:

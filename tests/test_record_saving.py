@@ -15,7 +15,10 @@ from lerobot_mtdagger.utils.errors import UserError
 
 
 def write_run(runs, name, phases=2, success=0.5):
-    """A run folder with the files a run writes: its records and heavier files that are not saved."""
+    """A run folder with the files a run writes: its records and heavier files that are not saved.
+
+    Round 0 is as a round written before ``meta/mtdagger.json`` existed (its record only in info.json).
+    """
     run = runs / name
     (run / "policies").mkdir(parents=True)
     (run / "config.json").write_text(json.dumps({"name": name}))
@@ -24,6 +27,8 @@ def write_run(runs, name, phases=2, success=0.5):
         meta = run / "rounds" / f"round-{k:03d}" / "meta"
         meta.mkdir(parents=True)
         (meta / "info.json").write_text(json.dumps({"round": k}))
+        if k > 0:
+            (meta / "mtdagger.json").write_text(json.dumps({"round": k}))
         (meta.parent / "data.parquet").write_bytes(b"frames")
         phase = run / "policies" / f"round-{k:03d}"
         phase.mkdir()
@@ -44,8 +49,8 @@ def test_saving_copies_only_the_records_and_replaces_a_run_whole(tmp_path):
         "need-seed0/config.json",
         "need-seed0/policies/round-000/training.json",
         "need-seed0/policies/round-001/training.json",
-        "need-seed0/rounds/round-000/info.json",
-        "need-seed0/rounds/round-001/info.json",
+        "need-seed0/rounds/round-000/info.json",  # older: the record is in info.json only
+        "need-seed0/rounds/round-001/mtdagger.json",  # the record, not the dataset's info
     ]
     (dest / "other-seed1").mkdir()
     (dest / "other-seed1" / "config.json").write_text("{}")

@@ -159,7 +159,7 @@ def drop_info_records(root: Path) -> None:
     """Rewrites every round's meta/info.json as LeRobot's own writer may: without keys it does not know."""
     for info_path in (root / "rounds").glob("round-*/meta/info.json"):
         info = json.loads(info_path.read_text())
-        del info["mtdagger"]
+        info.pop("mtdagger", None)  # LeRobot 0.6 rounds hold none
         info_path.write_text(json.dumps(info, indent=4))
 
 
@@ -179,14 +179,17 @@ def test_the_round_record_survives_lerobot_rewriting_info_json(finished, tmp_pat
 
 
 def remove_record_files(root: Path) -> None:
-    """Makes every round look as rounds did before meta/mtdagger.json existed (and so before the ledger)."""
+    """Makes every round look as rounds did before meta/mtdagger.json existed (and so before the ledger).
+
+    Their record was in info.json only, and carried no ledger flag.
+    """
     for sidecar in (root / "rounds").glob("round-*/meta/mtdagger.json"):
+        record = json.loads(sidecar.read_text())
+        record.pop("ledger")
+        info = sidecar.parent / "info.json"
+        info.write_text(json.dumps({**json.loads(info.read_text()), "mtdagger": record}))
         sidecar.unlink()
     (root / "ledger.json").unlink()
-    for info in (root / "rounds").glob("round-*/meta/info.json"):  # records of then carry no ledger flag
-        values = json.loads(info.read_text())
-        values["mtdagger"].pop("ledger")
-        info.write_text(json.dumps(values))
     for training in (root / "policies").glob("round-*/training.json"):
         values = json.loads(training.read_text())
         values.pop("ledger")
@@ -201,10 +204,11 @@ def test_rounds_written_before_the_record_file_existed_still_read_and_verify(fin
 
 def test_an_info_json_mirror_that_disagrees_with_the_record_file_is_named(finished, tmp_path):
     def edit_mirror(root: Path) -> None:
-        info_path = ExperimentDir(root).round_root(1) / "meta" / "info.json"
-        info = json.loads(info_path.read_text())
-        info["mtdagger"]["budget"] += 1
-        info_path.write_text(json.dumps(info))
+        round_root = ExperimentDir(root).round_root(1)
+        record = json.loads((round_root / "meta" / "mtdagger.json").read_text())
+        record["budget"] += 1  # a mirror (LeRobot 0.4 writes one; a copied round may bring one on 0.6)
+        info = json.loads((round_root / "meta" / "info.json").read_text())
+        (round_root / "meta" / "info.json").write_text(json.dumps({**info, "mtdagger": record}))
 
     _, _, problems = verify_experiment(ExperimentDir(damaged_copy(finished, tmp_path, edit_mirror)))
     assert any("differs from" in problem and "round-001" in problem for problem in problems), problems

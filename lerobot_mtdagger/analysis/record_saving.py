@@ -1,8 +1,9 @@
 """Saving runs' records for a study: copied out of ``outputs/`` and compacted into byte-stable archives.
 
-A run's records are its small JSON files (``config.json``, each round's ``meta/info.json``, each
-phase's ``training.json``): its numbers without frames or weights. ``lerobot-mtdagger records``
-writes them; ``saved_records`` (beside this module) reads them back for ``report --records``.
+A run's records are its small JSON files (``config.json``, each round's ``meta/mtdagger.json``, or
+``meta/info.json`` for a round written before that file, each phase's ``training.json``): its numbers
+without frames or weights. ``lerobot-mtdagger records`` writes them; ``saved_records`` (beside this
+module) reads them back for ``report --records``.
 
 - ``save_runs(runs, dest)``: every run under ``runs`` into ``dest/<run>/``, each replaced whole.
 - ``compact(root)``: each folder of saved runs into one ``runs-records.tar.gz``, the same bytes for the
@@ -22,6 +23,12 @@ import tempfile
 from pathlib import Path
 
 from lerobot_mtdagger.analysis.saved_records import ARCHIVE_NAME
+from lerobot_mtdagger.datasets.experiment_dir import (
+    INFO_FILE,
+    RECORD_FILE,
+    SAVED_INFO_FILE,
+    SAVED_RECORD_FILE,
+)
 from lerobot_mtdagger.datasets.experiment_files import CONFIG_FILE
 from lerobot_mtdagger.utils.errors import UserError
 
@@ -32,12 +39,18 @@ RESULTS_TABLE = "results.csv"
 
 
 def run_record_files(run: Path) -> dict[str, Path]:
-    """A run's record files, by their path in the saved copy (``rounds/<round>/info.json``, ...)."""
+    """A run's record files, by their path in the saved copy (``rounds/<round>/mtdagger.json``, ...).
+
+    A round's record is its ``meta/mtdagger.json``; a round written before that file keeps it only in
+    ``meta/info.json``, which is saved instead.
+    """
     files = {CONFIG_FILE: run / CONFIG_FILE}
     for round_dir in sorted(run.glob("rounds/round-*")):
-        info = round_dir / "meta" / "info.json"
-        if info.is_file():
-            files[f"rounds/{round_dir.name}/info.json"] = info
+        record, info = round_dir / RECORD_FILE, round_dir / INFO_FILE
+        if record.is_file():
+            files[f"rounds/{round_dir.name}/{SAVED_RECORD_FILE}"] = record
+        elif info.is_file():
+            files[f"rounds/{round_dir.name}/{SAVED_INFO_FILE}"] = info
     for phase_dir in sorted(run.glob("policies/round-*")):
         training = phase_dir / "training.json"
         if training.is_file():

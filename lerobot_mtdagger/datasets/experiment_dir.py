@@ -8,7 +8,7 @@ Layout of an experiment directory::
         rounds/
             round-000/               LeRobotDataset v3.0 of round 0 (expert demonstrations)
                 meta/mtdagger.json   the round's record (allocation, Kalman state, ...): the truth
-                meta/info.json       ... "mtdagger": a mirror of it for readers of the dataset info
+                meta/info.json       ... "mtdagger": a mirror of it on LeRobot 0.4 only (0.6 warns)
             round-001/               LeRobotDataset of round 1 (DAgger rollouts, expert labels)
             .staging/round-002/      a round being written: never read, deleted on resume
         policies/
@@ -70,6 +70,7 @@ from lerobot_mtdagger.datasets.records import (
 )
 from lerobot_mtdagger.datasets.round_writer import EpisodeFrames, write_round_episodes
 from lerobot_mtdagger.utils.errors import CorruptExperimentError, NotAnExperimentError, UserError
+from lerobot_mtdagger.utils.lerobot_compat import INFO_KEEPS_OTHER_KEYS
 from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 logger = logging.getLogger(__name__)
@@ -133,15 +134,20 @@ def write_json_atomic(path: Path, payload: Any) -> None:
 
 
 def write_record_files(root: Path, record: dict[str, Any]) -> None:
-    """Writes a dataset's record (``meta/mtdagger.json``) and its mirror in ``meta/info.json``.
+    """Writes a dataset's record (``meta/mtdagger.json``) and, on LeRobot 0.4, its ``meta/info.json`` mirror.
 
-    Each file is written anew (``write_json_atomic``), so a hard link to the former file is left intact.
+    LeRobot 0.6 warns of any key of ``info.json`` it does not know on every load, so there the mirror is
+    left out (and one copied from an older round removed). Each file is written anew
+    (``write_json_atomic``), so a hard link to the former file is left intact.
     """
     info_path = root / INFO_FILE
     info = json.loads(info_path.read_text())
-    info[RECORD_KEY] = record
     write_json_atomic(root / RECORD_FILE, record)
-    write_json_atomic(info_path, info)
+    if INFO_KEEPS_OTHER_KEYS:
+        write_json_atomic(info_path, {**info, RECORD_KEY: record})
+    elif RECORD_KEY in info:
+        del info[RECORD_KEY]
+        write_json_atomic(info_path, info)
 
 
 def read_committed_json(path: Path, fix: str) -> Any:
@@ -698,18 +704,22 @@ class ExperimentDir:
         return PhaseRecord.from_dict(values, where=f"The training record {path}")
 
 
+SAVED_RECORD_FILE = "mtdagger.json"
+"""A round's ``meta/mtdagger.json`` where the saved records keep it (``rounds/<round>/``)."""
+
 SAVED_INFO_FILE = "info.json"
-"""A round's ``meta/info.json`` where ``scripts/save_run_records.sh`` saves it (``rounds/<round>/``)."""
+"""A round's ``meta/info.json`` where the saved records of a round without ``mtdagger.json`` keep it."""
 
 
 class SavedRunRecords(ExperimentDir):
     """A run's small JSON records, saved apart from its datasets and weights, read as a run is read.
 
-    The layout ``scripts/save_run_records.sh`` writes, so that a study's numbers outlive its run
-    folders::
+    The layout ``lerobot-mtdagger records --action=save`` writes, so that a study's numbers outlive
+    their run folders::
 
         <run>/config.json                       the run's options
-        <run>/rounds/round-000/info.json        the round's meta/info.json (its record, "mtdagger")
+        <run>/rounds/round-000/mtdagger.json    the round's record (meta/mtdagger.json), or, for a
+                                                round written before that file, info.json (its "mtdagger")
         <run>/policies/round-000/training.json  the phase's training record, evaluation included
 
     Enough to tabulate and report the run (``analysis.results``), not to verify, resume, merge or push
@@ -719,18 +729,23 @@ class SavedRunRecords(ExperimentDir):
 
     @staticmethod
     def read_round_record_at(path: Path) -> RoundRecord:
-        """The record of the saved round at ``path`` (its ``info.json``).
+        """The record of the saved round at ``path`` (its ``mtdagger.json``, else its ``info.json``).
 
         Raises:
             CorruptExperimentError: If ``path`` holds no readable committed record.
         """
+        if (path / SAVED_RECORD_FILE).is_file():
+            fix = "save the run's records again"
+            record = read_committed_json(path / SAVED_RECORD_FILE, fix)
+            return round_record_from(record, path, path / SAVED_RECORD_FILE)
         return round_record_from_info(path, path / SAVED_INFO_FILE)
 
 
 def is_saved_records(root: Path) -> bool:
     """Whether ``root`` holds a run's saved records (``SavedRunRecords``) rather than a run folder."""
     first_round = Path(root) / ROUNDS_DIR / round_name(0)
-    return (first_round / SAVED_INFO_FILE).is_file() and not (first_round / INFO_FILE).is_file()
+    saved = (first_round / SAVED_RECORD_FILE).is_file() or (first_round / SAVED_INFO_FILE).is_file()
+    return saved and not (first_round / INFO_FILE).is_file()
 
 
 def open_run(root: Path) -> ExperimentDir:

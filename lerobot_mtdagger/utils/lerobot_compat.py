@@ -17,8 +17,9 @@ Moved in 0.5/0.6:
 Everything else the package imports from LeRobot has one spelling in both lines (the script checks
 that too). Behaviour that differs without a name moving is handled where it is used: LeRobot 0.6 logs
 through named loggers (``utils/quiet.py``), reads ``meta/info.json`` into a typed ``DatasetInfo`` that
-drops unknown keys (the round record is read from ``meta/mtdagger.json``), and probes torchcodec unless
-a dataset is created with a ``video_backend`` (``datasets/experiment_dir.py``).
+warns of and drops unknown keys on every load (so the round record lives in ``meta/mtdagger.json``, and
+its mirror in ``info.json`` is written on 0.4 only: ``INFO_KEEPS_OTHER_KEYS``), and probes torchcodec
+unless a dataset is created with a ``video_backend`` (``datasets/experiment_dir.py``).
 """
 
 from __future__ import annotations
@@ -45,8 +46,16 @@ try:  # LeRobot >= 0.5
 except ImportError:  # LeRobot 0.4
     from lerobot.datasets.utils import get_hf_features_from_features
 
+try:  # LeRobot >= 0.6: info.json read into a typed DatasetInfo, other keys warned of and dropped
+    from lerobot.datasets.utils import DatasetInfo  # noqa: F401
+
+    INFO_KEEPS_OTHER_KEYS = False
+except ImportError:  # LeRobot 0.4: info.json read as a dict, other keys kept
+    INFO_KEEPS_OTHER_KEYS = True
+
 __all__ = [
     "DEFAULT_FEATURES",
+    "INFO_KEEPS_OTHER_KEYS",
     "dataset_hf_features",
     "dataset_to_policy_features",
     "episode_data_writer",
