@@ -25,6 +25,7 @@ from lerobot_mtdagger.analysis.compare import (
 )
 from lerobot_mtdagger.analysis.figures import hardest_tasks, seed_reach
 from lerobot_mtdagger.analysis.launchers import Job, RunPool, is_finished
+from lerobot_mtdagger.analysis.record_saving import compact, save_runs
 from lerobot_mtdagger.cli import main
 from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir, writer_lock_holder
 from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS
@@ -360,12 +361,9 @@ def test_report_results_goes_alone(compared, tmp_path, capsys):
     assert "give --output_dir for the joined report" in capsys.readouterr().err
 
 
-SAVE_RUN_RECORDS = Path(__file__).resolve().parents[1] / "scripts" / "save_run_records.sh"
-
-
 def _save_records(runs: Path, dest: Path) -> Path:
-    """The runs' records as a study saves them before its ``outputs/`` may be lost (the real script)."""
-    subprocess.run(["bash", str(SAVE_RUN_RECORDS), str(runs), str(dest)], check=True)
+    """The runs' records as a study saves them before its ``outputs/`` is lost (``records --action=save``)."""
+    save_runs(runs, dest)
     return dest
 
 
@@ -377,7 +375,7 @@ def _rows_without_paths(report: Path) -> list[dict]:
 
 
 def test_runs_saved_as_records_report_as_their_folders_do(compared, tmp_path, capsys):
-    """``outputs/`` lost, the JSON records that ``save_run_records.sh`` kept give the same table."""
+    """``outputs/`` lost, the JSON records that ``records --action=save`` kept give the same table."""
     folder, _ = compared
     assert main(["report", f"--compare_dir={folder}", f"--output_dir={tmp_path / 'of-runs'}"]) == 0
     table_of_runs = capsys.readouterr().out.split("figures and summary")[0]
@@ -395,11 +393,9 @@ def test_runs_saved_as_records_report_as_their_folders_do(compared, tmp_path, ca
 
 
 def _compact(records: Path) -> Path:
-    """``scripts/compact_records.sh`` on a records folder; its archive."""
-    script = Path(__file__).resolve().parents[1] / "scripts" / "compact_records.sh"
-    result = subprocess.run(["bash", str(script), str(records)], capture_output=True, text=True)
-    assert result.returncode == 0, result.stderr
-    return records / "runs-records.tar.gz"
+    """``records --action=compact`` on a records folder; its archive."""
+    (archive,) = compact(records)
+    return archive
 
 
 def test_records_compacted_into_an_archive_report_as_their_folders_do(compared, tmp_path, capsys):

@@ -1,10 +1,13 @@
-"""``scripts/save_compare_records.sh``: a save keeps the runs an earlier save archived and outputs/ lost."""
+"""``scripts/save_compare_records.sh`` (the ``records`` command): a save keeps the runs an earlier save
+archived and outputs/ lost."""
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
+import sys
 import tarfile
 from pathlib import Path
 
@@ -35,8 +38,9 @@ def write_run(runs: Path, name: str, phases: int) -> None:
 
 
 def save(root: Path) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHON": sys.executable, "PYTHONPATH": str(REPO)}  # the stand-in has no .venv
     result = subprocess.run(
-        ["bash", "scripts/save_compare_records.sh", STUDY], cwd=root, capture_output=True, text=True
+        ["bash", "scripts/save_compare_records.sh", STUDY], cwd=root, capture_output=True, text=True, env=env
     )
     assert result.returncode == 0, result.stderr
     return result
