@@ -523,8 +523,16 @@ class SchedulerConfig(draccus.ChoiceRegistry):
             )
         if self.n_min is not None:
             _require_integer(self.n_min, "scheduler.n_min", 0)
-        # The Kalman filter checks p0, P0, Q and R0 with named errors.
-        KalmanSuccessEstimator(1, p0=self.p0, P0=self.P0, Q=self.Q, R0=self.R0)
+        self.new_kalman(1)  # the Kalman filter checks p0, P0, Q and R0 with named errors
+
+    @property
+    def kalman_options(self) -> dict[str, float]:
+        """The Kalman filter's hyperparameters, as an allocation records them."""
+        return {"p0": self.p0, "P0": self.P0, "Q": self.Q, "R0": self.R0}
+
+    def new_kalman(self, num_tasks: int) -> KalmanSuccessEstimator:
+        """A Kalman filter over ``num_tasks`` success rates with this config's hyperparameters."""
+        return KalmanSuccessEstimator(num_tasks, **self.kalman_options)
 
     @classmethod
     def default_choice_name(cls) -> str:
@@ -742,9 +750,6 @@ def scheduler_config_class(method: str) -> type[SchedulerConfig]:
     return SchedulerConfig.get_choice_class(method)
 
 
-METHODS: tuple[str, ...] = scheduling_methods()
-"""The paper's scheduling methods (``scheduling_methods()`` also lists methods registered later)."""
-
 STATE_FORMAT_VERSION = 1
 
 
@@ -879,7 +884,7 @@ class Scheduler:
             )
         self.config = config
         self.method = config.type
-        self.kalman = KalmanSuccessEstimator(num_tasks, p0=config.p0, P0=config.P0, Q=config.Q, R0=config.R0)
+        self.kalman = config.new_kalman(num_tasks)
         self.num_tasks = self.kalman.num_tasks
         self.raw_success = np.full(self.num_tasks, config.p0)
         self.gain = np.zeros(self.num_tasks)
@@ -1009,7 +1014,7 @@ class Scheduler:
             score=score.tolist(),
             probability=probability.tolist(),
             episodes_per_task=counts.tolist(),
-            kalman={"p0": self.config.p0, "P0": self.config.P0, "Q": self.config.Q, "R0": self.config.R0},
+            kalman=self.config.kalman_options,
             notes=_allocation_notes(self.config, self.measured),
             options=self.config.options(),
             history=self.history.to_dict() if reads_demos and self.history.rounds else None,
@@ -1068,9 +1073,7 @@ class Scheduler:
             return np.array([math.nan if v is None else v for v in values], dtype=np.float64)
 
         self.config = type(self.config)(**state["config"])
-        self.kalman = KalmanSuccessEstimator(
-            self.num_tasks, p0=self.config.p0, P0=self.config.P0, Q=self.config.Q, R0=self.config.R0
-        )
+        self.kalman = self.config.new_kalman(self.num_tasks)
         self.kalman.load_snapshot(state["kalman"])
         self.kalman_prior = {"p": list(state["kalman_prior"]["p"]), "P": list(state["kalman_prior"]["P"])}
         self.raw_success = _as_vector(state["raw_success"], "raw_success", self.num_tasks)
@@ -1125,7 +1128,7 @@ def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
     stored = Allocation.from_dict(record)
     config = stored.config()
     num_tasks = len(stored.episodes_per_task)
-    kalman = KalmanSuccessEstimator(num_tasks, p0=config.p0, P0=config.P0, Q=config.Q, R0=config.R0)
+    kalman = config.new_kalman(num_tasks)
     kalman.load_snapshot(stored.kalman_prior)
     if stored.success_rate is not None:
         kalman.update(stored.success_rate, stored.episodes)

@@ -13,7 +13,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from lerobot_mtdagger.scheduler import (
-    METHODS,
     SUCCESS,
     KalmanSuccessEstimator,
     Scheduler,
@@ -27,6 +26,9 @@ from lerobot_mtdagger.scheduler import (
     scheduling_methods,
     softmax,
 )
+
+METHODS = scheduling_methods()
+"""The paper's methods, as registered at import (later tests may register more)."""
 
 # ---------------------------------------------------------------------------------------------
 # Kalman filter

@@ -19,7 +19,6 @@ from lerobot_mtdagger.runner.training.round_data import (
     EPISODE_ID_STRIDE,
     TrainingData,
     load_round,
-    load_rounds,
 )
 from lerobot_mtdagger.runner.training.steps import StepOptions, train_phase
 from lerobot_mtdagger.students.mtdagger import MTDAggerOps, build_processors, per_task_loss
@@ -179,13 +178,12 @@ def toy_rounds(tmp_path_factory):
     return roots
 
 
-def test_load_round_and_concat_give_load_rounds_and_the_former_loader(toy_rounds):
+def test_load_round_and_concat_give_the_former_loader(toy_rounds):
     keys = ["observation.state"]
     parts = [load_round(root, position, keys) for position, root in enumerate(toy_rounds)]
     assert [len(p) for p in parts] == [3 * 2 * 12, 3 * 1 * 9]
     assert parts[1].episode_id.min() == EPISODE_ID_STRIDE
     joined = TrainingData.concat(parts)
-    assert_same_data(joined, load_rounds(toy_rounds, keys))
     assert_same_data(joined, former_load_rounds(toy_rounds, keys))
     assert joined.inputs["observation.state"].is_contiguous()
     joined.action[0] = 0.0  # owned, writable memory (not a read-only Arrow buffer)

@@ -146,6 +146,27 @@ def _from_mapping(cls: type, values: Mapping[str, Any], where: str) -> Any:
     return cls(**{f.name: values[f.name] for f in fields if f.name in values})
 
 
+ALLOCATION_VIEW = (
+    "success_rate",
+    "episodes",
+    "gain",
+    "kalman_prior",
+    "kalman_posterior",
+    "metric",
+    "score",
+    "probability",
+)
+"""The allocation's fields a round record also holds at its top level, for readers of the record."""
+
+
+def allocation_view(allocation: dict[str, Any] | None) -> dict[str, Any]:
+    """A round record's ``ALLOCATION_VIEW`` fields from its allocation (blank in an unscheduled round)."""
+    if allocation is not None:
+        return {key: allocation[key] for key in ALLOCATION_VIEW}
+    blank = {"p": None, "P": None}
+    return {**dict.fromkeys(ALLOCATION_VIEW), "kalman_prior": blank, "kalman_posterior": dict(blank)}
+
+
 @dataclass
 class RoundRecord:
     """The record of one committed round (``meta/info.json["mtdagger"]``).

@@ -67,7 +67,6 @@ DEFAULT_CAMERA = "corner"
 UPSIDE_DOWN_CAMERAS = frozenset({"corner", "corner2", "corner3", "corner4"})
 DEFAULT_POINTCLOUD_CAMERAS: tuple[str, ...] = ("corner", "corner2")
 ACTION_DIM = 4
-STATE_DIM = 39
 
 _OBJECT_NAMES = [f"obj{k}_{axis}" for k in (0, 1) for axis in ("x", "y", "z", "qw", "qx", "qy", "qz")]
 _FRAME_NAMES = ["hand_x", "hand_y", "hand_z", "gripper", *_OBJECT_NAMES]

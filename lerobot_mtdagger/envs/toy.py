@@ -29,7 +29,6 @@ SUCCESS_RADIUS = 0.05
 MAX_EPISODE_STEPS = 40
 START_BOX = 0.3  # starts are uniform in [-START_BOX, START_BOX]^2
 STATE_NAMES = ["x", "y"]
-PRIVILEGED_STATE_NAMES = ["x", "y", "goal_x", "goal_y", "wind_x", "wind_y"]
 ACTION_NAMES = ["push_x", "push_y"]
 
 

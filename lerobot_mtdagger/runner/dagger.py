@@ -50,7 +50,7 @@ import numpy as np
 from tqdm import tqdm
 
 from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
-from lerobot_mtdagger.datasets.records import RoundRecord
+from lerobot_mtdagger.datasets.records import RoundRecord, allocation_view
 from lerobot_mtdagger.envs import suite_from_config
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.runner.configs import RunConfig
@@ -68,7 +68,6 @@ from lerobot_mtdagger.runner.run_setup import (
     beta_for_round,
     check_budget,
     kept_tasks_check,
-    new_scheduler,
     unseen_task_suite,
 )
 from lerobot_mtdagger.runner.run_summary import finished_summary, is_finished, last_round, summary_line
@@ -126,7 +125,7 @@ def schedule_round(ctx: RunContext, round_index: int) -> tuple[Scheduler, Alloca
     """Feeds the scheduler round k-1's rollout success and phase k-1's gain, then allocates."""
     experiment = ctx.experiment
     previous = experiment.read_round_record(round_index - 1)
-    scheduler = new_scheduler(ctx.config, len(ctx.task_names))
+    scheduler = Scheduler(ctx.config.scheduler, len(ctx.task_names))
     if previous.scheduler_state is not None:
         scheduler.load_state_dict(previous.scheduler_state)
     phase = experiment.read_phase_record(round_index - 1)
@@ -236,34 +235,19 @@ def round_record(
         notes = ["round 0: expert demonstrations only, no scheduling and no policy yet"]
         if config.is_bc:
             notes.append("bc: the whole data budget in one round of expert demonstrations")
-        blank = {"p": None, "P": None}
-        unscheduled = dict.fromkeys(
-            ("success_rate", "episodes", "gain", "metric", "score", "probability", "eval_success")
-        )
         return RoundRecord(
             **common,
-            **unscheduled,
-            kalman_prior=blank,
-            kalman_posterior=blank,
+            **allocation_view(None),
+            eval_success=None,
             allocation=None,
             scheduler_state=None,
             notes=notes,
         )
     phase = ctx.experiment.read_phase_record(round_index - 1)
     alloc = allocation.to_dict()
-    copied = (
-        "success_rate",
-        "episodes",
-        "gain",
-        "kalman_prior",
-        "kalman_posterior",
-        "metric",
-        "score",
-        "probability",
-    )
     return RoundRecord(
         **common,
-        **{key: alloc[key] for key in copied},
+        **allocation_view(alloc),
         eval_success=phase.eval["success"] if phase.eval else None,
         allocation=alloc,
         scheduler_state=scheduler.state_dict(),

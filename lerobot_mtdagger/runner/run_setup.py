@@ -12,7 +12,6 @@ from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.rollout.expert_check import EXPERT_CHECK_FILE, ExpertCheck, measure_expert_check
-from lerobot_mtdagger.scheduler import Scheduler
 from lerobot_mtdagger.utils.errors import UserError
 
 logger = logging.getLogger(__name__)
@@ -24,11 +23,6 @@ def beta_for_round(config: RunConfig, round_index: int) -> float:
         return 1.0
     dagger = config.dagger
     return max(dagger.beta - (round_index - 1) * dagger.beta_decay, dagger.beta_min)
-
-
-def new_scheduler(config: RunConfig, num_tasks: int) -> Scheduler:
-    """A fresh scheduler of the run's method (its config class is the run's ``scheduler``)."""
-    return Scheduler(config.scheduler, num_tasks)
 
 
 def check_budget(config: RunConfig, num_tasks: int) -> None:

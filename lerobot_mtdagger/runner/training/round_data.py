@@ -159,16 +159,3 @@ def _decode_images(column: pa.ChunkedArray, root: Path) -> np.ndarray:
         with Image.open(source) as image:
             images.append(np.asarray(image, dtype=np.uint8))
     return np.stack(images)
-
-
-def load_rounds(roots: Sequence[Path], input_keys: Sequence[str]) -> TrainingData:
-    """Loads committed round datasets into memory (``load_round`` each, then ``TrainingData.concat``).
-
-    Args:
-        roots: Round dataset folders, in round order.
-        input_keys: Observation keys the policy reads.
-
-    Returns:
-        The concatenated frames.
-    """
-    return TrainingData.concat([load_round(root, i, input_keys) for i, root in enumerate(roots)])
