@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import subprocess
 import sys
@@ -99,3 +100,26 @@ def lerobot_train(dataset_root: Path, output_dir: Path, steps: int = 20, repo_id
     ]
     subprocess.run(command, check=True, capture_output=True, text=True)
     return output_dir / "checkpoints" / "last" / "pretrained_model"
+
+
+class RecordsHandler(logging.Handler):
+    """Collects the formatted messages it handles."""
+
+    def __init__(self) -> None:
+        super().__init__(level=logging.DEBUG)
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(f"{record.name}: {record.getMessage()}")
+
+
+@pytest.fixture
+def root_records():
+    """A handler on the root logger at INFO for the test; root's level and handlers are restored."""
+    root = logging.getLogger()
+    handler, level = RecordsHandler(), root.level
+    root.addHandler(handler)
+    root.setLevel(logging.INFO)
+    yield handler
+    root.removeHandler(handler)
+    root.setLevel(level)
