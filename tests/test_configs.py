@@ -15,9 +15,9 @@ import pytest
 
 from lerobot_mtdagger.analysis.results import results_rows
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.datasets.config_layout import flatten, option
+from lerobot_mtdagger.datasets.config_layout import flatten
 from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
-from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS, is_flat, migrate_run_config
+from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS, is_flat, migrate_run_config, stored_option
 from lerobot_mtdagger.datasets.verify import verify_experiment
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
@@ -266,7 +266,9 @@ def test_a_flat_config_migrates_into_the_groups():
     assert migrated["policy"] == flat["policy"] and migrated["scheduler"] == flat["scheduler"]
     leaves = flatten(migrated)
     assert {path for old, path in FLAT_OPTION_PATHS.items() if old in flat} <= set(leaves)
-    assert option(flat, "training.sampling") == option(migrated, "training.sampling") == "uniform"
+    assert (
+        stored_option(flat, "training.sampling") == stored_option(migrated, "training.sampling") == "uniform"
+    )
     # Every option of today's config is either a migrated one or one added since (with its default).
     today = flatten(parse("--suite.name=toy").to_dict())
     added = set(today) - set(leaves)

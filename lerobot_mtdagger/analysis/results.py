@@ -29,9 +29,9 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from lerobot_mtdagger.analysis.curves import CurvePoint, RunPoints, average_runs, curve_name
-from lerobot_mtdagger.datasets.config_layout import flatten, option
+from lerobot_mtdagger.datasets.config_layout import flatten
 from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE, SavedRunRecords, open_run
-from lerobot_mtdagger.datasets.migrations import migrate_run_config
+from lerobot_mtdagger.datasets.migrations import migrate_run_config, stored_option
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.utils.errors import UserError
 
@@ -129,7 +129,7 @@ def _row(
         "expert_frames_per_task": None if frames is None else frames.tolist(),
         "eval_success_mean": float(phase.eval_mean),
         "eval_success": [float(s) for s in phase.eval["success"]],
-        "eval_episodes_per_task": int(option(config, "rollout.eval_episodes") or 0),
+        "eval_episodes_per_task": int(stored_option(config, "rollout.eval_episodes") or 0),
         # The signals the scheduler saw after this phase (they decide round k+1's allocation).
         "metric": following.metric if following is not None else None,
         "kalman_p": following.kalman_posterior.get("p") if following is not None else None,
@@ -416,7 +416,7 @@ def run_progress(root: Path) -> RunProgress:
         raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
     experiment = open_run(root)
     config = experiment.read_config()
-    last_phase = 0 if config.get("mode") == "bc" else int(option(config, "dagger.rounds") or 0)
+    last_phase = 0 if config.get("mode") == "bc" else int(stored_option(config, "dagger.rounds") or 0)
     return RunProgress(
         root=Path(root),
         rounds=len(experiment.committed_rounds()),
@@ -481,7 +481,7 @@ def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = 
             raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
         config = open_run(root).read_config()
         is_bc = config.get("mode") == "bc"
-        method = (labels or {}).get(root) or ("bc" if is_bc else option(config, "scheduler.type"))
+        method = (labels or {}).get(root) or ("bc" if is_bc else stored_option(config, "scheduler.type"))
         ignored = PER_RUN_FIELDS + (BC_BUDGET_FIELDS if is_bc else ())
         shared = {
             key: value

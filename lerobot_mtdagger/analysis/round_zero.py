@@ -38,6 +38,7 @@ from lerobot_mtdagger.datasets.experiment_dir import (
     write_record_files,
 )
 from lerobot_mtdagger.datasets.experiment_files import CONFIG_FILE, STAGING_DIR
+from lerobot_mtdagger.datasets.migrations import migrate_run_config
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.utils.errors import UserError
 
@@ -61,7 +62,7 @@ def round_zero_differences(source: Mapping[str, Any], target: Mapping[str, Any])
     theirs, ours = (
         {
             key: value
-            for key, value in result_options(config, ROUND_ZERO_NEUTRAL_OPTIONS).items()
+            for key, value in result_options(migrate_run_config(config), ROUND_ZERO_NEUTRAL_OPTIONS).items()
             if not key.startswith(SCHEDULER_PREFIX)
         }
         for config in (source, target)

@@ -4,16 +4,15 @@
 observations, shared with ``eval``, ``shift`` and the LeRobot env plugin), ``dagger`` (rounds, demo
 budgets, beta), ``rollout`` (episode cuts, evaluation episodes, env workers), ``training``
 (steps, sampling, held-out split), ``policy`` and ``scheduler``. A config stored by an earlier
-version is read through ``migrations.migrate_run_config``, so every reader (resume, results, the
-Hub card) sees one layout.
+version is first read through ``migrations.migrate_run_config`` (``migrations.stored_option`` reads one
+option of a stored config in either layout), so every reader (resume, results, the Hub card) sees one
+layout; this module knows only today's.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from typing import Any
-
-from lerobot_mtdagger.datasets.migrations import is_flat, migrate_run_config
 
 
 def flatten(config: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -26,16 +25,6 @@ def flatten(config: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
         else:
             leaves[path] = value
     return leaves
-
-
-def option(config: Mapping[str, Any], path: str, default: Any = None) -> Any:
-    """The option at dotted ``path`` of a stored config in either layout (``default`` when absent)."""
-    node: Any = migrate_run_config(config) if is_flat(config) else config
-    for part in path.split("."):
-        if not isinstance(node, Mapping) or part not in node:
-            return default
-        node = node[part]
-    return node
 
 
 RESULT_NEUTRAL_OPTIONS: tuple[str, ...] = (
@@ -53,5 +42,8 @@ RESULT_NEUTRAL_OPTIONS: tuple[str, ...] = (
 
 
 def result_options(config: Mapping[str, Any], ignore: Sequence[str]) -> dict[str, Any]:
-    """A run config's leaves by dotted path, without the options in ``ignore`` (compared on resume)."""
-    return {key: value for key, value in flatten(migrate_run_config(config)).items() if key not in ignore}
+    """A run config's leaves by dotted path, without the options in ``ignore`` (compared on resume).
+
+    ``config`` is in today's layout (a stored one through ``migrations.migrate_run_config`` first).
+    """
+    return {key: value for key, value in flatten(config).items() if key not in ignore}

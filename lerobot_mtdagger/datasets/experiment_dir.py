@@ -340,8 +340,8 @@ class ExperimentDir:
                 f"Nothing to resume: {self.root} does not exist (drop --resume to start)."
             )
         stored_config = self.read_config()
-        stored = result_options(stored_config, ignore)
-        given = result_options(config, ignore)
+        stored = result_options(migrate_run_config(stored_config), ignore)
+        given = result_options(migrate_run_config(config), ignore)
         fill_added_options(stored, given, added_defaults or {})
         if adds_dagger_rounds(stored, given):
             stored[ROUNDS_OPTION] = given[ROUNDS_OPTION]

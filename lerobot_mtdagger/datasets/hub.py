@@ -33,8 +33,8 @@ from typing import Any
 
 from huggingface_hub import DatasetCardData, HfApi
 
-from lerobot_mtdagger.datasets.config_layout import option
 from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE, ExperimentDir, round_name
+from lerobot_mtdagger.datasets.migrations import stored_option
 from lerobot_mtdagger.datasets.push_config import PushConfig
 from lerobot_mtdagger.datasets.records import PhaseRecord, RoundRecord
 from lerobot_mtdagger.datasets_cards import card_template
@@ -167,8 +167,8 @@ def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: in
         "repo_id": repo_id,
         "round": str(last),
         "revision": round_name(last),
-        "suite": str(option(config, "suite.name", NOT_AVAILABLE)),
-        "obs_mode": str(option(config, "suite.obs_mode", NOT_AVAILABLE)),
+        "suite": str(stored_option(config, "suite.name", NOT_AVAILABLE)),
+        "obs_mode": str(stored_option(config, "suite.obs_mode", NOT_AVAILABLE)),
         "method": str(latest.method),
         "temperature": str(latest.temperature),
         "n_min": str(latest.n_min),

@@ -248,6 +248,16 @@ def migrate_run_config(config: Mapping[str, Any]) -> dict[str, Any]:
     return migrated
 
 
+def stored_option(config: Mapping[str, Any], path: str, default: Any = None) -> Any:
+    """The option at dotted ``path`` of a stored config in either layout (``default`` when absent)."""
+    node: Any = migrate_run_config(config) if is_flat(config) else config
+    for part in path.split("."):
+        if not isinstance(node, Mapping) or part not in node:
+            return default
+        node = node[part]
+    return node
+
+
 def former_option_values() -> dict[str, Any]:
     """What each option a migration added was before it existed, by dotted path."""
     values: dict[str, Any] = {}
