@@ -1,19 +1,14 @@
 """Experts named on the command line: ``--expert.path`` (LeRobot policy folders) and ``--expert.type``.
 
-The paper's experts are RL policies trained on the privileged state. Such a policy, saved as a
-LeRobot pretrained model folder whose ``observation.state`` input is the suite's privileged state,
-labels a run's frames with::
+::
 
     lerobot-mtdagger run --expert.path=experts/            # experts/<task>/: one policy per task
     lerobot-mtdagger run --expert.path=experts/multitask   # one policy for every task (task string in)
 
-A folder holding ``config.json`` is one multitask policy (it is handed each episode's task string, as
-LeRobot hands a policy ``observation["task"]``); otherwise every task of the suite needs a policy
-folder named after it inside. ``--expert.type`` names an expert factory ``factory(suite, task) ->
-Expert``: one registered with :func:`register_expert_type`, or an importable ``module:attribute``.
-Both are checked before anything is written: a folder that is not a policy, a policy whose input
-does not match the suite's privileged state, a task without an expert, an unknown type, each get one
-line naming the fix.
+A folder holding ``config.json`` is one multitask policy (handed each episode's task string); otherwise
+every task needs a policy folder named after it inside, whose ``observation.state`` input is the
+suite's privileged state. ``--expert.type`` names a factory ``factory(suite, task) -> Expert``
+(:func:`register_expert_type`, or ``module:attribute``). Both are checked before anything is written.
 """
 
 from __future__ import annotations
