@@ -96,11 +96,7 @@ def make_suite(
 
 
 def suite_from_config(config: SuiteConfig, **overrides: Any) -> TaskSuite:
-    """The suite a ``SuiteConfig`` names, after importing its ``module`` (``overrides``: of ``make_suite``).
-
-    Raises:
-        UserError: On an unknown suite or module, task or observation setting (one line, naming the option).
-    """
+    """The suite a ``SuiteConfig`` names, after importing its ``module`` (``UserError``: one line)."""
     if config.name is None:
         raise UserError("No suite given: pass --suite.name (e.g. --suite.name=metaworld-mt10).")
     config.check()

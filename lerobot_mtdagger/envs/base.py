@@ -115,11 +115,7 @@ class TaskSuite(abc.ABC):
     """Key of the suite's experts in the expert registry (``lerobot_mtdagger.experts``)."""
 
     def __init__(self, task_names: Sequence[str], observation: ObservationConfig) -> None:
-        """Stores the task order and the observation settings.
-
-        Raises:
-            ValueError: On an empty or duplicated task list.
-        """
+        """Stores the task order and observation settings (``ValueError`` on an empty or duplicated list)."""
         task_names = list(task_names)
         if not task_names:
             raise ValueError(f"Suite {self.name!r} needs at least one task.")
@@ -147,11 +143,7 @@ class TaskSuite(abc.ABC):
         return None
 
     def nearest_training_task(self, task_name: str, training_tasks: Sequence[str]) -> str:
-        """The training task most like the unseen ``task_name``, whose task input a policy may act with.
-
-        Raises:
-            UserError: Always here; a suite with a notion of task likeness (the drawers) overrides it.
-        """
+        """The training task most like the unseen ``task_name`` (a ``UserError`` here; drawers override)."""
         raise UserError(
             f"Suite {self.name!r} has no rule for the training task most like {task_name!r}: evaluate "
             "it with --unseen_rule=shared (a policy trained with --policy.task_dropout > 0)."

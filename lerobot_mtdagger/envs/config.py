@@ -24,7 +24,7 @@ class SuiteConfig:
     """A task suite and its observations.
 
     Attributes:
-        name: A registered suite name (``metaworld-mt10``, ``drawers``, ``toy``, ... or one ``module``
+        name: A registered suite name (``metaworld-mt10``, ``drawers``, ``toy``, ..., or one that ``module``
             registers). None: the command's default.
         tasks: Subset of the suite's tasks (all when empty; ``eval`` and ``shift`` also take
             ``heldout``: the suite's unseen tasks).
@@ -33,7 +33,8 @@ class SuiteConfig:
         image_size: Image side (rgb mode). None: 84 (``eval``: the policy's).
         mesh_detail: Share of the arm meshes' faces the observation renderer keeps, in (0, 1] (1: the
             exact model; 0.2 renders about twice as fast on a CPU).
-        placement: ``drawers`` only: how resets move and recolour the drawers (None: ``kitchen``).
+        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when None, or
+            ``narrow``).
         episode_length: Steps after which an episode is truncated (None: each task's own horizon).
         module: A module imported first that registers suites from outside the package, e.g.
             ``my_package.suites``.

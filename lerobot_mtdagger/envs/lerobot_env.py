@@ -6,11 +6,10 @@ Usage::
         --env.discover_packages_path=lerobot_mtdagger.envs --env.type=mtdagger_suite \
         --env.suite.name=metaworld-mt10 --env.task=reach-v3 --eval.n_episodes=10 --eval.batch_size=1
 
-The type name avoids "metaworld", which LeRobot routes to its own MetaWorld code. The env emits
-``agent_pos``, ``pixels`` and, for the point cloud, ``environment_state`` (the keys LeRobot keeps):
-evaluate a point-cloud policy with
-``--rename_map='{"observation.environment_state": "observation.pointcloud"}'``. The task name is
-handed to the policy as ``observation["task"]``; episodes end at the first success.
+The type name avoids "metaworld", which LeRobot routes to its own code. A point cloud arrives as
+``environment_state`` (the keys LeRobot keeps): evaluate a point-cloud policy with
+``--rename_map='{"observation.environment_state": "observation.pointcloud"}'``. Episodes end at
+the first success.
 """
 
 from __future__ import annotations

@@ -1,13 +1,9 @@
 """MetaWorld 3.1 (v3 environments) as multitask suites with state, RGB and point-cloud observations.
 
-- ``state``: MetaWorld's 39-d goal-visible vector (also the expert's privileged state).
-- ``rgb``: ``observation.image`` from ``camera`` and ``observation.state`` = hand xyz + gripper
-  opening (+ goal xyz with ``include_goal``: many goals are not drawn in the scene).
-- ``pointcloud``: ``observation.pointcloud`` ((num_points, 3) float32, world frame, metres) from
-  the ``corner`` and ``corner2`` depth cameras, cropped to the workspace, and the same state as ``rgb``.
-
-A seeded reset reproduces the initial object and goal positions. MetaWorld's success does not
-persist; an episode succeeds if ``info["success"]`` was true at any step.
+``state`` is MetaWorld's 39-d goal-visible vector (the expert's privileged state); ``rgb`` and
+``pointcloud`` add the image or the cropped world-frame cloud of the ``corner``/``corner2`` depth
+cameras to hand xyz + gripper opening (+ goal with ``include_goal``). Seeded resets reproduce the
+initial positions; an episode succeeds if ``info["success"]`` was true at any step.
 """
 
 from __future__ import annotations

@@ -1,13 +1,11 @@
 """The suite registry: which factory builds the suite of a name.
 
-A factory ``factory(options: SuiteOptions) -> TaskSuite`` is registered as a callable or a
-``"module:attribute"`` entry point imported on first use (the built-in suites are, so the toy suite
-never imports MuJoCo)::
+A factory ``factory(options: SuiteOptions) -> TaskSuite`` is registered as a callable or a lazily
+imported ``"module:attribute"`` (so the toy suite never imports MuJoCo)::
 
     register_suite("my-suite", lambda options: MySuite(options.tasks or MY_TASKS, options.observation))
 
-``--suite.module`` imports a module that registers suites; installed packages register by entry
-point (group ``lerobot_mtdagger.suites``).
+Installed packages register by entry point (group ``lerobot_mtdagger.suites``).
 """
 
 from __future__ import annotations

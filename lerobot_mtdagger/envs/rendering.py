@@ -1,11 +1,8 @@
 """Offscreen MuJoCo observations: RGB frames and point clouds from depth cameras.
 
-Observation cameras render without shadows, reflections, multisampling or a shadow map: each
-halves a CPU frame's cost or a renderer's memory and none helps a policy (``docs/benchmarks.md``).
-
-Point clouds: render metric depth per camera, back-project each pixel with the camera's pinhole
-intrinsics and pose into the world frame, keep the points inside the suite's ``CropBox`` (no table,
-floor or background), and sample ``num_points`` with the env's seeded generator.
+Observation cameras render without shadows, reflections, multisampling or shadow map (cheaper on a
+CPU, ``docs/benchmarks.md``). A cloud is each camera's metric depth back-projected into the world
+frame, cropped to the suite's ``CropBox`` and sampled to ``num_points`` with the env's generator.
 """
 
 from __future__ import annotations
@@ -61,11 +58,7 @@ class SceneRenderer:
     """
 
     def __init__(self, model: mujoco.MjModel, height: int, width: int, multisamples: int = 0) -> None:
-        """Prepares a renderer at ``height`` x ``width`` pixels with ``multisamples`` anti-aliasing samples.
-
-        Raises:
-            ValueError: If the size exceeds the model's offscreen buffer.
-        """
+        """Prepares a ``height`` x ``width`` renderer (``ValueError`` beyond the model's offscreen buffer)."""
         if height <= 0 or width <= 0:
             raise ValueError(f"Render size must be positive, got {height}x{width}.")
         offwidth, offheight = model.vis.global_.offwidth, model.vis.global_.offheight

@@ -1,9 +1,8 @@
 """A toy multitask suite without MuJoCo: a point mass pushed to a task-specific goal under wind.
 
-For tests: every part of the DAgger chain runs on it in seconds. The point starts in ``START_BOX``,
-moves by ``STEP_SIZE * clip(action, -1, 1) + wind`` and succeeds within ``SUCCESS_RADIUS`` of the
-goal. The policy sees only the position, so it must use the task; the expert sees position, goal
-and wind and is optimal. A learner that outputs zeros drifts with the wind and never succeeds.
+For tests: the whole DAgger chain runs on it in seconds. The policy sees only the position, so it
+must use the task; the expert sees goal and wind too and is optimal; a learner that outputs zeros
+drifts with the wind and never succeeds.
 """
 
 from __future__ import annotations
@@ -113,11 +112,7 @@ class ToySuite(TaskSuite):
         max_episode_steps: int | None = None,
         tasks: Sequence[ToyTask] = (),
     ) -> None:
-        """Selects the suite's tasks (of ``TOY_TASKS`` or the extra ``tasks``) in ``state`` mode.
-
-        Raises:
-            ValueError: On an unknown task or a mode other than ``state``.
-        """
+        """Selects the tasks, of ``TOY_TASKS`` or ``tasks`` (``ValueError`` if unknown, or not ``state``)."""
         if observation.obs_mode != "state":
             raise ValueError(
                 f"The toy suite has state observations only, got obs_mode={observation.obs_mode!r}."

@@ -95,11 +95,7 @@ class ActionCheckedExpert:
     """Checks an expert's output: a finite vector of the task's action size."""
 
     def __init__(self, expert: Expert, task_name: str, action_dim: int) -> None:
-        """Wraps ``expert``.
-
-        Raises:
-            TypeError: If ``expert`` lacks ``reset``/``act``.
-        """
+        """Wraps ``expert`` (``TypeError`` if it lacks ``reset``/``act``)."""
         if not isinstance(expert, Expert):
             raise TypeError(
                 f"The expert for {task_name!r} is a {type(expert).__name__} without reset() and "
@@ -115,11 +111,7 @@ class ActionCheckedExpert:
         self.expert.reset()
 
     def act(self, privileged_state: np.ndarray) -> np.ndarray:
-        """Returns the wrapped expert's action after checking it.
-
-        Raises:
-            ValueError: On a wrong action size or a non-finite action.
-        """
+        """The wrapped expert's action, checked (``ValueError`` on a wrong size or a non-finite value)."""
         action = np.asarray(self.expert.act(privileged_state), dtype=np.float32).reshape(-1)
         if action.shape != (self.action_dim,):
             raise ValueError(

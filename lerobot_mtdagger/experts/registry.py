@@ -35,11 +35,7 @@ EXPERTS: Registry[ExpertFactory] = Registry(
 
 
 def register_expert(suite_family: str, factory: ExpertFactory | str, task: str = ANY_TASK) -> None:
-    """Registers (or replaces) the expert factory of a suite family's task (``ANY_TASK``: every task).
-
-    Raises:
-        TypeError: If ``factory`` is neither callable nor an entry-point string.
-    """
+    """Registers (or replaces) a family's task's expert factory (``TypeError``: not callable or a string)."""
     EXPERTS.register((suite_family, task), factory, replace=True)
 
 
@@ -48,11 +44,7 @@ for _family in ("metaworld", "drawers", "toy"):
 
 
 def make_expert(suite: Any, task_name: str) -> ActionCheckedExpert:
-    """The expert of one task (or held-out task) of ``suite``, action-size checked.
-
-    Raises:
-        ValueError: If the suite does not build the task or no expert is registered for it.
-    """
+    """The action-checked expert of a task of ``suite`` (``ValueError``: not built, or no expert)."""
     suite.check_buildable(task_name)
     expert = suite.expert_overrides.get(task_name)
     if expert is None:

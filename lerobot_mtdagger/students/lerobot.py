@@ -1,16 +1,9 @@
 """LeRobot's own policies (ACT, Diffusion Policy) as the DAgger student: config, batches, losses.
 
-``LeRobotOps`` implements the runner's training seam (``steps.phase_ops``) for any LeRobot
-``PreTrainedPolicy`` from what it declares:
-
-- **Windows of frames**, as ``delta_timestamps`` give them: the observation history
-  (``observation_delta_indices``) and the action chunk (``action_delta_indices``) within the frame's
-  episode, clamped at its ends, with ``action_is_pad`` past them.
-- **The task** as a one-hot ``observation.environment_state`` (``policies.task_conditioning``),
-  zeroed with probability ``task_dropout`` in training.
-- **The loss** is the policy's own ``forward`` loss; the per-task loss is the same, measured without
-  gradients under a fixed seed so the same weights always measure the same.
-- **The optimiser and scheduler** are the config's presets, as ``lerobot-train`` builds them.
+``LeRobotOps`` implements the runner's training seam for any LeRobot ``PreTrainedPolicy``: frame
+windows as ``delta_timestamps`` give them (history and action chunk within the episode, with
+``action_is_pad``), the task as a one-hot ``observation.environment_state`` (zeroed by task dropout),
+the policy's own ``forward`` loss (per task under a fixed seed) and its config's optimiser presets.
 """
 
 from __future__ import annotations
@@ -72,11 +65,7 @@ class LeRobotStudentConfig:
 def lerobot_student_config(
     options: Any, suite_features: dict[str, Any], task_names: Sequence[str], task_dropout: float
 ) -> LeRobotStudentConfig:
-    """The LeRobot student of a run's ``--policy.type=act|diffusion`` options for a suite.
-
-    Raises:
-        ValueError: If the policy refuses the features (LeRobot's own check names what is missing).
-    """
+    """The LeRobot student of a run's options for a suite (``ValueError`` if the policy refuses them)."""
     config = lerobot_policy_config(options)
     features = dataset_to_policy_features(suite_features)
     config.input_features = {k: f for k, f in features.items() if f.type is not FeatureType.ACTION}
@@ -235,11 +224,7 @@ class LeRobotStudent(Student):
         return {"type": self.name, "batch_size": options.batch_size, **encoded}
 
     def check_run(self, config: Any) -> None:
-        """Refuses point clouds, temporal ensembling, ``lr_schedule`` and ``UNSUPPORTED_STUDENT_OPTIONS``.
-
-        Raises:
-            ValueError: Naming the option and the fix.
-        """
+        """Refuses point clouds, temporal ensembling, ``lr_schedule``, unsupported options: ``ValueError``."""
         for name, reason in UNSUPPORTED_STUDENT_OPTIONS.items():
             if getattr(config.policy, name, None) not in (None, False):
                 raise ValueError(f"--policy.{name} is not supported by run: {reason}; drop the option.")

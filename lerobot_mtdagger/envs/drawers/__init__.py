@@ -1,16 +1,11 @@
 """A procedurally generated drawer-opening suite on MetaWorld's Sawyer arena (``docs/drawers.md``).
 
-The paper opens 11 drawers in IsaacLab from point clouds and tests on an unseen one. Here each drawer
-is a ``DrawerVariant`` turned into MJCF at run time and placed on MetaWorld's table (same arm, 4-d
-action, cameras and renderer as the MetaWorld suites): a case and a drawer on a slide joint with a
-``bar``, ``knob``, ``lip`` or ``vbar`` handle. Success: open by ``SUCCESS_FRACTION`` of the travel;
-``info["progress"]`` is the paper's 0-3 real-robot score. Each reset places the case by the suite's
-``placement`` (``PLACEMENTS``).
-
-Modules: ``variants`` (``DrawerVariant``, constants, ``DRAWER_STATE_NAMES``), ``catalogue`` (the
-drawers), ``mjcf`` (MJCF text), ``scene`` (the MuJoCo env), ``suite`` (``DrawerSuite``), ``pictures``.
-The names a user needs are importable from here, lazily, so importing ``variants`` or ``catalogue``
-(as the drawer expert does) loads neither MuJoCo nor MetaWorld.
+Each drawer is a ``DrawerVariant`` turned into MJCF at run time: a case and a drawer on a slide joint
+with a ``bar``, ``knob``, ``lip`` or ``vbar`` handle, placed on MetaWorld's table by the suite's
+``placement``. Success: open by ``SUCCESS_FRACTION`` of the travel; ``info["progress"]`` is the paper's
+0-3 score. Modules: ``variants``, ``catalogue``, ``mjcf``, ``scene``, ``suite``, ``pictures``. The
+names a user needs are importable from here, lazily, so ``variants`` and ``catalogue`` (which the
+drawer expert imports) load neither MuJoCo nor MetaWorld.
 """
 
 from __future__ import annotations

@@ -121,11 +121,7 @@ class DrawerSceneEnv(SawyerXYZEnv):
         return self.surface_distance(points, sorted(self._handle_geoms))
 
     def surface_distance(self, points: np.ndarray, geoms: Sequence[int | str]) -> np.ndarray:
-        """Distance of each world point (N, 3+) to the nearest of some box/capsule/cylinder geoms, (N,).
-
-        Raises:
-            ValueError: On a geom of another type.
-        """
+        """Distance of each world point (N, 3+) to the nearest box/capsule/cylinder of ``geoms``, (N,)."""
         points = np.asarray(points, dtype=np.float64)[:, :3]
         distances = np.full(points.shape[0], np.inf)
         for geom in (self.model.geom(g).id for g in geoms):

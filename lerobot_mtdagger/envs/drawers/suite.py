@@ -119,11 +119,7 @@ class DrawerSuite(TaskSuite):
         )
 
     def nearest_training_task(self, task_name: str, training_tasks: Sequence[str]) -> str:
-        """The training drawer whose handle is most like the unseen ``task_name``'s (``nearest_variant``).
-
-        Raises:
-            UserError: If none of ``training_tasks`` has the unseen drawer's handle type.
-        """
+        """The training drawer whose handle is most like the unseen ``task_name``'s (``UserError``: none)."""
         variant = self.variants[task_name]
         known = [self.variants[name] for name in training_tasks if name in self.variants]
         nearest = nearest_variant(variant, known)

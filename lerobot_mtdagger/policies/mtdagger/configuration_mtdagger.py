@@ -138,12 +138,7 @@ class MTDAggerConfig(PreTrainedConfig):
         return {key: ft for key, ft in (self.input_features or {}).items() if is_pointcloud_feature(key, ft)}
 
     def validate_features(self) -> None:
-        """Checks the configured inputs and outputs.
-
-        Raises:
-            ValueError: With no usable input, no ``action`` output, a state that is not 1-D, or an empty
-                task vocabulary.
-        """
+        """Checks inputs and outputs (``ValueError``: no input, no ``action``, a state not 1-D, no tasks)."""
         if not (self.vector_features or self.image_features or self.pointcloud_features):
             raise ValueError(
                 "MTDAggerConfig has no input feature: give it observation.state, an observation.image* or an "

@@ -219,11 +219,7 @@ class MTDAggerPolicy(PreTrainedPolicy):
         self.head = mlp(fused, config.head_hidden_dims, action_dim, dropout=config.dropout)
 
     def _migrate_checkpoint(self, state_dict: dict[str, Tensor], prefix: str, *args: Any) -> None:
-        """Renames, in place, a checkpoint's weights from encoders not keyed by input to ``encoders.<key>``.
-
-        Raises:
-            ValueError: On a checkpoint whose one state MLP read several vector inputs concatenated.
-        """
+        """Renames a checkpoint's weights in place to ``encoders.<key>`` (``ValueError`` if unmappable)."""
         renames: dict[str, list[str]] = {}
         if any(name.startswith(f"{prefix}state_encoder.") for name in state_dict):
             if len(self.vector_keys) != 1:
@@ -246,11 +242,7 @@ class MTDAggerPolicy(PreTrainedPolicy):
     # ---------------------------------------------------------------------------------------------
 
     def task_indices(self, batch: dict[str, Any]) -> Tensor:
-        """Task index per sample: from the ``task`` strings when present (authoritative), else ``task_index``.
-
-        Raises:
-            ValueError: On a task string not in ``config.task_names`` or no task information at all.
-        """
+        """Task index per sample, from ``task`` strings or ``task_index`` (``ValueError``: unknown, none)."""
         device = self.task_embedding.weight.device
         tasks = batch.get(TASK_KEY)
         if tasks is not None:
