@@ -1,27 +1,11 @@
 """Task suites with state, RGB and point-cloud observations.
 
-``make_suite(name, tasks=None, observation=ObservationConfig(...), ...)`` builds the suite registered
-under ``name`` (``registry``); the package registers these:
-
-==================  =====================================================================
-name                tasks
-==================  =====================================================================
-metaworld-mt10      MetaWorld's MT10 list (v3 envs)
-metaworld-mt25      MetaWorld's MT25 list
-metaworld-mt50      MetaWorld's MT50 list (all v3 tasks)
-metaworld           any explicit ``tasks=[...]`` list of v3 task names
-drawers             the 11 procedurally generated training drawers (``envs/drawers/``);
-                    ``suite.heldout_task_names`` are unseen drawers the suite also builds
-toy                 a point mass pushed to task-specific goals (``envs/toy.py``): no MuJoCo,
-                    state only, for fast tests
-==================  =====================================================================
-
-``register_suite(name, factory)`` adds a suite (``docs/suites.md``: "Add a suite");
-``suite_from_config(config)`` builds the suite a ``SuiteConfig`` names (``run``, ``eval``, ``shift``
-and the LeRobot env plugin each hold one: ``envs/config.py``), after importing its ``module``.
-
-``tasks=[...]`` with a named list selects a subset in the given order. Rendering uses MuJoCo's EGL
-backend unless ``MUJOCO_GL`` is already set (``osmesa`` is the fallback without EGL).
+``make_suite(name, tasks=None, observation=ObservationConfig(...))`` builds a registered suite:
+``metaworld-mt10``/``-mt25``/``-mt50`` (MetaWorld's lists), ``metaworld`` (any ``tasks=[...]`` of v3
+names), ``drawers`` (11 generated drawers and unseen ones, ``envs/drawers/``) and ``toy`` (a point
+mass, no MuJoCo, for fast tests). ``register_suite`` adds one (``docs/suites.md``); a ``SuiteConfig``
+(``envs/config.py``) names one for ``suite_from_config``. Rendering uses MuJoCo's EGL backend unless
+``MUJOCO_GL`` is set (``osmesa`` without EGL).
 """
 
 from __future__ import annotations
@@ -92,15 +76,11 @@ def make_suite(
     """Builds a registered task suite.
 
     Args:
-        name: A registered suite name (``suite_names()``; the package's are ``SUITE_NAMES``).
-        tasks: Task subset (any order); required for ``metaworld``, optional for the named lists.
-        observation: What the envs show the policy (None: ``ObservationConfig()``, state).
-        max_episode_steps: Truncation length (the task's max path length when None).
-        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen``, the
-            default, or ``narrow``; see ``lerobot_mtdagger.envs.drawers.PLACEMENTS``).
-
-    Returns:
-        The suite.
+        name: A registered suite name (``suite_names()``).
+        tasks: Task subset in the given order; required for ``metaworld``, optional for the named lists.
+        observation: What the envs show the policy (None: state).
+        max_episode_steps: Truncation length (None: each task's own horizon).
+        placement: ``drawers`` only: how resets move and recolour the drawers (``PLACEMENTS``).
 
     Raises:
         ValueError: On an unknown suite, task or observation setting.
@@ -116,17 +96,7 @@ def make_suite(
 
 
 def suite_from_config(config: SuiteConfig, **overrides: Any) -> TaskSuite:
-    """The suite a ``SuiteConfig`` names (unset observation options at their defaults).
-
-    Its ``module`` (``--suite.module``) is imported first, so that the suites it registers are known.
-
-    Args:
-        config: The command's suite options.
-        **overrides: ``make_suite`` keyword arguments that replace the config's.
-
-    Raises:
-        UserError: On an unknown suite or module, task or observation setting (one line, naming the option).
-    """
+    """The suite a ``SuiteConfig`` names, after importing its ``module`` (``UserError``: one line)."""
     if config.name is None:
         raise UserError("No suite given: pass --suite.name (e.g. --suite.name=metaworld-mt10).")
     config.check()

@@ -1,17 +1,9 @@
-"""The task-suite interface shared by the MetaWorld and drawer suites.
+"""The task-suite interface shared by the MetaWorld, drawer and toy suites.
 
-A suite is a fixed, ordered list of tasks (task index i is ``task_names[i]`` everywhere: datasets,
-policy config, scheduler), plus:
-
-- ``make_env(task_name, seed=None)``: a gymnasium env whose observations are dicts keyed by LeRobot
-  feature names (``observation.state`` always, ``observation.image`` in ``rgb`` mode,
-  ``observation.pointcloud`` in ``pointcloud`` mode); ``info["success"]`` at every step and
-  ``info["privileged_state"]``, the low-dimensional state the expert acts on;
-- ``expert_family``: the key under which experts register for the suite's tasks
-  (``lerobot_mtdagger.experts.make_expert(suite, task)`` gives a task's expert; ``with_experts``
-  replaces some; suites never import experts);
-- ``features``: the LeRobot feature dict of what the suite emits plus ``action``;
-- ``make_vector_env(task_names, seeds)``: several tasks' envs stepped in parallel processes.
+A suite is a fixed, ordered list of tasks (task index i is ``task_names[i]`` everywhere). Its envs
+emit dicts keyed by LeRobot feature names (``observation.state``, ``observation.image``,
+``observation.pointcloud``) and put ``success`` and ``privileged_state`` (what the expert acts on) in
+``info``; ``expert_family`` keys its experts in ``lerobot_mtdagger.experts``.
 """
 
 from __future__ import annotations
@@ -37,12 +29,7 @@ POINTCLOUD_KEY = "observation.pointcloud"
 
 @dataclass(frozen=True)
 class CropBox:
-    """Axis-aligned box in world coordinates (metres) that keeps the workspace.
-
-    Attributes:
-        low: (x, y, z) lower corner.
-        high: (x, y, z) upper corner.
-    """
+    """Axis-aligned box in world coordinates (metres) that keeps the workspace; corners are (x, y, z)."""
 
     low: tuple[float, float, float]
     high: tuple[float, float, float]
@@ -62,8 +49,7 @@ class CropBox:
     def contains_planes(self, planes: np.ndarray) -> np.ndarray:
         """Boolean mask (...) of the points given as coordinate planes ``planes`` (3, ...) inside the box.
 
-        One comparison per face on each (contiguous) plane: several times faster than comparing
-        (N, 3) rows for the back-projected depth images of a point-cloud camera.
+        Several times faster than comparing (N, 3) rows for a depth camera's back-projected images.
         """
         inside = (planes[0] >= self.low[0]) & (planes[0] <= self.high[0])
         for axis in (1, 2):
@@ -85,16 +71,14 @@ class ObservationConfig:
         obs_mode: ``state``, ``rgb`` or ``pointcloud``.
         image_size: Side of the square RGB image in ``rgb`` mode, pixels.
         camera: Camera of the RGB image.
-        num_points: Points per cloud in ``pointcloud`` mode (the paper uses 4096; smaller on CPU).
+        num_points: Points per cloud in ``pointcloud`` mode.
         pointcloud_cameras: Depth cameras fused into the cloud (None: the suite's default).
         depth_size: Side of the square depth images behind the cloud, pixels.
         pointcloud_color: Append per-point RGB in [0, 1] (cloud shape (num_points, 6)).
-        crop: Workspace box of the cloud in world coordinates (None: the suite's default).
-        include_goal: In ``rgb`` and ``pointcloud`` modes, append the goal position to the
-            proprioceptive state (many MetaWorld goals are invisible in the scene).
-        mesh_detail: Share of the faces the observation renderer keeps of each large mesh (the
-            Sawyer arm's 67 k triangles are 85% of a depth frame's cost on a CPU); 1 renders the
-            model as it is (``rendering.simplified_model``).
+        crop: Workspace box of the cloud (None: the suite's default).
+        include_goal: In ``rgb`` and ``pointcloud`` modes, append the goal position to the state.
+        mesh_detail: Share of each large mesh's faces the observation renderer keeps (1: the exact
+            model; ``rendering.simplified_model``).
     """
 
     obs_mode: str = "state"
@@ -131,11 +115,7 @@ class TaskSuite(abc.ABC):
     """Key of the suite's experts in the expert registry (``lerobot_mtdagger.experts``)."""
 
     def __init__(self, task_names: Sequence[str], observation: ObservationConfig) -> None:
-        """Stores the task order and the observation settings.
-
-        Raises:
-            ValueError: On an empty or duplicated task list.
-        """
+        """Stores the task order and observation settings (``ValueError`` on an empty or duplicated list)."""
         task_names = list(task_names)
         if not task_names:
             raise ValueError(f"Suite {self.name!r} needs at least one task.")
@@ -163,22 +143,14 @@ class TaskSuite(abc.ABC):
         return None
 
     def nearest_training_task(self, task_name: str, training_tasks: Sequence[str]) -> str:
-        """The training task most like the unseen ``task_name``, whose task input a policy may act with.
-
-        Raises:
-            UserError: Always here: a suite without a notion of task likeness (the drawers have one).
-        """
+        """The training task most like the unseen ``task_name`` (a ``UserError`` here; drawers override)."""
         raise UserError(
             f"Suite {self.name!r} has no rule for the training task most like {task_name!r}: evaluate "
             "it with --unseen_rule=shared (a policy trained with --policy.task_dropout > 0)."
         )
 
     def task_index(self, task_name: str) -> int:
-        """Index of ``task_name`` in ``task_names``.
-
-        Raises:
-            ValueError: If the task is not in the suite.
-        """
+        """Index of ``task_name`` in ``task_names``; a ``ValueError`` if it is not in the suite."""
         if task_name not in self.task_names:
             raise ValueError(
                 f"Task {task_name!r} is not in suite {self.name!r}; its tasks: {self.task_names}."
@@ -190,11 +162,7 @@ class TaskSuite(abc.ABC):
         """Builds the env of one task; ``seed`` seeds its first reset."""
 
     def check_buildable(self, task_name: str) -> None:
-        """Checks that the suite builds ``task_name``: one of its tasks or of its held-out tasks.
-
-        Raises:
-            ValueError: Otherwise.
-        """
+        """Checks that the suite builds ``task_name`` (a task or a held-out one); ``ValueError`` otherwise."""
         if task_name not in self.task_names and task_name not in self.heldout_task_names:
             raise ValueError(
                 f"Task {task_name!r} is neither a task of suite {self.name!r} {self.task_names} nor held out "
@@ -202,9 +170,7 @@ class TaskSuite(abc.ABC):
             )
 
     def with_experts(self, experts: dict[str, Any]) -> TaskSuite:
-        """A copy of the suite with the expert of some tasks replaced (for example by RL policies).
-
-        ``lerobot_mtdagger.experts.make_expert`` returns these instead of the registered experts.
+        """A copy of the suite whose ``make_expert`` gives these experts for some tasks (e.g. RL policies).
 
         Raises:
             ValueError: On a task not in the suite.
@@ -233,11 +199,7 @@ class TaskSuite(abc.ABC):
         """Size of the action vector."""
 
     def with_expert_noise(self, noise: Any) -> TaskSuite:
-        """A copy of the suite whose experts act with ``noise`` (``experts.noise.ExpertNoise``).
-
-        The rollout workers add it to every expert action they execute
-        (``runner/rollout/rollout_worker.py``); None, or a noise of scale 0, leaves the experts as they are.
-        """
+        """A copy of the suite whose experts act with ``noise`` (``ExpertNoise``; None or scale 0: none)."""
         clone = self.with_observation()
         clone.expert_noise = noise if noise is not None and noise.active else None
         return clone
@@ -254,14 +216,8 @@ class TaskSuite(abc.ABC):
     ) -> gym.vector.VectorEnv:
         """Several tasks' envs stepped together (one process each when ``asynchronous``).
 
-        Autoreset is disabled: reset finished sub-envs with
-        ``envs.reset(options={"reset_mask": done})``. Infos carry ``success`` and
-        ``privileged_state`` per sub-env. Renderers are created inside the worker processes.
-
-        Args:
-            task_names: One task per sub-env (repeats allowed).
-            seeds: Seed of each sub-env's first reset.
-            asynchronous: Worker processes (True) or in-process stepping (False).
+        Autoreset is disabled: reset finished sub-envs with ``envs.reset(options={"reset_mask": done})``.
+        ``seeds`` seed each sub-env's first reset.
 
         Raises:
             ValueError: On mismatched lengths or an unknown task.

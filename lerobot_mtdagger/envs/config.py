@@ -1,8 +1,6 @@
 """``SuiteConfig``: the suite and its observations, one config for every command that builds a suite.
 
-``lerobot-mtdagger run`` (``--suite.name=drawers --suite.obs_mode=pointcloud``), ``eval`` and
-``shift`` (the same spellings) and LeRobot's env plugin (``--env.suite.name=...``) hold one
-``SuiteConfig`` and build their suite from it with ``suite_from_config``.
+``run``, ``eval``, ``shift`` (``--suite.*``) and LeRobot's env plugin (``--env.suite.*``) hold one.
 """
 
 from __future__ import annotations
@@ -26,23 +24,20 @@ class SuiteConfig:
     """A task suite and its observations.
 
     Attributes:
-        name: A registered suite name (``make_suite``: ``metaworld-mt10``, ``drawers``, ``toy``, ...,
-            or one that ``module`` registers). None: the command's default (``run``: the preset's).
+        name: A registered suite name (``metaworld-mt10``, ``drawers``, ``toy``, ..., or one that ``module``
+            registers). None: the command's default.
         tasks: Subset of the suite's tasks (all when empty; ``eval`` and ``shift`` also take
             ``heldout``: the suite's unseen tasks).
-        obs_mode: ``state``, ``rgb`` or ``pointcloud``. None: the command's default (``run``: the
-            preset's; ``eval``: what the policy was trained on).
+        obs_mode: ``state``, ``rgb`` or ``pointcloud``. None: the command's default (``eval``: the policy's).
         num_points: Points per cloud (pointcloud mode). None: 1 024 (``eval``: the policy's).
         image_size: Image side (rgb mode). None: 84 (``eval``: the policy's).
-        mesh_detail: Share of the faces of the arm's meshes the observation renderer keeps, in
-            (0, 1] (rgb and pointcloud modes; 1: the exact model). 0.2 renders about twice as fast
-            on a CPU and changes only the arm's silhouette by millimetres (``docs/benchmarks.md``).
-        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when
-            None; ``narrow``: the suite's first ranges). Refused for other suites.
+        mesh_detail: Share of the arm meshes' faces the observation renderer keeps, in (0, 1] (1: the
+            exact model; 0.2 renders about twice as fast on a CPU).
+        placement: ``drawers`` only: how resets move and recolour the drawers (``kitchen`` when None, or
+            ``narrow``).
         episode_length: Steps after which an episode is truncated (None: each task's own horizon).
-        module: A module imported before the suite is built, which registers suites from outside
-            the package (``register_suite``), e.g. ``my_package.suites``; ``name`` may then be one
-            of them. None: the package's suites only.
+        module: A module imported first that registers suites from outside the package, e.g.
+            ``my_package.suites``.
     """
 
     name: str | None = None
@@ -56,11 +51,7 @@ class SuiteConfig:
     module: str | None = None
 
     def check(self) -> None:
-        """Refuses options that cannot name a suite, before anything runs.
-
-        Raises:
-            UserError: One line naming the option and its fix.
-        """
+        """Refuses options that cannot name a suite, before anything runs (``UserError``, one line)."""
         if self.placement is not None and self.name != DRAWERS:
             raise UserError(f"suite.placement applies to the drawers suite only; drop it for {self.name!r}.")
         if self.placement is not None and self.placement not in PLACEMENTS:
@@ -87,10 +78,7 @@ class SuiteConfig:
             )
 
     def fill_defaults(self) -> None:
-        """Gives unset observation options their defaults (a run stores them resolved).
-
-        ``num_points`` 1 024, ``image_size`` 84 and, for the drawers, ``placement`` ``kitchen``.
-        """
+        """Gives unset observation options their defaults (1 024 points, 84 px images, ``kitchen``)."""
         if self.num_points is None:
             self.num_points = DEFAULT_NUM_POINTS
         if self.image_size is None:

@@ -6,17 +6,10 @@ Usage::
         --env.discover_packages_path=lerobot_mtdagger.envs --env.type=mtdagger_suite \
         --env.suite.name=metaworld-mt10 --env.task=reach-v3 --eval.n_episodes=10 --eval.batch_size=1
 
-The type name avoids "metaworld": LeRobot 0.4.4 routes any env type containing it to its own
-MetaWorld code. The gym env emits the raw keys LeRobot's ``preprocess_observation`` keeps:
-``agent_pos`` (-> ``observation.state``), ``pixels`` (-> ``observation.image``) and
-``environment_state`` for the point cloud (-> ``observation.environment_state``; LeRobot 0.4.4 drops
-any other key). A point-cloud policy reads ``observation.pointcloud``, so evaluate it with
-``--rename_map='{"observation.environment_state": "observation.pointcloud"}'``: lerobot-eval hands the
-map to the policy's rename step, which runs before normalisation.
-
-The env reports the task string (its unique task name) as ``task_description`` and ``task``, which
-LeRobot passes to the policy as ``observation["task"]``; episodes terminate at the first success (MetaWorld's
-success does not persist, and lerobot-eval reads ``is_success`` only at an episode's last step).
+The type name avoids "metaworld", which LeRobot routes to its own code. A point cloud arrives as
+``environment_state`` (the keys LeRobot keeps): evaluate a point-cloud policy with
+``--rename_map='{"observation.environment_state": "observation.pointcloud"}'``. Episodes end at
+the first success.
 """
 
 from __future__ import annotations
@@ -51,9 +44,7 @@ class LeRobotSuiteEnv(gym.Env):
 
         Args:
             render_mode: Gymnasium's render mode (``rgb_array``).
-            **suite_options: ``MTDAggerSuiteEnvConfig`` fields: ``suite`` (a ``SuiteConfig`` or its
-                mapping) and ``task`` (their defaults where left out), as
-                ``MTDAggerSuiteEnvConfig.gym_kwargs`` gives them.
+            **suite_options: ``MTDAggerSuiteEnvConfig.gym_kwargs``: ``suite`` and ``task``.
 
         Raises:
             TypeError: On an option that is not such a field.
@@ -113,10 +104,8 @@ class MTDAggerSuiteEnvConfig(EnvConfig):
     """``--env.type=mtdagger_suite``: one task of a lerobot-mtdagger suite for ``lerobot-eval``.
 
     Attributes:
-        suite: The suite and its observations (``SuiteConfig``, as ``lerobot-mtdagger run`` and
-            ``eval`` take it: ``--env.suite.name=drawers --env.suite.obs_mode=pointcloud``); its
-            ``obs_mode`` must match what the policy was trained on. ``suite.tasks`` is not used: the
-            env is one task, ``task``.
+        suite: The suite and its observations (``--env.suite.name=drawers --env.suite.obs_mode=pointcloud``);
+            ``obs_mode`` must match the policy's; ``suite.tasks`` is not used.
         task: Task name within the suite (also the task string handed to the policy).
     """
 

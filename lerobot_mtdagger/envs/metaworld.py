@@ -1,22 +1,9 @@
 """MetaWorld 3.1 (v3 environments) as multitask suites with state, RGB and point-cloud observations.
 
-What each observation mode shows the policy:
-
-- ``state``: ``observation.state`` is MetaWorld's 39-d goal-visible vector: hand xyz, gripper
-  opening, up to two objects' position + quaternion (14, zero-padded), the same 18 values of the
-  previous step, and the goal xyz. This is also the expert's privileged state.
-- ``rgb``: ``observation.image`` (H x W x 3 uint8 from ``camera``, default ``corner``) and
-  ``observation.state`` = hand xyz + gripper opening (+ goal xyz when ``include_goal``; many
-  MetaWorld goals, e.g. reach and push targets, are not drawn in the scene).
-- ``pointcloud``: ``observation.pointcloud`` ((num_points, 3) float32, world frame, metres; from the
-  depth cameras ``corner`` and ``corner2`` by default, cropped to the box x in [-0.6, 0.6], y in
-  [0.2, 1.1], z in [0.01, 0.7], which removes the table top (z = 0), the floor and the background)
-  and the same proprioceptive ``observation.state`` as ``rgb``.
-
-Episodes truncate at ``max_episode_steps`` (MetaWorld's max path length, 500). A seeded reset
-reproduces the initial object and goal positions: the object/goal vector is drawn from the env's
-own generator, re-seeded by ``reset(seed=...)``. MetaWorld's success does not persist after it
-first happens; an episode counts as successful if ``info["success"]`` was true at any step.
+``state`` is MetaWorld's 39-d goal-visible vector (the expert's privileged state); ``rgb`` and
+``pointcloud`` add the image or the cropped world-frame cloud of the ``corner``/``corner2`` depth
+cameras to hand xyz + gripper opening (+ goal with ``include_goal``). Seeded resets reproduce the
+initial positions; an episode succeeds if ``info["success"]`` was true at any step.
 """
 
 from __future__ import annotations
@@ -84,11 +71,7 @@ def observation_state_names(config: ObservationConfig) -> list[str]:
 
 
 def _make_raw_env(task_name: str) -> Any:
-    """Builds a v3 env with the goal visible and seedable random resets.
-
-    This is MetaWorld's goal-observable setting without its frozen goal: ``seeded_rand_vec`` makes
-    every reset draw the object/goal vector from the env's ``np_random``.
-    """
+    """A v3 env with the goal visible and seedable random resets (``seeded_rand_vec``, no frozen goal)."""
     env = ALL_V3_ENVIRONMENTS[task_name]()
     env._partially_observable = False
     del env.sawyer_observation_space  # cached property computed for the hidden goal
@@ -101,9 +84,8 @@ def _make_raw_env(task_name: str) -> Any:
 class MetaWorldTaskEnv(gym.Env):
     """One MetaWorld v3 task with LeRobot-keyed dict observations.
 
-    Subclasses for other scenes of MetaWorld's Sawyer arena (the drawer suite) override the
-    hooks ``_build_raw_env``, ``state_names``, ``_proprio_state`` and ``_step_info`` and the
-    class-level camera and crop defaults.
+    Other scenes of the Sawyer arena (the drawers) override ``_build_raw_env``, ``state_names``,
+    ``_proprio_state``, ``_step_info`` and the camera and crop defaults.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 80}
@@ -118,13 +100,9 @@ class MetaWorldTaskEnv(gym.Env):
         seed: int | None = None,
         max_episode_steps: int | None = None,
     ) -> None:
-        """Builds the env (about 0.2 s: it loads the task's MJCF model).
+        """Builds the env of a v3 task such as ``reach-v3`` (about 0.2 s).
 
-        Args:
-            task_name: A MetaWorld v3 task name such as ``reach-v3``.
-            observation: What the env shows the policy.
-            seed: Seed of the first reset (later unseeded resets continue its random stream).
-            max_episode_steps: Truncation length; MetaWorld's max path length (500) when None.
+        ``seed`` seeds the first reset; ``max_episode_steps`` None: MetaWorld's max path length (500).
         """
         self.task_name = task_name
         self.observation_config = observation
@@ -297,11 +275,7 @@ class MetaWorldSuite(TaskSuite):
         max_episode_steps: int | None = None,
         name: str = "metaworld",
     ) -> None:
-        """Checks the task names against MetaWorld's v3 environments.
-
-        Raises:
-            ValueError: On an unknown task.
-        """
+        """Checks the task names against MetaWorld's v3 environments (a ``ValueError`` on an unknown one)."""
         unknown = [t for t in task_names if t not in ALL_V3_ENVIRONMENTS]
         if unknown:
             raise UserError(f"Unknown MetaWorld v3 task(s) {unknown}; known tasks: {list(ALL_TASKS)}.")
@@ -328,10 +302,7 @@ class MetaWorldSuite(TaskSuite):
 
 
 def build_metaworld_suite(options: SuiteOptions) -> MetaWorldSuite:
-    """The factory of the MetaWorld suites (registered as ``metaworld-mt10/25/50`` and ``metaworld``).
-
-    A suite of ``NAMED_TASK_LISTS`` holds its list (``options.tasks``: a subset, in any order);
-    any other name (``metaworld``) holds exactly ``options.tasks``, v3 task names.
+    """The factory of the MetaWorld suites: ``metaworld-mt10/25/50`` (a subset of a list), ``metaworld``.
 
     Raises:
         UserError: On a placement, a task outside the named list, or no task for ``metaworld``.

@@ -1,16 +1,11 @@
 """The suite registry: which factory builds the suite of a name.
 
-A suite is registered by name with a factory ``factory(options: SuiteOptions) -> TaskSuite``, as a
-callable or as a ``"module:attribute"`` entry point imported on first use. The built-in suites
-register themselves that way (``toy``, ``drawers`` and the MetaWorld lists), so building the toy
-suite never imports MuJoCo or MetaWorld::
+A factory ``factory(options: SuiteOptions) -> TaskSuite`` is registered as a callable or a lazily
+imported ``"module:attribute"`` (so the toy suite never imports MuJoCo)::
 
     register_suite("my-suite", lambda options: MySuite(options.tasks or MY_TASKS, options.observation))
 
-``build_suite(options)`` then builds the suite ``options.name`` names; ``--suite.name`` takes any
-registered name, and ``--suite.module`` imports a module (one that registers suites) before the suite
-is built (``import_suite_module``). An installed package registers its suites by entry point (group
-``lerobot_mtdagger.suites``, ``utils.plugins``).
+Installed packages register by entry point (group ``lerobot_mtdagger.suites``).
 """
 
 from __future__ import annotations
@@ -34,11 +29,10 @@ class SuiteOptions:
 
     Attributes:
         name: The registered name asked for (one factory may serve several names).
-        tasks: The tasks, in order (a subset of the suite's, or its extra tasks); empty: the suite's own.
+        tasks: The tasks in order (empty: the suite's own).
         observation: What the envs show the policy.
         max_episode_steps: Truncation length (None: each task's own horizon).
-        placement: How resets move and recolour the drawers (``kitchen``, ``narrow``; None: the
-            default); a suite without placements refuses one (``refuse_placement``).
+        placement: Drawer placement (None: the default); other suites refuse one (``refuse_placement``).
     """
 
     name: str
@@ -55,11 +49,7 @@ class SuiteOptions:
         return list(self.tasks) if self.tasks else list(default)
 
     def refuse_placement(self) -> None:
-        """Refuses a placement, for a suite without placements.
-
-        Raises:
-            UserError: If a placement was given.
-        """
+        """Refuses a placement, for a suite without placements (``UserError`` if one was given)."""
         if self.placement is not None:
             raise UserError(
                 f"placement={self.placement!r} applies to the drawers suite only; drop it for {self.name!r}."
@@ -82,10 +72,7 @@ SUITES: Registry[SuiteFactory] = Registry(
 def register_suite(name: str, factory: SuiteFactory | str) -> None:
     """Registers the factory of a suite name (``--suite.name=<name>``, ``make_suite(name)``).
 
-    Args:
-        name: The suite's name.
-        factory: ``factory(options: SuiteOptions) -> TaskSuite``, or its ``"module:attribute"`` entry
-            point (imported when the suite is first built).
+    ``factory`` is ``factory(options: SuiteOptions) -> TaskSuite`` or its ``"module:attribute"``.
 
     Raises:
         UserError: If ``name`` is already registered (a ``ValueError``).
@@ -103,7 +90,7 @@ def build_suite(options: SuiteOptions) -> TaskSuite:
     """The suite ``options.name`` names, built by its registered factory.
 
     Raises:
-        UserError: On a name no factory is registered for (one line listing the registered names).
+        UserError: On an unregistered name (one line listing the registered names).
         ValueError: On a task or observation setting the suite refuses.
     """
     if options.name not in SUITES:
@@ -117,11 +104,7 @@ def build_suite(options: SuiteOptions) -> TaskSuite:
 
 
 def import_suite_module(module: str) -> None:
-    """Imports ``module`` (``--suite.module``), whose import registers its suites.
-
-    Raises:
-        UserError: If the module cannot be imported.
-    """
+    """Imports ``module`` (``--suite.module``), which registers its suites (``UserError`` if it fails)."""
     try:
         importlib.import_module(module)
     except ImportError as error:

@@ -1,26 +1,8 @@
 """Offscreen MuJoCo observations: RGB frames and point clouds from depth cameras.
 
-Rendering goes through MuJoCo's EGL backend (``MUJOCO_GL=egl``, set by ``lerobot_mtdagger.envs``
-unless the user chose a backend; Mesa renders on the CPU). ``MUJOCO_GL=osmesa`` is the fallback
-where EGL is missing (slower). Observation cameras render without shadows and reflections: with
-MetaWorld's 4096-pixel shadow map a CPU frame costs about four times more, and neither helps a
-policy. They also render without multisample anti-aliasing (MuJoCo's default is 4 samples), which
-halves the cost of an RGB frame on the CPU (measured: 17.6 ms -> 7.9 ms at 84 px). As shadows are never
-drawn, their OpenGL context is made without a shadow map (MetaWorld's is 4096 x 4096: 64 MiB of memory
-per renderer on Mesa, half of one; the frames are bit-identical, ``benchmarks/bench_renderer_memory.py``).
-
-Point clouds (the paper crops the background and feeds a PointNet):
-
-1. Render a depth image per camera. MuJoCo returns metric depth along the camera's optical axis.
-2. Back-project each pixel with the pinhole intrinsics of the camera (``fovy`` from the model,
-   square pixels, principal point at the image centre) into the camera frame (MuJoCo cameras look
-   along -z with +y up), then into the WORLD frame with the camera pose ``cam_xpos``/``cam_xmat``.
-3. Keep the points inside an axis-aligned crop box in world coordinates (``CropBox``); the box of a
-   suite removes the table surface, the floor and the background.
-4. Sample exactly ``num_points`` of them uniformly with the env's seeded generator (with replacement
-   only when fewer points survive the crop).
-
-Optional per-point colour comes from an RGB render of the same camera (values in [0, 1]).
+Observation cameras render without shadows, reflections, multisampling or shadow map (cheaper on a
+CPU, ``docs/benchmarks.md``). A cloud is each camera's metric depth back-projected into the world
+frame, cropped to the suite's ``CropBox`` and sampled to ``num_points`` with the env's generator.
 """
 
 from __future__ import annotations
@@ -57,11 +39,9 @@ def _register_exit_handler() -> None:
 
 
 def renderer_without_shadow_map(model: mujoco.MjModel, height: int, width: int) -> mujoco.Renderer:
-    """A ``mujoco.Renderer`` whose OpenGL context has no shadow map (for scenes drawn without shadows).
+    """A ``mujoco.Renderer`` whose OpenGL context has no shadow map (only for ``SceneRenderer``).
 
-    MuJoCo sizes the map from ``model.vis.quality.shadowsize`` when it makes the context; it is set to
-    0 for that moment only, so the model (shared with the physics and any other renderer) keeps its
-    value. Drawing with the shadow flag on would then show no shadows: only for ``SceneRenderer``.
+    ``model.vis.quality.shadowsize`` is 0 only while the context is made, so the shared model keeps it.
     """
     shadow_size = model.vis.quality.shadowsize
     model.vis.quality.shadowsize = 0
@@ -72,24 +52,13 @@ def renderer_without_shadow_map(model: mujoco.MjModel, height: int, width: int) 
 
 
 class SceneRenderer:
-    """RGB and depth rendering of one MuJoCo model with shadows and reflections turned off.
+    """RGB and depth rendering of one MuJoCo model with shadows and reflections off.
 
-    Creates its OpenGL context lazily, on first use, so an env can be built in one process and
-    stepped in another (vectorised collection).
+    Its OpenGL context is made on first use, so an env can be built in one process and stepped in another.
     """
 
     def __init__(self, model: mujoco.MjModel, height: int, width: int, multisamples: int = 0) -> None:
-        """Prepares a renderer for ``model`` at ``height`` x ``width`` pixels.
-
-        Args:
-            model: The MuJoCo model; its ``vis.quality.offsamples`` is set to ``multisamples``.
-            height: Image height in pixels.
-            width: Image width in pixels.
-            multisamples: Anti-aliasing samples of the offscreen buffer (0: none).
-
-        Raises:
-            ValueError: If the size exceeds the model's offscreen buffer.
-        """
+        """Prepares a ``height`` x ``width`` renderer (``ValueError`` beyond the model's offscreen buffer)."""
         if height <= 0 or width <= 0:
             raise ValueError(f"Render size must be positive, got {height}x{width}.")
         offwidth, offheight = model.vis.global_.offwidth, model.vis.global_.offheight
@@ -147,18 +116,9 @@ MIN_FACES_TO_SIMPLIFY = 1000
 def simplified_model(model: mujoco.MjModel, detail: float) -> mujoco.MjModel:
     """A copy of ``model`` for rendering only, its large untextured meshes simplified.
 
-    Each mesh of at least MIN_FACES_TO_SIMPLIFY faces without texture coordinates (the Sawyer arm's
-    visual meshes: 66 859 of the drawer scene's faces) keeps about ``detail`` of its faces
-    (quadric-error decimation, ``fast_simplification``), written into the mesh's own slots of the
-    copy, with smooth vertex normals recomputed. Geoms, bodies, cameras and lights are untouched, so
-    the copy renders the physics model's ``MjData``: MuJoCo places every geom from the data, and a
-    mesh's vertices stay in the frame its geom was compiled with. At 84 pixels a CPU depth frame of
-    the drawer scene costs 2.6x less at ``detail=0.2`` and the frames differ on the arm's
-    silhouette only (``docs/benchmarks.md``).
-
-    Args:
-        model: The physics model (not modified).
-        detail: Share of faces kept, in (0, 1]; 1 returns ``model`` itself.
+    Each mesh of at least ``MIN_FACES_TO_SIMPLIFY`` faces without texture coordinates (the Sawyer arm's)
+    keeps about ``detail`` of its faces (quadric decimation); geoms, bodies and cameras are untouched, so
+    the copy renders the physics model's ``MjData``. ``detail=1`` returns ``model`` itself.
 
     Raises:
         ValueError: If ``detail`` is outside (0, 1].
@@ -203,14 +163,10 @@ def _write_mesh(model: mujoco.MjModel, mesh: int, vertices: np.ndarray, faces: n
 
 
 def camera_rays(model: mujoco.MjModel, camera: str, height: int, width: int) -> np.ndarray:
-    """Per-pixel ray directions in the camera frame, scaled so that a depth d gives the point.
+    """Per-pixel ray directions in the camera frame, (H, W, 3) float64: a depth d gives the point ``d * ray``.
 
-    A pixel (row v, column u) at depth d is at ``d * ray[v, u]`` in the camera frame, where
-    ``ray = ((u + 0.5 - W/2) / f, -(v + 0.5 - H/2) / f, -1)`` and ``f = (H / 2) / tan(fovy / 2)``.
-    Row 0 of a MuJoCo render is the top of the image.
-
-    Returns:
-        (H, W, 3) float64 array.
+    ``ray = ((u + 0.5 - W/2) / f, -(v + 0.5 - H/2) / f, -1)``, ``f = (H / 2) / tan(fovy / 2)``; row 0 is
+    the top of the image.
 
     Raises:
         ValueError: If the model has no camera of that name.
@@ -233,21 +189,10 @@ def camera_rays(model: mujoco.MjModel, camera: str, height: int, width: int) -> 
 def depth_to_world(
     depth: np.ndarray, rays: np.ndarray, position: np.ndarray, rotation: np.ndarray
 ) -> np.ndarray:
-    """Back-projects a depth image to world coordinates, one plane per axis.
+    """Back-projects a (H, W) depth image to world coordinates, (3, H, W): one plane per axis.
 
-    The point of pixel (v, u) is ``rotation @ (depth[v, u] * rays[v, u]) + position``. The rays of
-    ``camera_rays`` are separable, ``(across[u], down[v], -1)``, so each world axis k is
-    ``depth * (R[k, 0] across[u] + R[k, 1] down[v] - R[k, 2]) + position[k]``: a few passes over
-    (H, W) arrays instead of an (H * W, 3) x (3, 3) product (about 5x faster at 84 x 84 pixels).
-
-    Args:
-        depth: (H, W) metric depth along the optical axis.
-        rays: (H, W, 3) from ``camera_rays``.
-        position: Camera position in the world, (3,) (``data.cam_xpos[id]``).
-        rotation: Camera-to-world rotation, (3, 3) (``data.cam_xmat[id].reshape(3, 3)``).
-
-    Returns:
-        (3, H, W): the world x, y and z of every pixel (``planes[:, mask].T`` gives (M, 3) points).
+    The point of pixel (v, u) is ``rotation @ (depth[v, u] * rays[v, u]) + position``, computed per
+    axis from the separable rays (about 5x faster than an (H * W, 3) x (3, 3) product).
     """
     across, down = rays[0, :, 0], rays[:, 0, 1]
     planes = np.empty((3, *depth.shape))
@@ -263,20 +208,9 @@ def depth_to_world(
 def sample_points(
     points: np.ndarray, num_points: int, rng: np.random.Generator, fallback: np.ndarray
 ) -> np.ndarray:
-    """Samples exactly ``num_points`` rows of ``points``.
+    """Samples exactly ``num_points`` rows of ``points`` (M, C), with replacement only when M is smaller.
 
-    Uniform without replacement when enough points exist, with replacement otherwise. When no point
-    is left at all (the crop removed everything), returns ``num_points`` copies of ``fallback`` so
-    the observation keeps its shape, and logs a warning.
-
-    Args:
-        points: (M, C) candidate points.
-        num_points: Number to return (> 0).
-        rng: The seeded generator of the env.
-        fallback: (C,) row used when M == 0.
-
-    Returns:
-        (num_points, C) array of the same dtype as ``points``.
+    With no point left, returns ``num_points`` copies of ``fallback`` (C,) and logs a warning.
     """
     count = points.shape[0]
     if count == 0:
@@ -297,11 +231,7 @@ class PointCloudCamera:
         num_points: int,
         with_color: bool = False,
     ) -> None:
-        """Precomputes the rays of each camera.
-
-        Raises:
-            ValueError: On an unknown camera, no camera, or ``num_points <= 0``.
-        """
+        """Precomputes each camera's rays (``ValueError``: an unknown camera, none, ``num_points <= 0``)."""
         if num_points <= 0:
             raise ValueError(f"num_points must be > 0, got {num_points}.")
         if not cameras:
@@ -321,11 +251,7 @@ class PointCloudCamera:
         return 6 if self.with_color else 3
 
     def capture(self, data: mujoco.MjData, rng: np.random.Generator) -> np.ndarray:
-        """Renders, back-projects, crops and samples the cloud.
-
-        Returns:
-            (num_points, 3) float32 world-frame xyz, or (num_points, 6) with rgb in [0, 1].
-        """
+        """Renders, back-projects, crops and samples: (num_points, 3) float32 xyz, or 6 with rgb in [0, 1]."""
         depths = {camera: self.renderer.depth(data, camera) for camera in self.cameras}
         colors = (
             {camera: self.renderer.rgb(data, camera) for camera in self.cameras} if self.with_color else None
@@ -339,14 +265,7 @@ class PointCloudCamera:
         rng: np.random.Generator,
         colors: dict[str, np.ndarray] | None = None,
     ) -> np.ndarray:
-        """``capture`` after its renders: back-projects, crops and samples the cloud.
-
-        Args:
-            data: The state the renders show (its camera poses are read).
-            depths: Each camera's (H, W) depth render.
-            rng: The seeded generator that samples the points.
-            colors: Each camera's (H, W, 3) uint8 render, when the cloud has colour.
-        """
+        """``capture`` after its renders (each camera's depth, and colour when the cloud has it)."""
         parts = []
         for camera, camera_id, rays in zip(self.cameras, self._ids, self._rays, strict=True):
             rotation = data.cam_xmat[camera_id].reshape(3, 3)

@@ -1,15 +1,8 @@
 """A toy multitask suite without MuJoCo: a point mass pushed to a task-specific goal under wind.
 
-For tests (ours and users'), the way stable-baselines3 ships tiny identity envs: every part of the
-DAgger chain (collection, round datasets, training, evaluation, scheduling) runs on it in seconds.
-
-Each task (``ToyTask``) has a goal in the plane and a constant wind. The point starts uniformly in
-``START_BOX`` (seeded reset), moves by ``STEP_SIZE * clip(action, -1, 1) + wind`` per step and
-succeeds when it is within ``SUCCESS_RADIUS`` of the goal; episodes truncate after
-``MAX_EPISODE_STEPS`` steps. The policy sees only the position (``observation.state`` = x, y), so it
-must use the task to know where to go; the expert acts on the privileged state (position, goal,
-wind) and is optimal: it reaches the goal in the fewest steps. A learner that outputs zeros drifts
-with the wind and never succeeds (every start lies farther from the goal than the wind can carry it).
+For tests: the whole DAgger chain runs on it in seconds. The policy sees only the position, so it
+must use the task; the expert sees goal and wind too and is optimal; a learner that outputs zeros
+drifts with the wind and never succeeds.
 """
 
 from __future__ import annotations
@@ -119,17 +112,7 @@ class ToySuite(TaskSuite):
         max_episode_steps: int | None = None,
         tasks: Sequence[ToyTask] = (),
     ) -> None:
-        """Selects the suite's tasks.
-
-        Args:
-            task_names: Names of ``TOY_TASKS`` or of ``tasks``.
-            observation: Must be ``state`` mode.
-            max_episode_steps: Truncation length (``MAX_EPISODE_STEPS`` when None).
-            tasks: Extra user-defined toy tasks that task names may refer to.
-
-        Raises:
-            ValueError: On an unknown task or a mode other than ``state``.
-        """
+        """Selects the tasks, of ``TOY_TASKS`` or ``tasks`` (``ValueError`` if unknown, or not ``state``)."""
         if observation.obs_mode != "state":
             raise ValueError(
                 f"The toy suite has state observations only, got obs_mode={observation.obs_mode!r}."

@@ -1,11 +1,8 @@
 """Experts: the ``Expert`` protocol, adapters for other policies, and the registry of each suite's.
 
-``make_expert(suite, task_name)`` gives the expert of a task (see ``registry``). The scripted experts
-of the built-in suites are registered by entry point and imported on first use: MetaWorld's policies
-(``metaworld``), the drawer controller (``drawers``) and the toy suite's optimal controller (``toy``).
-``ExpertNoise`` (``noise``) makes any expert imperfect, the way a stochastic RL policy acts;
-``--expert.path`` and ``--expert.type`` (``command_line``) name experts from the command line.
-Experts depend on the suites (they read the privileged state layout); suites never import experts.
+``make_expert(suite, task_name)`` gives the expert of a task; the built-in suites' scripted experts
+(``metaworld``, ``drawers``, ``toy``) are registered by entry point and imported on first use.
+Experts read the suites' privileged state layout; suites never import experts.
 """
 
 from __future__ import annotations

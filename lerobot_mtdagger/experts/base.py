@@ -1,17 +1,9 @@
 """The ``Expert`` protocol and the adapters that turn other policies into experts.
 
-An expert acts on the env's privileged low-dimensional state (``info["privileged_state"]``), never
-on the learner's observation. The paper's experts are PPO policies trained on state; any such
-policy can be brought in:
-
-- a plain function ``f(privileged_state) -> action``: ``CallableExpert(f, action_dim=4)``;
-- a LeRobot pretrained policy trained on the privileged state as ``observation.state``:
-  ``LeRobotPolicyExpert(policy, preprocessor, postprocessor)`` (load them with
-  ``make_policy``/``make_pre_post_processors`` or ``PreTrainedPolicy.from_pretrained``);
-- then ``suite.with_experts({"reach-v3": my_expert})`` or pass it where an ``Expert`` is expected.
-
-Every expert is wrapped in ``ActionCheckedExpert`` by ``make_expert``, so a plugged-in expert with the
-wrong action size fails on its first action with a message naming the task and both sizes.
+An expert acts on the env's privileged state (``info["privileged_state"]``), never on the learner's
+observation. A function ``f(privileged_state) -> action`` becomes one with ``CallableExpert``; a
+LeRobot policy trained on the privileged state as ``observation.state`` with ``LeRobotPolicyExpert``;
+hand either to ``suite.with_experts({"reach-v3": my_expert})``.
 """
 
 from __future__ import annotations
@@ -103,11 +95,7 @@ class ActionCheckedExpert:
     """Checks an expert's output: a finite vector of the task's action size."""
 
     def __init__(self, expert: Expert, task_name: str, action_dim: int) -> None:
-        """Wraps ``expert``.
-
-        Raises:
-            TypeError: If ``expert`` lacks ``reset``/``act``.
-        """
+        """Wraps ``expert`` (``TypeError`` if it lacks ``reset``/``act``)."""
         if not isinstance(expert, Expert):
             raise TypeError(
                 f"The expert for {task_name!r} is a {type(expert).__name__} without reset() and "
@@ -123,11 +111,7 @@ class ActionCheckedExpert:
         self.expert.reset()
 
     def act(self, privileged_state: np.ndarray) -> np.ndarray:
-        """Returns the wrapped expert's action after checking it.
-
-        Raises:
-            ValueError: On a wrong action size or a non-finite action.
-        """
+        """The wrapped expert's action, checked (``ValueError`` on a wrong size or a non-finite value)."""
         action = np.asarray(self.expert.act(privileged_state), dtype=np.float32).reshape(-1)
         if action.shape != (self.action_dim,):
             raise ValueError(
@@ -153,16 +137,9 @@ def run_expert_episode(
 ) -> ExpertEpisode:
     """Runs ``expert`` for one seeded episode of ``env`` (the expert always acts).
 
-    Args:
-        env: A suite env (dict observations, ``info["privileged_state"]`` and ``info["success"]``).
-        expert: The task's expert.
-        seed: Reset seed.
-        stop_on_success: End at the first success (MetaWorld's success does not persist).
-        noise: The episode's ``ActionNoise`` (``ExpertNoise.episode_process``), added to every action;
-            None: the expert as it is.
-
-    Returns:
-        The episode's outcome; ``steps`` is the episode length.
+    ``stop_on_success`` ends the episode at the first success (MetaWorld's success does not persist);
+    ``noise`` is the episode's ``ActionNoise``, added to every action (None: the expert as it is). The
+    outcome's ``steps`` is the episode length.
     """
     _, info = env.reset(seed=seed)
     expert.reset()

@@ -1,19 +1,9 @@
 """Experts named on the command line: ``--expert.path`` (LeRobot policy folders) and ``--expert.type``.
 
-The paper's experts are RL policies trained on the privileged state. Such a policy, saved as a
-LeRobot pretrained model folder whose ``observation.state`` input is the suite's privileged state,
-labels a run's frames with::
-
-    lerobot-mtdagger run --expert.path=experts/            # experts/<task>/: one policy per task
-    lerobot-mtdagger run --expert.path=experts/multitask   # one policy for every task (task string in)
-
-A folder holding ``config.json`` is one multitask policy (it is handed each episode's task string, as
-LeRobot hands a policy ``observation["task"]``); otherwise every task of the suite needs a policy
-folder named after it inside. ``--expert.type`` names an expert factory ``factory(suite, task) ->
-Expert``: one registered with :func:`register_expert_type`, or an importable ``module:attribute``.
-Both are checked before anything is written: a folder that is not a policy, a policy whose input
-does not match the suite's privileged state, a task without an expert, an unknown type, each get one
-line naming the fix.
+``--expert.path=experts/`` holds a policy folder per task; a folder with ``config.json`` is one
+multitask policy (handed each episode's task string). Each policy's ``observation.state`` input is
+the suite's privileged state. ``--expert.type`` names a factory ``factory(suite, task) -> Expert``
+(:func:`register_expert_type`, or ``module:attribute``). Both are checked before anything is written.
 """
 
 from __future__ import annotations
@@ -40,22 +30,14 @@ EXPERT_TYPES: Registry[Callable[[Any, str], Expert]] = Registry(
 
 
 def register_expert_type(name: str, factory: Callable[[Any, str], Expert]) -> None:
-    """Registers an expert factory under a name ``--expert.type`` can give (replacing one of that name).
-
-    Raises:
-        TypeError: If ``factory`` is not callable.
-    """
+    """Registers (or replaces) an expert factory as a ``--expert.type`` name (``TypeError``: not callable)."""
     if not callable(factory):
         raise TypeError(f"The expert type {name!r} needs a callable factory(suite, task), got {factory!r}.")
     EXPERT_TYPES.register(name, factory, replace=True)
 
 
 def expert_type_factory(name: str) -> Callable[[Any, str], Expert]:
-    """The factory of ``--expert.type``: a registered name, or an importable ``module:attribute``.
-
-    Raises:
-        UserError: If the name is neither registered nor importable, naming both ways to fix it.
-    """
+    """The ``--expert.type`` factory: a registered name or ``module:attribute`` (else a ``UserError``)."""
     if name in EXPERT_TYPES:
         return EXPERT_TYPES.get(name)
     known = sorted(EXPERT_TYPES.names()) or "none"
@@ -87,11 +69,7 @@ def privileged_state_size(suite: Any) -> int:
 
 
 def _policy_input_size(policy: Any, folder: Path) -> int:
-    """The size of a policy's ``observation.state`` input.
-
-    Raises:
-        UserError: If the policy has no such input.
-    """
+    """The size of a policy's ``observation.state`` input (``UserError`` if it has none)."""
     feature = policy.config.input_features.get(STATE_KEY)
     if feature is None:
         inputs = sorted(policy.config.input_features)
@@ -155,11 +133,7 @@ def policy_experts(path: Path, suite: Any) -> dict[str, LeRobotPolicyExpert]:
 
 
 def command_line_experts(suite: Any, path: str | None, type_name: str | None) -> Any:
-    """``suite`` with the experts the command line names (itself when it names none).
-
-    Raises:
-        UserError: On a bad path or type (see :func:`policy_experts`, :func:`expert_type_factory`).
-    """
+    """``suite`` with the experts the command line names (``UserError`` on a bad path or type)."""
     if path is not None:
         return suite.with_experts(policy_experts(Path(path), suite))
     if type_name is not None:
@@ -170,11 +144,7 @@ def command_line_experts(suite: Any, path: str | None, type_name: str | None) ->
 
 
 def _expert_of(factory: Callable[..., Any], type_name: str, suite: Any, task: str) -> Expert:
-    """The expert ``factory(suite, task)`` gives for ``task``, checked.
-
-    Raises:
-        UserError: If ``factory`` cannot be called as ``factory(suite, task)`` or gives no ``Expert``.
-    """
+    """The checked expert ``factory(suite, task)`` gives (``UserError`` if the call fails or gives none)."""
     fix = "give --expert.type a factory(suite, task) that returns an object with reset() and act(state)"
     try:
         inspect.signature(factory).bind(suite, task)

@@ -1,42 +1,19 @@
 """The scripted expert of the drawer suite: a stateless controller on the privileged state.
 
-It must label any state a learner reaches (DAgger asks it about the learner's states), so it keeps
-no memory: each action follows from the privileged state alone (``DRAWER_STATE_NAMES``).
+It labels any state a learner reaches, so each action follows from ``DRAWER_STATE_NAMES`` alone.
 
-1. Gripper open: servo the hand towards a target above the grasp pose whose height grows with the
-   planar misalignment (``clearance``: 0 within ``ALIGN_TOLERANCE`` along the pull axis and within
-   the closing range across it, ``FUNNEL_SLOPE`` metres per metre beyond, at most ``SAFE_HEIGHT``):
-   a funnel that ends at the grasp pose. A hand more than ``RISE_FIRST`` below the funnel rises
-   before it moves sideways (the fingers clear the handle). Across the pull axis the funnel is as
-   wide as the closing range (``closing_half_width``): there the rear pad descends into the gap
-   behind the handle without landing on it, so a hand at the handle's depth a centimetre off
-   sideways slides over rather than rising.
-2. At the grasp pose's depth and along-axis position, within the closing range across it: close
-   the gripper (the rear pad pulls the handle into the grip).
-3. Gripper closed on the handle: pull along the drawer's axis until it is open by
-   ``OPEN_TARGET`` of its travel, correcting sideways and vertical drift; then hold. "On the handle"
-   is where closing catches it (``hold_half_width``): the rear pad (``PAD_HALF_WIDTH`` either side of
-   the hand) overlaps the handle across the pull axis, the pull then opens the drawer (measured on
-   every handle type: a vertical bar is caught 2 cm off its axis and missed 2.5 cm off).
-4. Gripper closed anywhere else (a learner closed it, or the grip slipped): open it, rising to the
-   funnel's height if below it, before approaching again.
+1. Gripper open: servo towards a target above the grasp pose whose height grows with the planar
+   misalignment (``clearance``): a funnel ending at the grasp pose. A hand more than ``RISE_FIRST``
+   below the funnel rises before it moves sideways.
+2. At the grasp pose, within the closing range across the pull axis: close the gripper.
+3. Closed on the handle (within ``hold_half_width``): pull along the drawer's axis until it is open
+   by ``OPEN_TARGET`` of its travel, correcting drift; then hold.
+4. Closed anywhere else: open, rising to the funnel's height, and approach again.
 
-The command is a continuous function of the hand's position everywhere except the gripper's
-open/close decision. DAgger needs that: a point-cloud learner localises the handle to about a
-centimetre, and an earlier version of this controller, which retreated to the safe height whenever
-the open hand was low and more than 8 mm off, gave its learner states labels that flipped from
-"descend" to "rise at full speed" within that centimetre (54% of the states its BC student visited;
-visual DAgger rounds then lowered success, ``experiments/visual-collapse-dev/README.md``).
-
-An earlier version closed only within 8 mm of the grasp pose and held only within 1.5 cm across the
-axis for every handle, and its funnel rose for sideways misalignment too: its round-1 point-cloud
-students stopped at a vertical bar's depth 1.7 cm off sideways, where it said "rise" (52% of their
-steps) a few millimetres from states where it said "close", although the pads would have caught
-the bar there.
-
-The grasp pose comes from the env (``grasp_x/y/z``: the hand position that puts the open
-gripper's rear pad behind the handle); it moves with the drawer, so the controller also recovers
-from drawers a learner left half open.
+The command is continuous in the hand's position except for the gripper's open/close decision, so
+a learner that localises the handle to a centimetre gets consistent labels. The grasp pose comes from
+the env and moves with the drawer, so the controller also recovers from half-open drawers.
+See ``docs/drawers.md`` (Scripted experts) for the ranges and how they were measured.
 """
 
 from __future__ import annotations
@@ -97,10 +74,7 @@ class DrawerScriptedExpert:
 
     @classmethod
     def closing_half_width(cls, variant: DrawerVariant) -> float:
-        """How far across the pull axis the expert closes (never less than ``ALIGN_TOLERANCE``).
-
-        Inside the holding range, with the pad inside the gap between a bar's standoffs.
-        """
+        """How far across the pull axis the expert closes: inside the holding range and a bar's standoffs."""
         free = variant.free_gap_half_width() - PAD_HALF_WIDTH
         return max(ALIGN_TOLERANCE, min(cls.holding_half_width(variant), free) - CLOSE_MARGIN)
 
@@ -142,10 +116,8 @@ class DrawerScriptedExpert:
     def clearance(self, lateral: float, along: float) -> float:
         """Height above the grasp pose the hand keeps at a planar misalignment (the approach funnel).
 
-        0 within ``ALIGN_TOLERANCE`` along the pull axis and the closing range across it, rising by
-        ``FUNNEL_SLOPE`` metres per metre of misalignment beyond, at most ``SAFE_HEIGHT``:
-        continuous, so a centimetre of misalignment asks for a few centimetres of height, not for a
-        retreat to the safe height.
+        0 within ``ALIGN_TOLERANCE`` along the axis and the closing range across it, then ``FUNNEL_SLOPE``
+        metres per metre, at most ``SAFE_HEIGHT``.
         """
         across = max(0.0, abs(lateral) - self.close_half_width)
         planar = math.hypot(across, along)

@@ -19,11 +19,7 @@ class MetaWorldScriptedExpert:
     """MetaWorld's hand-written policy for one task, acting on the 39-d goal-visible state."""
 
     def __init__(self, task_name: str) -> None:
-        """Builds the scripted policy of ``task_name``.
-
-        Raises:
-            ValueError: If MetaWorld has no scripted policy for the task.
-        """
+        """Builds the scripted policy of ``task_name`` (``ValueError`` if MetaWorld has none)."""
         if task_name not in ENV_POLICY_MAP:
             raise UserError(
                 f"MetaWorld has no scripted policy for {task_name!r}; known: {sorted(ENV_POLICY_MAP)}."

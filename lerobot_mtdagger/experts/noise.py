@@ -1,28 +1,15 @@
 """Imperfect experts: temporally correlated Gaussian noise on an expert's actions.
 
-The paper's experts are SAC and PPO policies trained on the privileged state: stochastic, and
-successful on 80-95% of episodes. MetaWorld's scripted experts are deterministic and succeed on about
-98%, a regime where behaviour cloning saturates at a few demonstrations. ``ExpertNoise`` makes any
-expert act the way a stochastic RL policy acts: at step ``t`` of an episode the expert executes
+At step ``t`` of an episode the expert executes::
 
     a_t = clip(mu(s_t) + e_t, low, high)
     e_0 = sigma * z_0,   e_t = rho * e_(t-1) + sqrt(1 - rho^2) * sigma * z_t,   z_t ~ N(0, I)
 
-where ``mu`` is the wrapped expert, ``low``/``high`` the env's action bounds, ``sigma`` the noise
-scale (one for every task, or a task's own: ``task_scales``) and ``rho`` its step-to-step
-correlation: every ``e_t`` has standard deviation ``sigma`` (an AR(1) process, the discretised
-Ornstein-Uhlenbeck noise of DDPG; ``rho = 0`` is white noise).
-
-The stored label is, by ``labels``:
-
-- ``noisy``: the executed action ``a_t``: the expert is a stochastic policy and its samples are its
-  demonstrations (what the paper's SAC/PPO experts give);
-- ``clean``: the expert's intended action ``clip(mu(s_t))``: noise only perturbs the states the
-  expert visits (DART, Laskey et al. 2017).
-
-Each episode's noise is drawn from its own generator, seeded by ``(seed, NOISE_STREAM, round, task,
-episode)``: it does not depend on workers, lanes or any other random draw, and a run with
-``scale = 0`` draws nothing and is the run without noise, frame for frame.
+``mu`` is the wrapped expert, ``sigma`` the noise scale (per task: ``task_scales``) and ``rho`` its
+step-to-step correlation (an AR(1) process, DDPG's discretised Ornstein-Uhlenbeck noise). The label
+is ``a_t`` (``labels="noisy"``: a stochastic policy's demonstrations) or ``clip(mu(s_t))``
+(``"clean"``: DART, Laskey et al. 2017). Each episode draws from its own generator, seeded by
+``(seed, NOISE_STREAM, round, task, episode)``; ``scale = 0`` draws nothing.
 """
 
 from __future__ import annotations
@@ -44,16 +31,12 @@ class ExpertNoise:
     """How far experts are from perfect (``--expert.noise*``, ``--expert.labels``).
 
     Attributes:
-        scale: Standard deviation ``sigma`` of the noise added to each action component, in action
-            units (MetaWorld's and the drawers' actions lie in [-1, 1]); 0 turns noise off.
-        correlation: Step-to-step correlation ``rho`` of the noise, in [0, 1): 0 is white noise, 0.9
-            keeps a perturbation for about ten steps.
-        seed: Seed of the noise, apart from the run's seed (the same demonstrations' noise can be
-            redrawn, or kept while the run's seed changes).
-        labels: ``noisy`` (the label is the executed action) or ``clean`` (the expert's own action).
-        task_scales: ``(task, scale)`` pairs: these tasks' own noise scale instead of ``scale`` (one
-            scale cannot put every expert at the same success: easy tasks' experts shrug off a noise
-            that breaks a grasping task's).
+        scale: Standard deviation ``sigma`` of the noise on each action component, in action units;
+            0 turns noise off.
+        correlation: Step-to-step correlation ``rho``, in [0, 1) (0.9 keeps a perturbation about ten steps).
+        seed: Seed of the noise, apart from the run's seed.
+        labels: ``noisy`` (the executed action) or ``clean`` (the expert's own action).
+        task_scales: ``(task, scale)`` pairs: these tasks' own scale instead of ``scale``.
     """
 
     scale: float = 0.0
@@ -89,11 +72,8 @@ class ExpertNoise:
     ) -> ActionNoise | None:
         """The noise of one episode (None when this task's expert gets none).
 
-        Args:
-            episode_key: ``(round, task, episode)``: which episode, for its own generator.
-            low: The env's lower action bounds.
-            high: The env's upper action bounds.
-            task: The task's name, for its own scale (``task_scales``); None: ``scale``.
+        ``episode_key`` is ``(round, task, episode)``, which seeds the episode's generator; ``low``/``high``
+        are the action bounds; ``task`` picks its own scale (None: ``scale``).
         """
         scale = self.scale_for(task)
         if scale <= 0.0:
@@ -113,15 +93,7 @@ class ActionNoise:
         high: np.ndarray,
         scale: float | None = None,
     ) -> None:
-        """Starts the process; the first ``perturb`` draws ``e_0``.
-
-        Args:
-            noise: The noise's settings.
-            rng: The episode's own generator.
-            low: The env's lower action bounds.
-            high: The env's upper action bounds.
-            scale: This task's ``sigma`` (``ExpertNoise.scale_for``); None: ``noise.scale``.
-        """
+        """Starts the process with the episode's generator; the first ``perturb`` draws ``e_0``."""
         self.noise = noise
         self.scale = noise.scale if scale is None else scale
         self.rng = rng
@@ -140,12 +112,7 @@ class ActionNoise:
         return self._state
 
     def perturb(self, action: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The executed action and the label for the expert's ``action`` at this step.
-
-        Returns:
-            ``(executed, label)``, both float32 and within the action bounds: the noisy action, and
-            the noisy action again (``labels="noisy"``) or the clipped expert action (``clean``).
-        """
+        """The executed action and the label for the expert's ``action``, both float32 within the bounds."""
         action = np.asarray(action, dtype=np.float32)
         noisy = np.clip(action + self.sample(action.size).astype(np.float32), self.low, self.high)
         if self.noise.labels == "clean":

@@ -1,17 +1,12 @@
 """The expert registry: which expert labels a task, keyed by suite family and task name.
 
-Suites know nothing of experts (``envs`` does not import ``experts``); a factory is registered for a
-suite family (``TaskSuite.expert_family``: ``metaworld``, ``drawers``, ``toy``), for all its tasks or
-for one task, as a callable or as a ``"module:attribute"`` entry point imported on first use (the
-built-in suites' scripted experts are registered that way, so using the toy suite never imports
-MetaWorld)::
+A factory is registered for a suite family (``TaskSuite.expert_family``) and one task or all of
+them, as a callable or a ``"module:attribute"`` entry point imported on first use::
 
     register_expert("metaworld", lambda suite, task: MyPPOExpert(task), task="push-v3")
 
-``make_expert(suite, task)`` then returns, in order of precedence, the expert the suite was given
-with ``suite.with_experts({...})``, the factory registered for ``(family, task)``, or the one
-registered for the whole family; always wrapped in ``ActionCheckedExpert``, so an expert with the
-wrong action size fails on its first action naming the task.
+``make_expert`` returns, in order of precedence, the suite's own (``suite.with_experts``), the
+factory for ``(family, task)``, or the family's; wrapped in ``ActionCheckedExpert``.
 """
 
 from __future__ import annotations
@@ -40,18 +35,7 @@ EXPERTS: Registry[ExpertFactory] = Registry(
 
 
 def register_expert(suite_family: str, factory: ExpertFactory | str, task: str = ANY_TASK) -> None:
-    """Registers the expert factory of a suite family's task (``ANY_TASK``: every task).
-
-    A factory registered before for the same family and task is replaced.
-
-    Args:
-        suite_family: The suites' ``expert_family``.
-        factory: ``factory(suite, task_name) -> Expert``, or its ``"module:attribute"`` entry point.
-        task: One task name, or ``ANY_TASK``.
-
-    Raises:
-        TypeError: If ``factory`` is neither callable nor an entry-point string.
-    """
+    """Registers (or replaces) a family's task's expert factory (``TypeError``: not callable or a string)."""
     EXPERTS.register((suite_family, task), factory, replace=True)
 
 
@@ -60,15 +44,7 @@ for _family in ("metaworld", "drawers", "toy"):
 
 
 def make_expert(suite: Any, task_name: str) -> ActionCheckedExpert:
-    """The expert of one task of ``suite``, action-size checked.
-
-    Args:
-        suite: A ``TaskSuite``.
-        task_name: One of its tasks or held-out tasks.
-
-    Raises:
-        ValueError: If the suite does not build the task or no expert is registered for it.
-    """
+    """The action-checked expert of a task of ``suite`` (``ValueError``: not built, or no expert)."""
     suite.check_buildable(task_name)
     expert = suite.expert_overrides.get(task_name)
     if expert is None:

@@ -1,7 +1,6 @@
 """LeRobot policy plugins (``--policy.discover_packages_path=lerobot_mtdagger.policies``).
 
-Importing this package registers the ``mtdagger`` policy type with LeRobot, and the processor step
-that gives LeRobot policies trained as students their one-hot task vector (``task_conditioning``).
+Importing this package registers the ``mtdagger`` policy type and the one-hot task processor step.
 """
 
 from lerobot_mtdagger.policies.mtdagger import (

@@ -1,16 +1,10 @@
 """How a LeRobot policy without a task input is told its task: a one-hot task vector.
 
-ACT, Diffusion Policy and most LeRobot policies read observations only. A multitask student of
-those types reads its task as ``observation.environment_state``: a one-hot vector over the run's
-training tasks (``FeatureType.ENV``, which LeRobot's normalisers leave as it is). A task the policy
-was not trained on (an unseen drawer) gets the zero vector, the "any task" input that task dropout
-trains (a training frame's vector is zeroed with probability ``task_dropout``), as the ``mtdagger``
-policy's shared embedding does.
-
-The vector is built from the batch's ``task`` strings by ``TaskOneHotProcessorStep``, the first
-step of the saved pre-processor, so a saved student acts on LeRobot's usual observation + ``task``
-batch (what ``lerobot-eval`` passes) once this package is imported (it registers the step).
-Training batches build the same vector from task indices (``task_one_hot``).
+A multitask ACT or Diffusion student reads its task as ``observation.environment_state``, one-hot
+over the training tasks (``FeatureType.ENV``: left unnormalised). An unseen task gets the zero
+vector, the "any task" input that task dropout trains. ``TaskOneHotProcessorStep``, the first step of
+the saved pre-processor, builds it from the ``task`` strings, so a saved student acts on LeRobot's
+usual batch; training batches build it from task indices (``task_one_hot``).
 """
 
 from __future__ import annotations
@@ -43,10 +37,9 @@ def task_one_hot(task_index: torch.Tensor, num_tasks: int) -> torch.Tensor:
 
 @ProcessorStepRegistry.register(ONE_HOT_STEP)
 class TaskOneHotProcessorStep(ProcessorStep):
-    """Writes the one-hot task vector of the batch's ``task`` strings into ``observation.environment_state``.
+    """Writes the one-hot vector of the batch's ``task`` strings into ``observation.environment_state``.
 
-    A task outside ``task_names`` (a held-out task) gets the zero vector. A transition without a
-    ``task`` (e.g. normalising stored frames) passes unchanged.
+    A task outside ``task_names`` gets the zero vector; a transition without a ``task`` passes unchanged.
     """
 
     def __init__(self, task_names: Sequence[str] = ()) -> None:

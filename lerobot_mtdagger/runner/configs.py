@@ -1,9 +1,7 @@
 """The options of ``lerobot-mtdagger run`` (``RunConfig``, draccus), their checks and their older names.
 
-Every option a preset fills (``presets.PRESET_FIELDS``) has one home, its own field; None there means
-"from the preset" (``--preset``, default ``small``), so a value given on the command line always wins.
-The option groups are in ``option_groups`` (``--dagger.*``, ``--rollout.*``, ``--expert.*``,
-``--training.*``) and ``policy_options`` (``--policy.*``); the presets' values in ``presets``.
+An option a preset fills (``presets.PRESET_FIELDS``) is None until the preset fills it, so a value
+given on the command line always wins. The groups live in ``option_groups`` and ``policy_options``.
 """
 
 from __future__ import annotations
@@ -46,36 +44,27 @@ cache_dataclass_sources()  # draccus.parse(RunConfig) in 0.1 s instead of 2-3 s 
 class RunConfig:
     """Options of ``lerobot-mtdagger run`` (one Multitask DAgger experiment, or the BC baseline).
 
-    Thirteen top-level options; the rest sit in their group (``--suite.obs_mode``, ``--dagger.rounds``,
-    ``--rollout.eval_episodes``, ``--training.steps_rule``, ``--policy.lr``, ``--scheduler.n_min``).
-    A flat config stored before the groups existed is migrated on reading
-    (``datasets/migrations.py``), and the old spellings are refused with the new one named.
+    A flat config of an older layout is migrated on reading (``datasets/migrations.py``); the old
+    spellings are refused with the new one named.
 
     Attributes:
         preset: One of ``PRESETS``; fills every option of ``PRESET_FIELDS`` left unset (None).
-        mode: ``dagger`` (Algorithm 1 with ``scheduler``) or ``bc``: ONE round of expert
-            demonstrations with the same data budget (``initial_demos + rounds * budget / num_tasks``
-            per task, split uniformly), trained like a DAgger phase (``phase_steps``); the scheduler
-            is unused.
-        suite: The suite and its observations (``SuiteConfig``; shared with ``eval``, ``shift`` and
-            the LeRobot env plugin).
+        mode: ``dagger`` (Algorithm 1 with ``scheduler``) or ``bc``: ONE round of expert demonstrations
+            with the same data budget (``initial_demos + rounds * budget / num_tasks`` per task), trained
+            like a DAgger phase; the scheduler is unused.
+        suite: The suite and its observations (``SuiteConfig``).
         dagger: Rounds, demo budgets and beta (``DAggerConfig``).
         rollout: Episode cuts, evaluation episodes and env workers (``RolloutConfig``).
         training: Steps per phase, sampling, held-out split (``TrainingConfig``).
-        scheduler: ``--scheduler.type=uniform|need|need_raw|gain`` and its hyperparameters
-            (``scheduler.n_min`` from the preset when unset).
-        expert: The experts' quality: noise on their actions, and which action is the label
-            (``ExpertConfig``; off by default).
-        policy: The student and its options: ``--policy.type=mtdagger`` (default; ``PolicyOptions``)
-            or a LeRobot policy (``act``, ``diffusion``) with LeRobot's own options plus
-            ``batch_size`` (``StudentOptions``). ``policy.batch_size`` (and for ``mtdagger``
-            ``policy.lr``) come from the preset when unset.
+        scheduler: The allocation method (``--scheduler.type``) and its hyperparameters.
+        expert: The experts' quality: noise on their actions, which action is the label (``ExpertConfig``).
+        policy: The student and its options: ``--policy.type=mtdagger`` (default; ``PolicyOptions``) or a
+            LeRobot policy (``act``, ``diffusion``) with LeRobot's own options plus ``batch_size``.
         output_dir: Experiment directory (refused if it exists, unless ``resume``); default
             ``outputs/mtdagger/<preset>-<method>-seed<seed>``.
         seed: Seed of everything (collection, evaluation, training).
         resume: Continue the experiment in ``output_dir`` from its last committed round.
-        progress: Show progress bars (only on a terminal); the summary line of each round is
-            always printed.
+        progress: Show progress bars (only on a terminal); each round's summary line is always printed.
     """
 
     preset: str = "small"
@@ -180,13 +169,10 @@ class RunConfig:
         return self.seed if self.training.seed is None else self.training.seed
 
     def phase_steps(self, frames: int) -> int:
-        """Optimiser steps of one training phase on ``frames`` training frames.
+        """Optimiser steps of one training phase on ``frames`` training frames (by ``steps_rule``).
 
-        A DAgger phase takes ``steps_per_round`` steps (``steps_rule=fixed``) or ``epochs`` passes
-        over its frames (``steps_rule=epochs``), or at most ``plateau_max_steps`` (``steps_rule=plateau``:
-        the held-out loss ends it sooner). BC trains once, on its final data, by the same rule,
-        except with fixed steps and a warm start: the final DAgger policy has then taken
-        ``(rounds + 1) * steps_per_round`` steps in all, and so does BC.
+        BC trains once, on its final data, by the same rule; with fixed steps and a warm start it takes
+        ``(rounds + 1) * steps_per_round`` steps, as the final DAgger policy has in all.
         """
         training = self.training
         if training.steps_rule == "plateau":
@@ -199,11 +185,9 @@ class RunConfig:
 
     @classmethod
     def option_defaults(cls) -> dict[str, Any]:
-        """What each option was before it existed, by dotted path (e.g. ``training.plateau_every: 200``).
+        """Each option's value for runs stored without it, by dotted path (``training.plateau_every: 200``).
 
-        Its plain default, except where a migration names what runs made before it had
-        (``migrations.former_option_values``). Policy options are those of ``mtdagger`` (the only
-        student then).
+        Its plain default, unless a migration names another (``migrations.former_option_values``).
         """
         defaults: dict[str, Any] = {}
         for group, options in (
@@ -230,21 +214,20 @@ class RunConfig:
 
 
 RUN_OPTION_RENAMES: dict[str, str] = FLAT_OPTION_PATHS
-"""``run``'s (and ``compare``'s run) options before they were grouped, and their spelling today."""
+"""``run``'s (and ``compare``'s) ungrouped option names, and their grouped spelling."""
 
 
 SUITE_OPTION_RENAMES: dict[str, str] = {
     old: new for old, new in FLAT_OPTION_PATHS.items() if new.startswith("suite.")
 }
-"""``eval``'s and ``shift``'s suite options before ``SuiteConfig``, and their spelling today."""
+"""``eval``'s and ``shift``'s ungrouped suite option names, and their ``--suite.*`` spelling."""
 
 
 def renamed_option_error(args: Sequence[str], renames: Mapping[str, str] | None = None) -> str | None:
-    """A message naming the new spelling when ``args`` use an option that was renamed (else None).
+    """A message naming the new spelling when ``args`` use a renamed option (else None).
 
-    ``--scheduler.type=bc`` became ``--mode=bc`` (BC is a run mode, not a scheduler), ``--n_min``
-    became ``--scheduler.n_min`` (one home per option), and each option of ``renames`` (the
-    command's grouped options: ``--obs_mode`` became ``--suite.obs_mode``) its new path.
+    Covers ``--scheduler.type=bc`` (now ``--mode=bc``), ``--n_min`` (now ``--scheduler.n_min``) and
+    each option of ``renames``.
     """
     for arg in args:
         name, _, value = arg.partition("=")

@@ -10,31 +10,11 @@ The loop, with round k's dataset committed before the policy trained on it::
     phase k       train pi_{k+1} on D(k) (warm start from pi_k); losses; evaluate -> policies/round-k
                   beta_{k+1} = max(beta_k - delta, beta_min)
 
-This is the paper's ordering ("round k: train on D(k-1), then schedule and collect") with the
-training of round k+1 stored beside round k. ``--mode=bc`` (the baseline) runs round 0 only, with the
-whole budget ``n0 + rounds * B / N`` per task, trained like a DAgger phase (``RunConfig.phase_steps``).
-
-The scheduler is fed two measurements, both of the learner alone:
-
-- task need: the success of the previous round's episodes where ONLY the learner acted (round 1's
-  are the first; under step mixing with beta > 0 there are none, and the Kalman filter only
-  predicts). An episode where the expert executed some actions may succeed because of them.
-- performance gain: ``max(0, L_previous - L_end)`` per task, where ``L_previous`` is the loss of the
-  policy that collected the round (the previous phase's) and ``L_end`` that of the newly trained
-  one, on the same frames in the same normalisation. With a warm start and fixed normalisation
-  ``L_previous`` is the loss at the start of training (the paper's ``L_start``); unlike the latter
-  it stays meaningful when a phase retrains from scratch or renormalises. Phase 0 has no previous
-  policy, so round 1 is allocated by the prior (a loss drop from random weights would rank the tasks
-  by the scale of their actions).
-
-Normalisation statistics come from round 0's training frames and stay fixed (``normalisation``), so
-a warm-started policy sees its inputs as before; held-out episodes (``gain_split=heldout`` or
-``steps_rule=plateau``) are chosen once per episode and stay held out.
-
-Resuming: committed rounds and phases are immutable; a run restarts at the first uncommitted step (a
-training phase from its saved progress, where it has some: ``runner.training.phase_progress``).
-Every random choice derives from the seed and the round, and the scheduler's state after each round
-is stored in the round's record, so a resumed run makes the same allocations as an uninterrupted one.
+``--mode=bc`` runs round 0 only, with the whole budget. Task need is the success of the episodes
+where only the learner acted; performance gain is ``max(0, L_previous - L_end)`` per task, the
+previous phase's policy against the new one on the same frames (``docs/dagger.md``, "The protocol").
+Committed rounds and phases are immutable: a resumed run restarts at the first uncommitted step and,
+as every random choice derives from the seed and the round, makes the same allocations.
 """
 
 from __future__ import annotations
@@ -292,10 +272,7 @@ def train_round(ctx: RunContext, round_index: int) -> None:
 def evaluate_student(
     ctx: RunContext, trained: TrainedPhase, round_index: int
 ) -> tuple[dict | None, dict | None]:
-    """``EvalResult.to_dict()`` on the training tasks and on the unseen ones (None: not evaluated).
-
-    A phase that ``--rollout.eval_phases`` leaves out is not evaluated at all.
-    """
+    """``EvalResult.to_dict()`` on the training and the unseen tasks (None: the phase is not evaluated)."""
     if not ctx.config.rollout.evaluates(round_index):
         return None, None
     runner = ctx.config.student.make_runner(trained.policy, trained.preprocessor, trained.postprocessor)
@@ -311,8 +288,7 @@ def evaluate_student(
 def evaluate_phase(ctx: RunContext, runner: PolicyRunner, workers: EnvWorkers) -> EvalResult | None:
     """Evaluates the freshly trained policy on the tasks of ``workers`` (None when eval_episodes is 0).
 
-    ``ctx.workers`` step the training tasks; workers of ``ctx.heldout_suite`` the unseen ones, whose
-    result is recorded beside the training tasks' and never reaches the scheduler.
+    The unseen tasks' result is recorded beside the training tasks' and never reaches the scheduler.
     """
     if ctx.config.rollout.eval_episodes == 0:
         return None
@@ -340,16 +316,13 @@ def run(
 ) -> list[str]:
     """Runs (or resumes) one experiment; returns the per-round summary lines.
 
-    Args:
-        config: The run's options.
-        on_summary: Called with each round's summary line as soon as the round is done.
-        on_start: Called once every check has passed and the experiment is locked, before any round
-            (a refused run never calls it).
+    ``on_summary`` gets each round's line as soon as the round is done; ``on_start`` is called once
+    every check has passed and the experiment is locked.
 
     Raises:
         UserError: If the output directory exists and ``resume`` is false, on a bad config, on a
-            foreign output directory or one whose committed files changed (left untouched), and
-            (``ExperimentLockedError``) if another run is writing into it.
+            foreign or altered output directory, and (``ExperimentLockedError``) if another run writes
+            into it.
         FloatingPointError: If training diverges.
         WorkerDiedError: If an env worker process dies.
     """

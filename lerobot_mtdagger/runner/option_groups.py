@@ -1,7 +1,6 @@
 """The option groups of ``run``: ``--dagger.*``, ``--rollout.*``, ``--expert.*`` and ``--training.*``.
 
-Each group's options, the choices each takes and the checks that refuse a bad value; the env workers'
-options (``WorkerOptions``) are shared with ``eval`` and ``shift``.
+The env workers' options (``WorkerOptions``) are shared with ``eval`` and ``shift``.
 """
 
 from __future__ import annotations
@@ -22,8 +21,7 @@ RUN_MODES: tuple[str, ...] = ("dagger", "bc")
 
 
 MIXING_MODES: tuple[str, ...] = ("episode", "step")
-"""``episode``: one beta coin per episode (the expert or the learner acts throughout); ``step``: a coin
-at every step (classic DAgger)."""
+"""``episode``: one beta coin per episode; ``step``: a coin at every step (classic DAgger)."""
 
 
 NORMALISATIONS: tuple[str, ...] = ("fixed", "recompute")
@@ -31,8 +29,7 @@ NORMALISATIONS: tuple[str, ...] = ("fixed", "recompute")
 
 
 STEPS_RULES: tuple[str, ...] = ("fixed", "epochs", "plateau")
-"""``fixed``: ``steps_per_round`` per phase; ``epochs``: ``epochs`` passes over the phase's frames;
-``plateau``: until the loss on held-out episodes stops improving."""
+"""``fixed`` steps, ``epochs`` passes over the frames, or until the held-out loss stops (``plateau``)."""
 
 
 SAMPLINGS: tuple[str, ...] = ("uniform", "balanced")
@@ -40,8 +37,7 @@ SAMPLINGS: tuple[str, ...] = ("uniform", "balanced")
 
 
 LR_SCHEDULES: tuple[str, ...] = ("constant", "cosine")
-"""``constant``: the learning rate throughout a phase; ``cosine``: decayed to 0 over the phase's steps
-(each phase starts again at the full rate)."""
+"""``constant``, or ``cosine``: decayed to 0 over each phase's steps."""
 
 
 WORKER_BACKENDS: tuple[str, ...] = ("local", "ray")
@@ -78,9 +74,8 @@ class DAggerConfig:
         beta: Probability of executing the expert's action in the first DAgger round.
         beta_decay: Subtracted from beta after every DAgger round.
         beta_min: Floor of beta.
-        mixing: ``episode`` (one beta coin per episode: the expert or the learner acts throughout)
-            or ``step`` (a coin at every step). Task need is measured on the episodes where only the
-            learner acted, so under ``step`` mixing with beta > 0 a round measures nothing.
+        mixing: ``episode`` (one beta coin per episode) or ``step`` (a coin at every step). Task need
+            reads learner-only episodes, so ``step`` with beta > 0 measures nothing.
     """
 
     rounds: int | None = None
@@ -118,18 +113,13 @@ class DAggerConfig:
 class WorkerOptions:
     """Env workers: how many, and where they run (``run``'s ``--rollout.*``, ``eval``'s and ``shift``'s own).
 
-    One definition of the options, their checks and the workers they start, for every command that
-    steps envs; each command keeps its spelling (``--rollout.workers`` for ``run``, ``--workers``
-    for ``eval``).
-
     Attributes:
-        workers: Env worker processes for collection and evaluation (None: one per core; 0: step
-            the envs in the main process; with ``worker_backend=ray``, at least one actor). Never
-            changes a result.
-        worker_backend: ``local`` (forked processes on this machine) or ``ray`` (Ray actors spread
-            over a Ray cluster, ``runner/rollout/ray_workers.py``). Never changes a result.
-        ray_address: The Ray cluster of ``worker_backend=ray`` (``auto``: the one ``ray start`` left
-            on this machine; ``ray://host:10001``; None: start a local Ray).
+        workers: Env worker processes for collection and evaluation (None: one per core; 0: in the main
+            process). Never changes a result.
+        worker_backend: ``local`` (forked processes) or ``ray`` (Ray actors on a cluster). Never changes
+            a result.
+        ray_address: The Ray cluster of ``worker_backend=ray`` (``auto``: the one ``ray start`` left on
+            this machine; ``ray://host:10001``; None: start a local Ray).
     """
 
     workers: int | None = None
@@ -139,9 +129,7 @@ class WorkerOptions:
     def check_workers(self, prefix: str = "") -> None:
         """Refuses a negative count, an unknown backend or a missing Ray, before anything runs.
 
-        Args:
-            prefix: The options' group on the command line (``rollout.`` for ``run``), as the
-                messages name them.
+        ``prefix`` is the options' group as the messages name it (``rollout.`` for ``run``).
         """
         resolve_workers(self.workers)
         _require_choice(self.worker_backend, f"{prefix}worker_backend", WORKER_BACKENDS)
@@ -157,8 +145,7 @@ class WorkerOptions:
     def env_workers(self, suite: Any, reserve_cpus: bool = True) -> Any:
         """The ``EnvWorkers`` of ``suite`` on this config's backend (a context manager).
 
-        ``reserve_cpus=False``: a pool that runs only while the run's own workers wait (on Ray its
-        actors reserve no CPU, so a cluster the size of ``workers`` does not wait on itself).
+        ``reserve_cpus=False``: a pool that runs only while the run's own workers wait (no Ray CPUs).
         """
         from lerobot_mtdagger.runner.rollout.ray_workers import make_env_workers
 
@@ -171,16 +158,12 @@ class RolloutEpisodes:
 
     Attributes:
         eval_episodes: Evaluation episodes per task after each training phase (None: the preset's).
-        max_steps: Steps after which a DAgger rollout is cut (None: the env's own horizon, the one
-            evaluation runs to).
-        expert_multiple: Cut a DAgger rollout at this multiple of the steps the expert alone takes
-            to succeed from the same reset seed (the expert runs that episode first, unrecorded; no
-            cut where it fails). None: no such cut. ``max_steps`` still applies.
+        max_steps: Steps after which a DAgger rollout is cut (None: the env's own horizon).
+        expert_multiple: Cut a DAgger rollout at this multiple of the steps the expert alone takes to
+            succeed from the same reset (no cut where it fails). None: no such cut.
         steps_after_success: Steps recorded after the first success before an episode ends.
-        eval_phases: The phases whose policy is evaluated (0: round 0's, the only phase of a BC run);
-            None: every phase. A study whose analysis reads only some budgets evaluates those alone
-            (evaluation is most of a study's cost); the scheduler does not read evaluations, so
-            allocations are unchanged.
+        eval_phases: The phases whose policy is evaluated (0: round 0's, a BC run's only one); None: every
+            phase. Allocations do not depend on it.
     """
 
     eval_episodes: int | None = None
@@ -194,8 +177,7 @@ class RolloutEpisodes:
 class RolloutConfig(WorkerOptions, RolloutEpisodes):
     """Episodes: where a DAgger rollout is cut, evaluation, env workers (``--rollout.*``).
 
-    The options of ``RolloutEpisodes``, then the env workers (``WorkerOptions``): a dataclass takes
-    the fields of its last base first, which keeps their order in ``config.json`` and ``--help``.
+    A dataclass takes its last base's fields first: ``RolloutEpisodes``' options come before the workers'.
     """
 
     def check(self) -> None:
@@ -221,28 +203,21 @@ class RolloutConfig(WorkerOptions, RolloutEpisodes):
 class ExpertConfig:
     """How far the experts are from perfect (``--expert.*``; ``experts/noise.py`` gives the formula).
 
-    Off by default: the experts act as they are. With ``noise > 0`` every action an expert executes
-    gets temporally correlated Gaussian noise, the way a stochastic RL policy acts (the paper's SAC
-    and PPO experts succeed on 80-95% of episodes; MetaWorld's scripted ones on about 98%).
-
     Attributes:
-        noise: Standard deviation of the noise on each action component, in action units (actions
-            lie in [-1, 1]); 0: no noise.
+        noise: Standard deviation of the noise on each action component, in action units (actions lie
+            in [-1, 1]); 0: no noise.
         noise_by_task: Some tasks' own noise instead of ``noise``, by task name, e.g.
-            ``'{assembly-v3: 0.05, reach-v3: 0.6}'`` (one level cannot put every expert at the same
-            success). None: ``noise`` for every task.
+            ``'{assembly-v3: 0.05, reach-v3: 0.6}'``. None: ``noise`` for every task.
         noise_correlation: Step-to-step correlation of the noise, in [0, 1) (0: white noise).
         noise_seed: Seed of the noise, apart from ``--seed``.
-        labels: What a frame stores as the expert's label: ``noisy`` (the executed action: the
-            expert is a stochastic policy) or ``clean`` (the expert's own action: DART-style).
-        path: LeRobot policy folders acting on the privileged state (``observation.state``): one
-            multitask policy folder, or a folder with one policy folder per task named after it
-            (``experts/command_line.py``). None: the registered experts.
-        type: An expert factory ``factory(suite, task) -> Expert``: a name registered with
-            ``register_expert_type``, or an importable ``module:attribute``. None: the registered experts.
-        min_success: Keep only the tasks whose expert (as the run uses it, noise included) succeeds at
-            least this often over ``success_episodes`` episodes, measured before round 0 (the paper kept
-            the MT50 tasks its SAC experts passed at 80%; ``rollout/expert_check.py``). None: every task.
+        labels: What a frame stores as the expert's label: ``noisy`` (the executed action) or ``clean``
+            (the expert's own action: DART-style).
+        path: LeRobot policy folders acting on the privileged state: one multitask policy folder, or one
+            policy folder per task (``experts/command_line.py``). None: the registered experts.
+        type: An expert factory ``factory(suite, task) -> Expert``: a registered name or an importable
+            ``module:attribute``. None: the registered experts.
+        min_success: Keep only the tasks whose expert succeeds at least this often, measured before
+            round 0 (``rollout/expert_check.py``). None: every task.
         success_episodes: Episodes per task that ``min_success`` is measured on.
     """
 
@@ -272,11 +247,7 @@ class ExpertConfig:
             )
 
     def suite_with_experts(self, suite: Any) -> Any:
-        """``suite`` with these experts: the named ones (``path``, ``type``) and their noise.
-
-        Raises:
-            UserError: On a path or type that gives no valid expert for every task (one line).
-        """
+        """``suite`` with these experts (``path``, ``type``) and their noise (``UserError`` on a bad one)."""
         unknown = sorted(set(self.noise_by_task or {}) - set(suite.task_names))
         if unknown:
             raise UserError(
@@ -306,35 +277,26 @@ class TrainingConfig:
     Attributes:
         steps_per_round: Training steps after each round (``steps_rule=fixed``; None: the preset's).
         warm_start: Continue from the previous round's weights (else retrain from scratch).
-        steps_rule: ``fixed`` (``steps_per_round`` steps per phase), ``epochs`` (``epochs`` passes
-            over the phase's training frames, at least one step) or ``plateau`` (until the loss on
-            held-out episodes stops improving, at most ``plateau_max_steps``; the weights of its
-            minimum are kept). ``plateau`` holds ``heldout_fraction`` of each task's episodes out of
-            training, BC's and DAgger's alike. None: from the preset (``fixed`` except
-            ``metaworld-pixels``: ``epochs``).
-        epochs: Passes over the training frames per phase when ``steps_rule=epochs``; None: from the
-            preset (100 except ``metaworld-pixels``: 10).
+        steps_rule: ``fixed`` (``steps_per_round`` per phase), ``epochs`` (``epochs`` passes over the
+            phase's frames) or ``plateau`` (until the held-out loss stops improving, at most
+            ``plateau_max_steps``; the best weights are kept). None: from the preset.
+        epochs: Passes over the training frames per phase when ``steps_rule=epochs``; None: the preset's.
         plateau_every: Steps between two held-out loss measurements when ``steps_rule=plateau``.
         plateau_patience: Measurements without a new minimum that end a ``plateau`` phase.
         plateau_max_steps: Most steps of a ``plateau`` phase.
-        normalisation: ``fixed`` (statistics of round 0's training frames for every phase: a warm
-            start sees inputs normalised as before) or ``recompute`` (statistics of D(k) each phase).
+        normalisation: ``fixed`` (statistics of round 0's training frames for every phase) or
+            ``recompute`` (of D(k) each phase).
         sampling: ``uniform`` (frames uniformly) or ``balanced`` (a task uniformly, then one of its
-            frames); None: from the preset (``uniform`` except ``metaworld-pixels``: ``balanced``).
-        lr_schedule: ``constant`` or ``cosine`` (the ``mtdagger`` policy's learning rate decayed to 0
-            over each phase's steps; a LeRobot student follows its config's scheduler preset).
+            frames); None: from the preset.
+        lr_schedule: ``constant`` or ``cosine`` (``mtdagger`` only; a LeRobot student follows its config's
+            scheduler preset).
         gain_split: ``train`` (per-task loss on the training data) or ``heldout`` (on held-out episodes).
-        heldout_fraction: Fraction of each task's episodes held out of training when
-            ``gain_split=heldout`` or ``steps_rule=plateau`` (decided once per episode, so an
-            episode never changes side; a task's first episode is always trained on).
-        seed: Seed of the phases' initial weights, batch order and task dropout, where it is to
-            differ from the run's ``--seed`` (which keeps every other draw: the episodes collected,
-            evaluated and held out). A BC run repeated with other training seeds trains on the very
-            same data: the spread between trainings, apart from the data's. None: ``--seed``.
-        progress_every_s: Seconds of training between two saves of a phase's progress
-            (``policies/.progress``), from which a phase cut off part-way resumes with
-            ``--resume=true`` and ends as it would have (``runner.training.phase_progress``); 0: never saved,
-            a cut phase starts over. Changes no result.
+        heldout_fraction: Fraction of each task's episodes held out when ``gain_split=heldout`` or
+            ``steps_rule=plateau`` (an episode never changes side; a task's first is always trained on).
+        seed: Seed of the phases' initial weights, batch order and task dropout, if it is to differ from
+            ``--seed`` (which keeps the episodes collected, evaluated and held out). None: ``--seed``.
+        progress_every_s: Seconds of training between two saves of a phase's progress, from which a cut
+            phase resumes with ``--resume=true``; 0: never saved. Changes no result.
     """
 
     steps_per_round: int | None = None
@@ -380,11 +342,7 @@ class TrainingConfig:
 
 
 def check_device(device: str) -> None:
-    """Refuses a torch device this machine does not have, before anything runs.
-
-    Raises:
-        ValueError: Naming the device and the devices there are.
-    """
+    """Refuses a torch device this machine lacks, before anything runs (``ValueError`` naming its devices)."""
     import torch
 
     try:
@@ -407,11 +365,7 @@ def check_device(device: str) -> None:
 
 
 def resolve_workers(workers: int | None) -> int:
-    """The env worker count an option asks for: one per core for None, else ``workers``.
-
-    Raises:
-        ValueError: If ``workers`` is negative.
-    """
+    """The env worker count an option asks for: one per core for None (``ValueError`` if negative)."""
     if workers is not None and workers < 0:
         raise ValueError(f"workers must be >= 0 (0: envs in the main process), got {workers}.")
     return default_worker_count() if workers is None else workers

@@ -1,9 +1,7 @@
 """The run's ``--policy.*`` options: the default student's (``PolicyOptions``) or another student's.
 
-``--policy.type`` chooses the student (``StudentOptions``, over the students registered in
-``runner.student``); other students' options classes (LeRobot's: ``students.options``) are offered
-by the parser only when the options name a student other than ``mtdagger`` (``students_for``), so
-parsing the options of a run of ``mtdagger`` imports no student module, no torch and no LeRobot.
+Other students' options classes are offered to the parser only when the options name one
+(``students_for``), so parsing a ``mtdagger`` run's options imports no torch and no LeRobot.
 """
 
 from __future__ import annotations
@@ -28,13 +26,11 @@ class PolicyOptions:
         state_hidden_dims: Hidden sizes of the state MLP.
         head_hidden_dims: Hidden sizes of the action head.
         pointnet_dims: PointNet per-point MLP sizes.
-        pointnet_layer_norm: LayerNorm after every PointNet layer and its projection (DP3's encoder;
-            with ``pointcloud_embedding_dim=64`` and 512 points, DP3's size).
+        pointnet_layer_norm: LayerNorm after every PointNet layer and its projection (DP3's encoder).
         pointcloud_embedding_dim: Output size of the point-cloud encoder.
         task_embedding_dim: Task embedding size.
-        task_dropout: Probability of training a sample on the shared "any task" embedding instead of
-            its own (``MTDAggerConfig.task_dropout``: what lets the policy act on unseen tasks). None:
-            ``UNSEEN_TASK_DROPOUT`` for a suite with held-out tasks (the drawers), else 0.
+        task_dropout: Probability of training a sample on the shared "any task" embedding, which lets
+            the policy act on unseen tasks. None: ``UNSEEN_TASK_DROPOUT`` with held-out tasks, else 0.
         device: Torch device.
     """
 
@@ -67,13 +63,7 @@ _LEROBOT_STUDENTS_PARSED: contextvars.ContextVar[bool] = contextvars.ContextVar(
 
 
 def names_lerobot_student(options: Sequence[str]) -> bool:
-    """Whether command-line options may choose a student other than ``mtdagger`` (a LeRobot one).
-
-    They may with a registered ``--policy.type`` other than ``mtdagger``, or a ``--config_path`` file.
-
-    Raises:
-        UserError: If ``--policy.type`` names no registered student (one line listing them).
-    """
+    """Whether the options may choose a student other than ``mtdagger`` (``UserError``: unknown type)."""
     for position, option in enumerate(options):
         name, separator, value = option.partition("=")
         if name == "--config_path":
@@ -87,11 +77,7 @@ def names_lerobot_student(options: Sequence[str]) -> bool:
 
 @contextlib.contextmanager
 def students_for(options: Sequence[str]) -> Iterator[None]:
-    """Offers LeRobot's students to the parser only if ``options`` may name one.
-
-    ``--help`` and a refused option then answer without importing LeRobot and torch (seconds on a
-    small machine).
-    """
+    """Offers LeRobot's students to the parser only if ``options`` may name one (fast ``--help``)."""
     token = _LEROBOT_STUDENTS_PARSED.set(names_lerobot_student(options))
     try:
         yield
@@ -102,10 +88,7 @@ def students_for(options: Sequence[str]) -> Iterator[None]:
 class StudentOptions:
     """The student policy and its options: ``--policy.type`` (draccus choice type; default ``mtdagger``).
 
-    Each registered student (``runner.student``) gives its options class: ``mtdagger`` takes
-    ``PolicyOptions``; ``act`` and ``diffusion`` take LeRobot's own config of that policy
-    (``students.options.lerobot_students()``) plus ``batch_size``. A stored config without ``type``
-    is ``mtdagger``.
+    Each registered student gives its options class; a stored config without ``type`` is ``mtdagger``.
     """
 
     @classmethod
@@ -115,21 +98,14 @@ class StudentOptions:
 
     @classmethod
     def get_known_choices(cls) -> dict[str, type]:
-        """Every ``--policy.type`` and its options class.
-
-        ``mtdagger`` alone while options that name no other student are parsed (``students_for``).
-        """
+        """Every ``--policy.type`` and its options class (``mtdagger`` alone unless ``students_for``)."""
         if not _LEROBOT_STUDENTS_PARSED.get():
             return {MTDAGGER_TYPE: PolicyOptions}  # the mtdagger student's options_class()
         return {name: get_student(name).options_class() for name in student_names()}
 
     @classmethod
     def get_choice_name(cls, subcls: type) -> str:
-        """The ``--policy.type`` of an options class.
-
-        Raises:
-            ValueError: If ``subcls`` is not a student's options class.
-        """
+        """The ``--policy.type`` of an options class (``ValueError`` if it is no student's)."""
         for name, choice in cls.get_known_choices().items():
             if choice is subcls:
                 return name
@@ -147,5 +123,5 @@ def student_type(options: Any) -> str:
 
 
 def policy_options_dict(options: Any) -> dict[str, Any]:
-    """JSON-ready policy options: ``mtdagger``'s fields as before (no ``type``), else type + its own."""
+    """JSON-ready policy options: ``mtdagger``'s fields alone (no ``type``), else ``type`` and its own."""
     return student_of_options(options).options_dict(options)

@@ -1,8 +1,4 @@
-"""What a run settles before its rounds: kept and unseen tasks, the budget check, scheduler and beta.
-
-``dagger.run`` reads them once; each is a function of the run's options (and, for the kept tasks,
-of a measurement stored with the experiment so a resume reads it back).
-"""
+"""What a run settles before its rounds: kept and unseen tasks, the budget check, scheduler and beta."""
 
 from __future__ import annotations
 
@@ -26,11 +22,7 @@ def beta_for_round(config: RunConfig, round_index: int) -> float:
 
 
 def check_budget(config: RunConfig, num_tasks: int) -> None:
-    """Refuses a round budget that cannot give every task n_min episodes, before anything runs.
-
-    Raises:
-        UserError: With the numbers and the fix.
-    """
+    """Refuses a round budget that cannot give every task n_min episodes (``UserError`` with the numbers)."""
     budget = config.dagger.budget_for(num_tasks)
     n_min = config.scheduler.min_episodes
     if not config.is_bc and budget < n_min * num_tasks:
@@ -42,11 +34,7 @@ def check_budget(config: RunConfig, num_tasks: int) -> None:
 
 
 def kept_tasks_check(config: RunConfig, suite: TaskSuite, experiment: ExperimentDir) -> ExpertCheck | None:
-    """The tasks ``--expert.min_success`` keeps: read back on a resume, else measured (None: no rule).
-
-    Raises:
-        UserError: If no task is kept, or a resumed experiment's ``expert_check.json`` is unreadable.
-    """
+    """The tasks ``--expert.min_success`` keeps: read back on a resume, else measured (None: no rule)."""
     options = config.expert
     if options.min_success is None:
         return None
@@ -60,11 +48,7 @@ def kept_tasks_check(config: RunConfig, suite: TaskSuite, experiment: Experiment
 
 
 def unseen_task_suite(config: RunConfig, suite: TaskSuite) -> TaskSuite | None:
-    """The held-out tasks every phase is also evaluated on.
-
-    None where the suite has none, the policy has no shared task embedding to act on them with
-    (``--policy.task_dropout=0``), or nothing is evaluated.
-    """
+    """The held-out tasks each phase is also evaluated on (None: none, no shared embedding, no evaluation)."""
     heldout = suite.heldout_suite()
     if heldout is None or config.rollout.eval_episodes == 0:
         return None

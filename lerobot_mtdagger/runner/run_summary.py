@@ -1,7 +1,4 @@
-"""What a run says of its rounds: one summary line per round, also of a finished run resumed.
-
-A resume of a finished run reads its lines from the records and writes nothing to its folder.
-"""
+"""What a run says of its rounds: one summary line per round, also of a finished run resumed."""
 
 from __future__ import annotations
 

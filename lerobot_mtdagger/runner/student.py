@@ -1,18 +1,11 @@
 """The student contract (``Student``) and the registry of students by ``--policy.type``.
 
-As LeRobot names its policies (``PreTrainedPolicy`` subclasses, found by ``get_policy_class(name)``),
-the runner finds the student of a run by its ``--policy.type`` (``get_student(name)``) and asks it,
-through ``Student``, for everything that differs between students: its options, its policy config
-and policy, its training seam, the previous phase's loss and its evaluation runner. The built-in
-students (``datasets.student_types.BUILTIN_STUDENT_TYPES``) are registered below as entry points,
-imported on first use, so parsing the options of ``mtdagger`` never imports LeRobot's policies::
+As LeRobot finds a policy class by name, the runner finds its student with ``get_student`` and asks
+it for everything that differs between students::
 
     register_student("my-student", MyStudent)  # MyStudent(Student) or "my_package.students:MyStudent"
 
-An installed package registers its students by entry point (group ``lerobot_mtdagger.students``,
-``utils.plugins``), so ``lerobot-mtdagger run --policy.type=<its name>`` finds them.
-
-Reading this module imports no torch and no LeRobot.
+Built-in and installed students are entry points imported on first use: this module imports no torch.
 """
 
 from __future__ import annotations
@@ -36,13 +29,11 @@ from lerobot_mtdagger.utils.registry import Registry
 class Student(abc.ABC):
     """What the runner needs from a student policy (one per ``--policy.type``).
 
-    A student is built with its registered name; ``policy_type`` is the LeRobot policy type of the
-    policies it saves (None: its name), which evaluation finds it by.
-
     Attributes:
         name: The ``--policy.type`` it is registered under.
         lr_option: The name of its learning-rate option (``--policy.<lr_option>``).
-        policy_type: The LeRobot ``type`` of the policies it builds (None: ``name``).
+        policy_type: The LeRobot ``type`` of the policies it builds, which evaluation finds it by
+            (None: ``name``).
     """
 
     lr_option: str = "lr"
@@ -62,72 +53,40 @@ class Student(abc.ABC):
         """The dataclass of its ``--policy.*`` options (with ``batch_size`` and ``device``)."""
 
     def options_dict(self, options: Any) -> dict[str, Any]:
-        """JSON-ready options for the run's record, with ``type`` (the default student's omits it).
-
-        Args:
-            options: Its options (an instance of ``options_class()``).
-        """
+        """JSON-ready options for the run's record, with ``type`` (the default student's omits it)."""
         values = dataclasses.asdict(options)
         return values if self.name == MTDAGGER_TYPE else {"type": self.name, **values}
 
     def check_run(self, config: Any) -> None:
-        """Refuses run options the student cannot train with (none by default).
-
-        Args:
-            config: The run's ``RunConfig``.
-
-        Raises:
-            ValueError: Naming the option and the fix.
-        """
+        """Refuses run options the student cannot train with (none by default) with a ``ValueError``."""
         del config
 
     @abc.abstractmethod
     def policy_config(
         self, options: Any, suite_features: dict[str, Any], task_names: Sequence[str], unseen: bool
     ) -> Any:
-        """Its policy config for a suite.
+        """Its policy config for a suite: ``task_names``, ``image_features``, ``task_dropout`` and ``device``.
 
-        Args:
-            options: Its ``--policy.*`` options.
-            suite_features: The suite's dataset features.
-            task_names: The training tasks, in order.
-            unseen: Whether the suite has held-out tasks (task dropout may then apply).
-
-        Returns:
-            A config with ``task_names``, ``image_features``, ``task_dropout`` and ``device``.
+        ``unseen``: the suite has held-out tasks (task dropout may then apply).
         """
 
     @abc.abstractmethod
     def make_policy(self, policy_cfg: Any, stats: dict[str, dict[str, Any]]) -> tuple[Any, Any, Any]:
-        """A freshly initialised policy on its config's device and its processors for ``stats``.
+        """A freshly initialised policy on its config's device, its pre- and its post-processor for ``stats``.
 
-        Draw the weights on the CPU (then move them), so that a seed gives the same weights on
-        every device.
-
-        Returns:
-            The policy, its pre-processor and its post-processor.
+        Draw the weights on the CPU (then move them), so a seed gives the same weights on every device.
         """
 
     @abc.abstractmethod
     def phase_ops(self, policy: Any, data: Any, options: Any) -> Any:
         """Its training seam for one phase (``step_loss``, ``task_losses``, ``optimizer``).
 
-        Args:
-            policy: The policy to train.
-            data: The phase's normalised frames (``normalise.NormalisedData``).
-            options: The phase's ``steps.StepOptions``.
+        ``data`` are the phase's ``NormalisedData``; ``options`` its ``steps.StepOptions``.
         """
 
     @abc.abstractmethod
     def previous_losses(self, runner: Any, data: Any, index: Any, options: Any) -> list[float | None]:
-        """The previous phase's policy's per-task loss on this phase's frames (performance gain's start).
-
-        Args:
-            runner: The previous phase's policy (``evaluate.PolicyRunner``).
-            data: This phase's normalised frames.
-            index: The frames to measure on.
-            options: This phase's ``steps.StepOptions``.
-        """
+        """The previous phase's policy's (``runner``) per-task loss on this phase's frames ``index``."""
 
     @abc.abstractmethod
     def make_runner(self, policy: Any, preprocessor: Any, postprocessor: Any) -> Any:
@@ -155,12 +114,7 @@ STUDENTS: Registry[type[Student]] = Registry(
 
 
 def register_student(name: str, student: StudentEntry) -> None:
-    """Registers the student of a ``--policy.type``.
-
-    Args:
-        name: The ``--policy.type``.
-        student: A ``Student`` subclass (built with ``name``), or its ``"module:attribute"`` entry
-            point, imported when the student is first asked for.
+    """Registers the student of a ``--policy.type``: a ``Student`` subclass or its ``"module:attribute"``.
 
     Raises:
         UserError: If ``name`` is already registered.
@@ -177,11 +131,7 @@ def student_names() -> list[str]:
 
 
 def check_student_name(name: str) -> str:
-    """``name`` if a student is registered under it, without building the student.
-
-    Raises:
-        UserError: On a name no student is registered for (one line listing the registered ones).
-    """
+    """``name`` if a student is registered under it, without building it (else a one-line ``UserError``)."""
     if name not in STUDENTS:
         raise UserError(
             f"Unknown --policy.type {name!r}; registered students: {', '.join(student_names())} (a student "
@@ -192,12 +142,7 @@ def check_student_name(name: str) -> str:
 
 
 def get_student(name: str) -> Student:
-    """The student of a ``--policy.type``.
-
-    Raises:
-        UserError: On a name no student is registered for (one line listing the registered ones), or
-            an entry point that does not import.
-    """
+    """The student of a ``--policy.type`` (``UserError`` on an unregistered name or a failing entry point)."""
     check_student_name(name)
     return _student(name, STUDENTS.entry(name), STUDENTS.get(name))
 
@@ -212,11 +157,7 @@ def _student(name: str, entry: StudentEntry, student_class: type[Student]) -> St
 
 
 def student_of_options(options: Any) -> Student:
-    """The student whose options class ``options`` is (exactly).
-
-    Raises:
-        ValueError: If no registered student takes options of that class.
-    """
+    """The student whose options class ``options`` is exactly (``ValueError`` if none)."""
     for name in student_names():
         student = get_student(name)
         if type(options) is student.options_class():
@@ -225,11 +166,7 @@ def student_of_options(options: Any) -> Student:
 
 
 def student_of_policy(policy: Any) -> Student:
-    """The student that built ``policy``: the one named by its config's ``type``, or whose policy type it is.
-
-    Raises:
-        UserError: If no registered student builds policies of that type.
-    """
+    """The student that built ``policy`` (by its config's ``type``); a ``UserError`` if none."""
     policy_type = policy.config.type
     if policy_type in STUDENTS:
         return get_student(policy_type)

@@ -23,14 +23,10 @@ def predict_action_chunk(policy: Any, batch: dict[str, torch.Tensor]) -> torch.T
 class ChunkRunner(PolicyRunner):
     """A LeRobot policy that acts in chunks (ACT, Diffusion Policy), one action queue PER EPISODE.
 
-    LeRobot's ``select_action`` keeps one queue for its whole batch, but the episodes of a rollout
-    batch start and end at different steps. Here each running episode (a rollout lane) has its own
-    observation history (``n_obs_steps``, the first observation repeated at the start, as LeRobot
-    does) and its own queue of the chunk's first ``n_action_steps`` actions; the policy is queried,
-    batched, for the episodes whose queue is empty. Called without lanes (``shift``, a plain call),
-    every row is a fresh episode: the first action of a new chunk. The chunk itself comes from
-    ``predict_chunk(policy, batch)``, the student's (``LeRobotStudent.predict_chunk``): LeRobot's
-    ``predict_action_chunk`` unless the policy needs its history handed over another way.
+    LeRobot's ``select_action`` keeps one queue for the whole batch, but a rollout's episodes start and
+    end at different steps. Each running episode (lane) keeps its own observation history and queue of
+    ``n_action_steps`` actions; the policy is queried, batched, for the lanes whose queue is empty.
+    Without lanes every row is a fresh episode.
     """
 
     tracks_episodes = True
@@ -49,13 +45,8 @@ class ChunkRunner(PolicyRunner):
     ) -> None:
         """Wraps a LeRobot policy in eval mode with its processors.
 
-        Args:
-            policy: A LeRobot ``PreTrainedPolicy`` that acts in chunks.
-            preprocessor: Its saved pre-processor.
-            postprocessor: Its saved post-processor.
-            predict_chunk: ``(policy, batch) -> (B, n, action_dim)`` normalised chunks for batches of
-                current observations or of histories (B, n_obs_steps, ...); None: LeRobot's
-                ``predict_action_chunk``.
+        ``predict_chunk`` gives normalised chunks (B, n, action_dim) for batches of current observations or
+        of histories (B, n_obs_steps, ...); None: LeRobot's ``predict_action_chunk``.
         """
         super().__init__(policy, preprocessor, postprocessor)
         self.predict_chunk = predict_chunk or predict_action_chunk
@@ -74,11 +65,8 @@ class ChunkRunner(PolicyRunner):
     ) -> np.ndarray:
         """Actions for a batch of running episodes.
 
-        Args:
-            observations: One observation per row.
-            tasks: Task name of each row.
-            lanes: The running episode (rollout lane) of each row (None: every row a fresh episode).
-            starts: Whether the row is its episode's first observation (its lane's queue restarts).
+        ``lanes`` are the rows' running episodes (None: every row a fresh episode); ``starts`` mark an
+        episode's first observation, which restarts its lane's queue.
         """
         inputs = {
             key: torch.from_numpy(np.stack([observation[key] for observation in observations]))
@@ -96,10 +84,7 @@ class ChunkRunner(PolicyRunner):
         return np.stack([self.queues[lane].popleft().numpy() for lane in lanes])
 
     def predict(self, inputs: dict[str, torch.Tensor], tasks: Sequence[str]) -> torch.Tensor:
-        """Unnormalised actions (B, action_dim): each row a fresh episode (its chunk's first action).
-
-        LeRobot's ``select_action`` would carry one action queue over calls; here nothing carries over.
-        """
+        """Unnormalised actions (B, action_dim), each row a fresh episode (its chunk's first action)."""
         batch = self.preprocess(inputs, tasks)
         keys = [key for key in batch if key.startswith("observation.")]
         if self.history_length > 1:  # a fresh episode's history repeats its first observation

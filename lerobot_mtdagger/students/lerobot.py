@@ -1,27 +1,9 @@
 """LeRobot's own policies (ACT, Diffusion Policy) as the DAgger student: config, batches, losses.
 
-The runner trains its student through one seam (``steps.phase_ops``): a training batch at given
-frames, the loss of one step, the per-task imitation loss and the optimiser. ``mtdagger`` has its
-fast implementation in ``mtdagger.py`` (``MTDAggerOps``); ``LeRobotOps`` here implements it for any LeRobot
-``PreTrainedPolicy`` of ``options.lerobot_students()`` from what LeRobot's policies declare
-(``LeRobotStudent`` is their ``runner.student.Student``, registered as ``act``, and
-``DiffusionStudent`` as ``diffusion``):
-
-- **Windows of frames**, as LeRobot's ``delta_timestamps`` give them: a frame's observation history
-  (``observation_delta_indices``: Diffusion's ``n_obs_steps``) and its action chunk
-  (``action_delta_indices``: ACT's ``chunk_size``, Diffusion's ``horizon``), taken within the frame's
-  episode, clamped at its ends, with ``action_is_pad`` where a chunk runs past them. DAgger frames
-  are labelled by the expert at every state the rollout visited, so a chunk is the expert's labels
-  at the next states of the same rollout.
-- **The task** as a one-hot ``observation.environment_state`` (``policies.task_conditioning``),
-  zeroed with probability ``task_dropout`` in training (the "any task" input unseen tasks get).
-- **The step's loss** is the policy's own ``forward`` loss; the **per-task imitation loss** (what
-  performance gain and the plateau stop measure) is that same loss per task, measured without
-  gradients under a fixed seed (ACT's VAE and dropout, Diffusion's noise draw are random), so the
-  same weights always measure the same.
-- **The optimiser and scheduler** are the policy config's presets (``get_optimizer_preset``,
-  ``get_scheduler_preset``) over ``get_optim_params()``, as ``lerobot-train`` builds them, with the
-  preset's gradient clipping; the scheduler runs over the phase's steps.
+``LeRobotOps`` implements the runner's training seam for any LeRobot ``PreTrainedPolicy``: frame
+windows as ``delta_timestamps`` give them (history and action chunk within the episode, with
+``action_is_pad``), the task as a one-hot ``observation.environment_state`` (zeroed by task dropout),
+the policy's own ``forward`` loss (per task under a fixed seed) and its config's optimiser presets.
 """
 
 from __future__ import annotations
@@ -60,8 +42,7 @@ class LeRobotStudentConfig:
     """A LeRobot student: its LeRobot policy config and the run's tasks.
 
     Attributes:
-        policy: The LeRobot policy config, with the suite's observations and the one-hot task vector
-            as inputs.
+        policy: The LeRobot policy config; its inputs include the one-hot task vector.
         task_names: The training tasks, in the order of the one-hot positions.
         task_dropout: Probability of zeroing a training frame's task vector.
     """
@@ -84,11 +65,7 @@ class LeRobotStudentConfig:
 def lerobot_student_config(
     options: Any, suite_features: dict[str, Any], task_names: Sequence[str], task_dropout: float
 ) -> LeRobotStudentConfig:
-    """The LeRobot student of a run's ``--policy.type=act|diffusion`` options for a suite.
-
-    Raises:
-        ValueError: If the policy refuses the features (LeRobot's own check names what is missing).
-    """
+    """The LeRobot student of a run's options for a suite (``ValueError`` if the policy refuses them)."""
     config = lerobot_policy_config(options)
     features = dataset_to_policy_features(suite_features)
     config.input_features = {k: f for k, f in features.items() if f.type is not FeatureType.ACTION}
@@ -101,10 +78,7 @@ def lerobot_student_config(
 
 
 def make_lerobot_student(spec: LeRobotStudentConfig) -> Any:
-    """A freshly initialised LeRobot policy of ``spec`` on its config's device, as LeRobot's ``make_policy``.
-
-    Seed torch before for reproducible weights (drawn on the CPU, then moved).
-    """
+    """A freshly initialised LeRobot policy of ``spec`` on its device (seed torch first: same weights)."""
     return get_policy_class(spec.policy.type)(spec.policy).to(spec.policy.device)
 
 
@@ -116,19 +90,12 @@ def make_lerobot_processors(spec: LeRobotStudentConfig, stats: dict[str, dict[st
 
 
 class EpisodeWindows:
-    """Frame indices of each frame's observation history and action chunk within its episode.
-
-    Frames of one episode must be consecutive (as round datasets store them).
-    """
+    """Frame indices of each frame's observation history and action chunk (episodes' frames consecutive)."""
 
     def __init__(
         self, episode_id: torch.Tensor, observation_deltas: Sequence[int] | None, action_deltas: Sequence[int]
     ) -> None:
-        """Finds each frame's episode bounds.
-
-        Raises:
-            ValueError: If an episode's frames are not consecutive.
-        """
+        """Finds each frame's episode bounds (``ValueError`` if an episode's frames are not consecutive)."""
         count = len(episode_id)
         starts_here = torch.ones(count, dtype=torch.bool)
         if count:
@@ -162,17 +129,10 @@ class EpisodeWindows:
 
 
 class LeRobotOps:
-    """The training seam for a LeRobot policy (see the module docstring).
-
-    Args:
-        policy: The LeRobot policy.
-        data: The phase's normalised frames (``normalise.NormalisedData``).
-        task_dropout: Probability of zeroing a training frame's task vector.
-        seed: Seed of the task dropout and of the loss measurements.
-    """
+    """The training seam for a LeRobot policy on a phase's normalised frames (see the module docstring)."""
 
     def __init__(self, policy: Any, data: Any, task_dropout: float, seed: int) -> None:
-        """Prepares the frame windows of ``data``."""
+        """Prepares the frame windows; ``seed`` seeds the task dropout and the loss measurements."""
         self.policy = policy
         self.data = data
         self.task_dropout = task_dropout
@@ -245,11 +205,9 @@ class LeRobotOps:
 
 
 class LeRobotStudent(Student):
-    """A LeRobot policy as the DAgger student, its ``--policy.type`` LeRobot's (``act``, ``diffusion``).
+    """A LeRobot policy as the DAgger student, for LeRobot's ``--policy.type`` (``act``, ``diffusion``).
 
-    Its options are LeRobot's config of the policy plus ``batch_size`` (``lerobot_options_class``);
-    its training seam ``LeRobotOps``; its evaluation runner ``chunk_runner.ChunkRunner`` (an action queue
-    per episode).
+    Options: LeRobot's config plus ``batch_size``; training: ``LeRobotOps``; evaluation: ``ChunkRunner``.
     """
 
     lr_option = "optimizer_lr"
@@ -266,13 +224,7 @@ class LeRobotStudent(Student):
         return {"type": self.name, "batch_size": options.batch_size, **encoded}
 
     def check_run(self, config: Any) -> None:
-        """Refuses point clouds, temporal ensembling, ``lr_schedule`` and the options ``run`` ignores.
-
-        The ignored options are those of ``options.UNSUPPORTED_STUDENT_OPTIONS``.
-
-        Raises:
-            ValueError: Naming the option and the fix.
-        """
+        """Refuses point clouds, temporal ensembling, ``lr_schedule``, unsupported options: ``ValueError``."""
         for name, reason in UNSUPPORTED_STUDENT_OPTIONS.items():
             if getattr(config.policy, name, None) not in (None, False):
                 raise ValueError(f"--policy.{name} is not supported by run: {reason}; drop the option.")
@@ -316,10 +268,9 @@ class LeRobotStudent(Student):
         return ChunkRunner(policy, preprocessor, postprocessor, predict_chunk=self.predict_chunk)
 
     def predict_chunk(self, policy: Any, batch: dict[str, torch.Tensor]) -> torch.Tensor:
-        """Normalised action chunks (B, n, action_dim): LeRobot's ``predict_action_chunk``.
+        """Normalised action chunks (B, n, action_dim) from LeRobot's ``predict_action_chunk``.
 
-        ``batch`` holds one current observation per row, or (with ``n_obs_steps > 1``) each row's
-        history (B, n_obs_steps, ...), which ``DiffusionStudent`` hands over.
+        ``batch`` holds current observations, or histories (B, n_obs_steps, ...) for ``DiffusionStudent``.
         """
         return policy.predict_action_chunk(batch)
 
@@ -327,9 +278,8 @@ class LeRobotStudent(Student):
 class DiffusionStudent(LeRobotStudent):
     """Diffusion Policy: its observation history goes to the denoiser directly.
 
-    LeRobot's ``predict_action_chunk`` reads the history from the policy's own queues (one for the
-    whole batch); the runner keeps a history per episode, so with ``n_obs_steps > 1`` the images are
-    stacked as Diffusion's ``forward`` stacks them and ``generate_actions`` is called.
+    LeRobot's ``predict_action_chunk`` reads the history from one queue for the whole batch; the runner
+    keeps one per episode, so the images are stacked as ``forward`` does and ``generate_actions`` called.
     """
 
     def predict_chunk(self, policy: Any, batch: dict[str, torch.Tensor]) -> torch.Tensor:

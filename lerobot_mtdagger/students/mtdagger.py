@@ -1,11 +1,8 @@
 """The ``mtdagger`` student: the package's own policy (``--policy.type=mtdagger``, the default).
 
-Its options are ``PolicyOptions``; its policy ``MTDAggerPolicy`` with its own processors
-(``policy_config``, ``build_processors``); its training seam ``MTDAggerOps`` (fused AdamW on the
-imitation loss); its per-task loss the action MSE (``per_task_loss``), and the previous phase's the
-MSE of that policy's actions in this phase's normalisation (``per_task_loss_of``); its evaluation
-runner ``evaluate.PolicyRunner`` (one action per observation). The registry imports this module when
-the student is first asked for more than its options (``runner.student``).
+Options ``PolicyOptions``; policy ``MTDAggerPolicy`` with its processors; training seam
+``MTDAggerOps``; per-task loss the action MSE (``per_task_loss``, and ``per_task_loss_of`` for the
+previous phase's policy); evaluation runner ``evaluate.PolicyRunner``.
 """
 
 from __future__ import annotations
@@ -61,10 +58,7 @@ def build_processors(config: MTDAggerConfig, stats: dict[str, dict[str, np.ndarr
 
 
 def make_optimizer(policy: MTDAggerPolicy, lr: float) -> torch.optim.AdamW:
-    """AdamW over the policy's parameters with its configured weight decay.
-
-    The update is one fused kernel per step on CPU and CUDA rather than a Python loop over tensors.
-    """
+    """AdamW over the policy's parameters with its weight decay, one fused kernel per step."""
     fused = policy.task_embedding.weight.device.type in ("cpu", "cuda")
     return torch.optim.AdamW(
         policy.parameters(), lr=lr, weight_decay=policy.config.optimizer_weight_decay, fused=fused or None
@@ -72,11 +66,10 @@ def make_optimizer(policy: MTDAggerPolicy, lr: float) -> torch.optim.AdamW:
 
 
 class MTDAggerOps:
-    """The training seam for the ``mtdagger`` policy (``students.lerobot.LeRobotOps`` for LeRobot's).
+    """The training seam for the ``mtdagger`` policy.
 
-    A step's loss is ``policy.imitation_loss`` (the first step of each log interval calls the full
-    ``policy.forward``: same loss and gradient, with per-task losses logged at debug level); the
-    per-task loss is the action MSE of ``policy.predict``; the optimiser is a fused AdamW.
+    A step's loss is ``policy.imitation_loss`` (the first of each log interval calls ``policy.forward``
+    to log per-task losses); the per-task loss is the action MSE of ``policy.predict``.
     """
 
     def __init__(
@@ -103,10 +96,7 @@ class MTDAggerOps:
         return per_task_loss(self.policy, self.data, index, num_tasks)
 
     def optimizer(self, steps: int) -> tuple[torch.optim.Optimizer, Any, float]:
-        """Fused AdamW (``make_optimizer``), its schedule over ``steps``, the config's gradient clip norm.
-
-        ``constant``: no scheduler; ``cosine``: the rate decays from ``lr`` to 0 at step ``steps``.
-        """
+        """Fused AdamW, its schedule over ``steps`` (none, or ``cosine`` to 0), the gradient clip norm."""
         optimizer = make_optimizer(self.policy, self.lr)
         scheduler = None
         if self.lr_schedule == "cosine":
@@ -141,20 +131,11 @@ def per_task_loss_of(
     index: torch.Tensor,
     num_tasks: int,
 ) -> list[float | None]:
-    """Mean MSE per task of another policy's actions, in ``data``'s normalisation.
+    """Mean MSE per task of another policy's actions, in ``data``'s normalisation (None where no frame).
 
-    The other policy (e.g. the previous phase's, with its own normalisation statistics) acts on the
-    raw frames; its unnormalised actions are normalised like ``data``'s labels, so its loss is
-    comparable with ``per_task_loss`` of the policy trained on ``data``.
-
-    Args:
-        predict: Raw inputs by key and task names -> unnormalised actions (``PolicyRunner.predict``).
-        data: The normalised frames (its pre-processor normalises the predictions).
-        index: Frames to measure on.
-        num_tasks: Number of tasks.
-
-    Returns:
-        The loss per task (None where a task has no frame at ``index``).
+    ``predict`` (raw inputs, task names -> unnormalised actions, e.g. the previous phase's
+    ``PolicyRunner.predict``) acts on the raw frames; its actions are normalised like ``data``'s labels,
+    so the loss compares with ``per_task_loss``.
     """
     sums = torch.zeros(num_tasks, dtype=torch.float64)
     counts = torch.zeros(num_tasks, dtype=torch.float64)

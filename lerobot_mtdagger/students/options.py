@@ -1,9 +1,7 @@
 """The options of LeRobot's students (``act``, ``diffusion``): LeRobot's own config of the policy.
 
-Each takes LeRobot's config of that policy plus ``batch_size`` (``lerobot_options_class``), offered
-by the parser only when the options name a student other than ``mtdagger``
-(``runner.policy_options.students_for``); the options ``run`` cannot honour are refused
-(``UNSUPPORTED_STUDENT_OPTIONS``).
+The parser offers them only when ``--policy.type`` names such a student; options ``run`` cannot
+honour are refused (``UNSUPPORTED_STUDENT_OPTIONS``).
 """
 
 from __future__ import annotations

@@ -1,11 +1,7 @@
 """The drawers of the suite: 11 training drawers and 4 held-out drawers, and their names.
 
-Each row is one ``DrawerVariant`` (fields: ``variants.py``), written one field per keyword and
-grouped by what the fields describe: the handle, then the case and drawer (size, travel, joint
-damping and friction), then the pose on the table (front centre x, y, yaw, plinth elevation), then
-the colours that differ from the defaults. ``drawer-kitchen`` models a standard kitchen drawer (the
-suite's "real" drawer). The held-out drawers each differ from every training drawer in at least five
-parameters.
+Each row is one ``DrawerVariant``, its fields grouped: handle, case and drawer, pose on the table,
+colours. Each held-out drawer differs from every training drawer in at least five parameters.
 """
 
 from __future__ import annotations

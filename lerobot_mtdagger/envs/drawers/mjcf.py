@@ -1,8 +1,6 @@
 """MJCF generation: a ``DrawerVariant`` turned into the model of MetaWorld's arena with that drawer.
 
-``drawer_body_xml`` writes the drawer's own bodies (case, drawer on its slide joint, handle, and the
-``handle`` and ``hook`` sites); ``drawer_mjcf`` wraps it in MetaWorld's scene, arm and gripper
-includes. Pure string building: no MuJoCo import (``scene.py`` compiles the result).
+Pure string building, no MuJoCo import (``scene.py`` compiles the result).
 """
 
 from __future__ import annotations
@@ -157,10 +155,7 @@ def _handle_geoms(v: DrawerVariant) -> tuple[list[str], np.ndarray, np.ndarray]:
 
 
 def drawer_body_xml(v: DrawerVariant, lift: float = 0.0) -> str:
-    """The ``<body>`` of the case, the drawer, its joint, handle and sites (MJCF fragment).
-
-    ``lift`` is the most a reset raises the case (``Placement.lift``): the plinth is that much longer.
-    """
+    """The case, the drawer, its joint, handle and sites (MJCF ``<body>``); the plinth is ``lift`` longer."""
     handle_geoms, handle_center, hook = _handle_geoms(v)
     # MetaWorld's compiler takes inertia from geom groups 4-5 only: the drawer gets explicit inertia,
     # about 0.8 kg for a 30 x 20 cm drawer, scaled with its footprint.
@@ -188,11 +183,10 @@ def drawer_body_xml(v: DrawerVariant, lift: float = 0.0) -> str:
 
 
 def drawer_mjcf(v: DrawerVariant, lift: float = 0.0) -> str:
-    """The complete MJCF of MetaWorld's arena with the drawer of ``v``.
+    """The complete MJCF of MetaWorld's arena with the drawer of ``v`` (``lift`` as in ``drawer_body_xml``).
 
-    Includes MetaWorld's scene, arm and gripper (``../scene``, ``../objects`` relative to the file,
-    which ``DrawerSceneEnv`` writes next to links to MetaWorld's asset folders). ``lift`` as in
-    ``drawer_body_xml``.
+    Its includes are relative (``../scene``, ``../objects``): ``DrawerSceneEnv`` writes the file next to
+    links to MetaWorld's asset folders.
     """
     return f"""<mujoco model="{v.name}">
     <include file="../scene/basic_scene.xml"/>

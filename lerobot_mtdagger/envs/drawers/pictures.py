@@ -12,17 +12,7 @@ from lerobot_mtdagger.envs.drawers.variants import DrawerVariant
 def render_drawer_picture(
     variant: DrawerVariant, height: int = 240, width: int = 320, opening_fraction: float = 0.5
 ) -> np.ndarray:
-    """A picture of a drawer (half open by default) seen from the robot's side, (H, W, 3) uint8.
-
-    Args:
-        variant: The drawer.
-        height: Picture height in pixels (<= 480).
-        width: Picture width in pixels (<= 640).
-        opening_fraction: How far the drawer is drawn open, as a fraction of its travel.
-
-    Raises:
-        ValueError: If ``opening_fraction`` is outside [0, 1].
-    """
+    """A drawer from the robot's side, (H, W, 3) uint8 (``ValueError``: opening_fraction not in [0, 1])."""
     if not 0.0 <= opening_fraction <= 1.0:
         raise ValueError(f"opening_fraction must be in [0, 1], got {opening_fraction}.")
     env = DrawerSceneEnv(variant)

@@ -1,8 +1,7 @@
 """The raw MuJoCo env: MetaWorld's Sawyer arena with one drawer (``DrawerSceneEnv``).
 
-Compiles the MJCF of ``mjcf.py`` next to links to MetaWorld's asset folders, places the case on each
-reset, and computes the privileged state (``DRAWER_STATE_NAMES``), success, progress and reward.
-Observations are plain arrays; ``suite.py`` turns them into LeRobot-keyed dicts.
+Places the case on each reset and computes the privileged state, success, progress and reward;
+``suite.py`` turns its array observations into LeRobot-keyed dicts.
 """
 
 from __future__ import annotations
@@ -44,11 +43,7 @@ def _metaworld_assets() -> Path:
 
 
 class DrawerSceneEnv(SawyerXYZEnv):
-    """MetaWorld's Sawyer arena with one procedurally generated drawer (raw, array observations).
-
-    The MJCF is written to a temporary folder that links MetaWorld's asset folders (its includes
-    are relative), compiled, and deleted again.
-    """
+    """MetaWorld's Sawyer arena with one drawer; its MJCF is compiled from a temporary folder."""
 
     max_path_length = MAX_EPISODE_STEPS
 
@@ -126,11 +121,7 @@ class DrawerSceneEnv(SawyerXYZEnv):
         return self.surface_distance(points, sorted(self._handle_geoms))
 
     def surface_distance(self, points: np.ndarray, geoms: Sequence[int | str]) -> np.ndarray:
-        """Distance of each world point (N, 3+) to the nearest of some box/capsule/cylinder geoms, (N,).
-
-        Raises:
-            ValueError: On a geom of another type.
-        """
+        """Distance of each world point (N, 3+) to the nearest box/capsule/cylinder of ``geoms``, (N,)."""
         points = np.asarray(points, dtype=np.float64)[:, :3]
         distances = np.full(points.shape[0], np.inf)
         for geom in (self.model.geom(g).id for g in geoms):
@@ -203,11 +194,7 @@ class DrawerSceneEnv(SawyerXYZEnv):
         return self._get_obs()
 
     def _on_the_table(self, x: float, y: float, yaw: float) -> tuple[float, float]:
-        """The case front's (x, y), moved the least that keeps the turned case on the table.
-
-        A shift the placement draws may push a deep case through MetaWorld's back wall or over the
-        table's side; the case then stands as close to that limit as it fits.
-        """
+        """The case front's (x, y), moved the least that keeps the turned case on the table, off the wall."""
         corners = self.variant.case_corners_xy(x, y, yaw)
         x -= max(0.0, corners[:, 0].max() - TABLE_X_LIMIT) - max(0.0, -TABLE_X_LIMIT - corners[:, 0].min())
         y -= max(0.0, corners[:, 1].max() - TABLE_Y_RANGE[1]) - max(

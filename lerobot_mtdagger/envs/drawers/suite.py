@@ -1,10 +1,4 @@
-"""The drawer suite: LeRobot-keyed envs (``DrawerTaskEnv``) and the ``DrawerSuite`` that builds them.
-
-``DrawerTaskEnv`` wraps a ``DrawerSceneEnv`` like the MetaWorld suites wrap theirs (same
-observation modes, cameras, point-cloud crop ``DRAWER_CROP``); ``DrawerSuite`` selects training
-drawers from the catalogue (or user-defined variants), names the held-out ones, and gives each
-drawer the scripted expert of ``lerobot_mtdagger.experts.drawers`` (through the expert registry).
-"""
+"""The drawer suite: LeRobot-keyed envs (``DrawerTaskEnv``) and the ``DrawerSuite`` that builds them."""
 
 from __future__ import annotations
 
@@ -91,13 +85,11 @@ class DrawerSuite(TaskSuite):
         """Selects the drawers of the suite.
 
         Args:
-            task_names: Training drawers (any of ``DRAWER_TASKS`` and ``HELDOUT_TASKS``, or the
-                names of ``variants``).
+            task_names: Training drawers (of ``DRAWER_TASKS``, ``HELDOUT_TASKS`` or ``variants``).
             observation: What the envs show the policy.
-            max_episode_steps: Truncation length (``MAX_EPISODE_STEPS`` when None).
-            variants: Extra drawer variants (user-defined) that task names may refer to.
-            placement: How resets move and recolour the drawers: a ``PLACEMENTS`` name or a
-                ``Placement`` (``DEFAULT_PLACEMENT`` when None).
+            max_episode_steps: Truncation length (None: ``MAX_EPISODE_STEPS``).
+            variants: Extra user-defined drawer variants that task names may refer to.
+            placement: A ``PLACEMENTS`` name or a ``Placement`` (None: ``DEFAULT_PLACEMENT``).
 
         Raises:
             ValueError: On an unknown drawer or placement.
@@ -127,15 +119,7 @@ class DrawerSuite(TaskSuite):
         )
 
     def nearest_training_task(self, task_name: str, training_tasks: Sequence[str]) -> str:
-        """The training drawer whose handle is most like ``task_name``'s (``nearest_variant``).
-
-        Args:
-            task_name: An unseen drawer of the suite.
-            training_tasks: The drawers the policy was trained on (those the suite knows count).
-
-        Raises:
-            UserError: If no training drawer has the unseen drawer's handle type.
-        """
+        """The training drawer whose handle is most like the unseen ``task_name``'s (``UserError``: none)."""
         variant = self.variants[task_name]
         known = [self.variants[name] for name in training_tasks if name in self.variants]
         nearest = nearest_variant(variant, known)

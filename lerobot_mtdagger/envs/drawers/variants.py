@@ -1,9 +1,6 @@
 """What a drawer is: the ``DrawerVariant`` dataclass, its validation, and the suite's constants.
 
-Holds the handle types, the success and pull fractions, the per-reset placement range, the episode
-length, the table limits and handle-part sizes the validation checks against, and the names of the
-privileged state (``DRAWER_STATE_NAMES``, ``STATE_INDEX``). Numpy and the standard library only: no
-MuJoCo, MetaWorld or gymnasium, so the scripted expert and the catalogue depend on nothing heavier.
+Numpy and the standard library only, so the scripted expert and the catalogue import no MuJoCo.
 """
 
 from __future__ import annotations
@@ -40,15 +37,12 @@ class Placement:
     Attributes:
         name: The setting's name (``PLACEMENTS``).
         x: Shift across the table, +- metres.
-        y: Shift towards or away from the robot, +- metres (then moved towards the robot as far as
-            needed to keep the case in front of MetaWorld's back wall).
+        y: Shift towards or away from the robot, +- metres.
         yaw: Turn about the vertical, +- degrees.
         lift: The case stands up to this many metres higher (on a taller plinth).
         colour: Shift of each RGB channel of the case, the front and the handle, +-.
-        keep_on_table: Move a case that a shift pushes over the table's edge or into MetaWorld's
-            back wall back just far enough. ``narrow`` does not (its first version let deep cases
-            reach up to 4 cm into the back wall, static geoms that never touch) so that it replays
-            exactly.
+        keep_on_table: Move a case that a shift pushes off the table or into the back wall back just
+            far enough (``narrow`` does not, so that it replays exactly).
     """
 
     name: str
@@ -67,11 +61,7 @@ class Placement:
 
     @property
     def reset_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Low and high of the per-reset offset vector.
-
-        x, y, yaw, then lift and 9 colour shifts (case, front, handle RGB) unless the setting has
-        neither: the ``narrow`` setting's 3 values are drawn exactly as before other settings existed.
-        """
+        """Low and high of the per-reset offset vector: x, y, yaw, then lift and 9 colour shifts if any."""
         low, high = [-self.x, -self.y, -self.yaw], [self.x, self.y, self.yaw]
         if self.lift or self.colour:
             low += [0.0] + [-self.colour] * 9
@@ -96,11 +86,7 @@ DEFAULT_PLACEMENT = "kitchen"
 
 
 def placement_named(name: str | None) -> Placement:
-    """The placement setting ``name`` (``DEFAULT_PLACEMENT`` when None).
-
-    Raises:
-        ValueError: On an unknown name, listing the settings.
-    """
+    """The placement setting ``name`` (None: ``DEFAULT_PLACEMENT``); a ``ValueError`` lists the settings."""
     name = DEFAULT_PLACEMENT if name is None else name
     if name not in PLACEMENTS:
         raise ValueError(f"Unknown drawer placement {name!r}; choose one of {sorted(PLACEMENTS)}.")
@@ -143,10 +129,9 @@ class DrawerVariant:
         name: Task name, ``drawer-<handle>-<what sets it apart>``.
         handle: ``bar``, ``knob``, ``lip`` or ``vbar``.
         handle_size: Bar length (bar, vbar), cap radius (knob) or tab width (lip).
-        handle_height: Height of the handle centre on the front, as a fraction of half the front
-            height (-1 bottom edge, 0 centre, 1 top edge); must be 0 for ``lip``.
-        handle_clearance: Gap between the front panel and the back of the handle (finger room);
-            unused by ``lip`` (its tab stands flush on the top edge; the finger goes behind it).
+        handle_height: Handle centre on the front, a fraction of half the front height (-1 bottom,
+            1 top); 0 for ``lip``.
+        handle_clearance: Gap between the front panel and the back of the handle (unused by ``lip``).
         width: Outer width of the case.
         height: Outer height of the case.
         depth: Outer depth of the case.
@@ -156,7 +141,7 @@ class DrawerVariant:
         x: Case front centre, world x (the table spans about -0.6 .. 0.6).
         y: Case front centre, world y (the case extends from here away from the robot).
         yaw: Case rotation about the vertical axis; 0 faces the robot.
-        elevation: Height of a plinth under the case (0: the case stands on the table).
+        elevation: Height of a plinth under the case (0: on the table).
         case_rgba: Case colour.
         front_rgba: Front panel colour.
         handle_rgba: Handle colour.
@@ -279,11 +264,7 @@ class DrawerVariant:
     def case_corners_xy(
         self, x: float | None = None, y: float | None = None, yaw: float | None = None
     ) -> np.ndarray:
-        """World (x, y) of the four footprint corners of the case, (4, 2).
-
-        At the variant's nominal pose, or with the case front's centre at ``x``, ``y`` and turned by
-        ``yaw`` radians where given.
-        """
+        """World (x, y) of the case footprint's corners, (4, 2), at the nominal or given pose (yaw: rad)."""
         half = self.width / 2
         local = np.array([[-half, 0.0], [half, 0.0], [-half, self.depth], [half, self.depth]])
         yaw = math.radians(self.yaw) if yaw is None else yaw
@@ -319,8 +300,7 @@ class DrawerVariant:
     def free_gap_half_width(self) -> float:
         """Half-width across the pull axis of the finger gap behind the handle free of standoffs.
 
-        A bar's two standoffs cross that gap at the handle's height (a finger pad must not descend
-        onto them); a vertical bar's standoffs, a knob's stem and a lip stand below the pads (``inf``).
+        A bar's standoffs cross it at the handle's height; other handles leave it free (``inf``).
         """
         if self.handle == "bar":
             return self.handle_size / 2 - BAR_POST_INSET - STANDOFF_RADIUS
@@ -349,8 +329,8 @@ class DrawerVariant:
     def handle_distance(self, other: DrawerVariant) -> float:
         """How unlike ``other``'s handle this drawer's is (what the ``nearest`` unseen-task rule ranks by).
 
-        Infinite across handle types; else the relative difference of ``handle_size`` plus the
-        difference of ``handle_height`` (fractions of half the front height).
+        Infinite across handle types; else the relative difference of ``handle_size`` plus that of
+        ``handle_height``.
         """
         if self.handle != other.handle:
             return math.inf
@@ -359,10 +339,7 @@ class DrawerVariant:
 
 
 def nearest_variant(variant: DrawerVariant, candidates: Sequence[DrawerVariant]) -> DrawerVariant | None:
-    """The candidate whose handle is most like ``variant``'s (``handle_distance``; the first on a tie).
-
-    None when no candidate has ``variant``'s handle type.
-    """
+    """The candidate whose handle is most like ``variant``'s (first on a tie; None if none has its type)."""
     ranked = sorted(candidates, key=variant.handle_distance)  # stable: ties keep the given order
     if not ranked or math.isinf(variant.handle_distance(ranked[0])):
         return None

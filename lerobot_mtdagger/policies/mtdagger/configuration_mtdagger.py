@@ -1,9 +1,7 @@
 """Configuration of the multitask DAgger policy (LeRobot policy type ``mtdagger``).
 
-The paper's appendix "Multitask Policy Architecture": an observation encoder per input (MLP for the
-state vectors, a small CNN for images, PointNet for point clouds), a learned task embedding from the
-task index, fusion by concatenation and an MLP head that outputs the action, trained with MSE on the
-experts' actions.
+The paper's appendix "Multitask Policy Architecture": an encoder per input, a learned task
+embedding, fusion by concatenation and an MLP head trained with MSE on the experts' actions.
 """
 
 from __future__ import annotations
@@ -28,14 +26,12 @@ def is_pointcloud_feature(key: str, feature: PolicyFeature) -> bool:
 class MTDAggerConfig(PreTrainedConfig):
     """Multitask policy: per-input encoders + learned task embedding -> MLP action head.
 
-    Inputs are chosen from ``input_features``: 1-D STATE/ENV features go through one MLP (concatenated),
-    VISUAL features through a shared small CNN each, and ``observation.*pointcloud*`` features of shape
-    (N, C) through a PointNet (shared per-point MLP + max-pool).
+    1-D STATE/ENV inputs go through one MLP, each VISUAL input through a small CNN, and
+    ``observation.*pointcloud*`` inputs of shape (N, C) through a PointNet.
 
     Attributes:
-        task_names: The task vocabulary in a fixed order (task index i = task_names[i]). Saved with the
-            model; at eval time LeRobot hands the policy only the task string, which is mapped through
-            this list. Filled from the training dataset's tasks when left empty.
+        task_names: The task vocabulary in a fixed order (task index i = task_names[i]), saved with the
+            model and filled from the training dataset when empty; LeRobot hands the policy the task string.
         task_embedding_dim: Size of the learned task embedding z_i.
         state_hidden_dims: Hidden layer sizes of the state MLP encoder.
         state_embedding_dim: Output size of the state encoder.
@@ -44,21 +40,16 @@ class MTDAggerConfig(PreTrainedConfig):
         pointnet_dims: Sizes of PointNet's shared per-point MLP; the last is the max-pooled feature size.
         pointcloud_embedding_dim: Output size of the point-cloud encoder (after the max-pool projection).
         pointnet_layer_norm: LayerNorm after every per-point layer and after the projection, as DP3's
-            encoder (``pointnet_dims=(64, 128, 256)``, ``pointcloud_embedding_dim=64``: about 59 k
-            parameters); without it, ReLU between the layers and before the projection.
+            encoder; without it, ReLU between the layers and before the projection.
         head_hidden_dims: Hidden layer sizes of the action head.
         dropout: Dropout in the action head.
-        task_dropout: Probability, per training sample, of replacing its task embedding by one shared
-            "any task" embedding (learned alongside the tasks' own). With ``task_dropout > 0`` the
-            policy also acts on a task it was not trained on (an unseen drawer): any task string
-            outside ``task_names`` gets the shared embedding. With 0 (the default) such a task is an
-            error, and the checkpoint has no shared embedding.
+        task_dropout: Probability, per training sample, of replacing its task embedding by a shared
+            "any task" embedding, which then acts on tasks outside ``task_names`` (0: such tasks fail).
         optimizer_lr: AdamW learning rate (the paper: 3e-4 on MetaWorld, 1e-4 on the drawers).
         optimizer_weight_decay: AdamW weight decay.
         optimizer_grad_clip_norm: Gradient clipping norm.
-        normalization_mapping: Normalisation per feature type. Point clouds are typed STATE by LeRobot;
-            the pre-processor pools their per-point statistics into per-channel ones (see
-            ``processor_mtdagger``), so every point is normalised alike.
+        normalization_mapping: Normalisation per feature type (point clouds, typed STATE, are normalised
+            per channel: ``processor_mtdagger``).
     """
 
     n_obs_steps: int = 1
@@ -147,12 +138,7 @@ class MTDAggerConfig(PreTrainedConfig):
         return {key: ft for key, ft in (self.input_features or {}).items() if is_pointcloud_feature(key, ft)}
 
     def validate_features(self) -> None:
-        """Checks the inputs and outputs the policy was configured with.
-
-        Raises:
-            ValueError: With no usable input, no ``action`` output, a state that is not 1-D, or an empty
-                task vocabulary.
-        """
+        """Checks inputs and outputs (``ValueError``: no input, no ``action``, a state not 1-D, no tasks)."""
         if not (self.vector_features or self.image_features or self.pointcloud_features):
             raise ValueError(
                 "MTDAggerConfig has no input feature: give it observation.state, an observation.image* or an "

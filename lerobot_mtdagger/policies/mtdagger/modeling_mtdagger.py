@@ -1,8 +1,7 @@
-"""The multitask DAgger policy: per-input encoders + learned task embedding -> MLP action head.
+"""The multitask DAgger policy (paper appendix "Multitask Policy Architecture").
 
-Paper appendix "Multitask Policy Architecture": h_o = f_enc(o) (PointNet for point clouds, a CNN for
-images, an MLP for proprioception), z_i = Embedding(task index), h = [h_o, z_i], a = f_policy(h),
-trained with MSE on the experts' actions.
+h_o = f_enc(o) (PointNet for point clouds, a CNN for images, an MLP for proprioception),
+z_i = Embedding(task index), a = f_policy([h_o, z_i]), trained with MSE on the experts' actions.
 """
 
 from __future__ import annotations
@@ -60,20 +59,15 @@ class ImageEncoder(nn.Module):
 class PointNetEncoder(nn.Module):
     """PointNet: a per-point MLP shared by all points, max-pooled over points, then projected.
 
-    In training (gradients on) the max-pool is computed by ``max_pool_of_winners``: the same values
-    and gradients as ``point_mlp(points).max(dim=1)``, at about half the cost.
+    With gradients on, the max-pool is ``max_pool_of_winners`` (same values and gradients, half the cost).
     """
 
     def __init__(
         self, in_channels: int, dims: Sequence[int], output_dim: int, layer_norm: bool = False
     ) -> None:
-        """Builds the per-point MLP and the projection.
+        """Builds the per-point MLP (``dims``; the last is the pooled size) and the projection.
 
-        Args:
-            in_channels: Channels per point (3: xyz, 6: xyz + rgb).
-            dims: Per-point layer sizes; the last is the max-pooled feature size.
-            output_dim: Size of the projected cloud feature.
-            layer_norm: DP3's layout: Linear-LayerNorm-ReLU per point, projection Linear-LayerNorm.
+        ``in_channels`` is 3 (xyz) or 6 (xyz + rgb); ``layer_norm`` gives DP3's layout.
         """
         super().__init__()
         if layer_norm:
@@ -95,16 +89,13 @@ class PointNetEncoder(nn.Module):
 
 
 SEARCH_CHUNK_POINTS = 2048
-"""Points per chunk of a pass without gradients on a CPU: a few clouds at a time keep the per-point
-features in the CPU's cache (measured: 2-3x faster than all clouds at once at 512 points)."""
+"""Points per chunk of a pass without gradients on a CPU (in cache: 2-3x faster at 512 points)."""
 
 
 def cloud_chunks(points: Tensor) -> tuple[Tensor, ...]:
     """(B, N, C) split along B into chunks of about SEARCH_CHUNK_POINTS points on a CPU, whole elsewhere.
 
-    The chunks are for a CPU's cache. On a GPU they would only multiply the kernel launches: at 1 024
-    points a batch of 256 clouds made 128 passes of the per-point MLP, and PointNet trained at a
-    tenth of the RGB encoder's samples/s on an H100 (docs/benchmarks.md, "On a GPU").
+    On a GPU chunks would only multiply kernel launches (``docs/benchmarks.md``, "On a GPU").
     """
     if points.device.type != "cpu":
         return (points,)
@@ -136,21 +127,12 @@ def normalised_mlp(input_dim: int, dims: Sequence[int]) -> nn.Sequential:
 def max_pool_of_winners(per_point: nn.Module, points: Tensor) -> Tensor:
     """``per_point(points).max(dim=1).values`` with a gradient that flows through the winners only.
 
-    After a max-pool over points, feature c of a cloud depends on one point only: the point that
-    wins c. So the per-point network runs without autograd on all N points to find the winners (a
-    few clouds at a time, ``per_point_features``), then again, with autograd, on the distinct
-    winners of each cloud (padded to the largest count in the batch; typically 60-120 of 512 points
-    for 256 features), whose features are gathered per channel. Values are those of the dense
-    max-pool, and so is the gradient (ties go to one winner, as ``max`` does); the backward pass and
-    the stored activations shrink from N points to the winners (``benchmarks/bench_pointnet.py``).
-
-    Args:
-        per_point: A network applied to each point independently (no batch statistics), e.g. an MLP
-            of Linear, ReLU and LayerNorm layers, mapping (B, N, C) to (B, N, F).
-        points: (B, N, C) clouds.
-
-    Returns:
-        (B, F) max-pooled features.
+    Feature c of a pooled cloud depends on the one point that wins c. The per-point network runs
+    without autograd on all N points to find the winners, then with autograd on each cloud's distinct
+    winners (padded; typically 60-120 of 512 points): values and gradient are the dense max-pool's,
+    while backward and stored activations shrink to the winners (``benchmarks/bench_pointnet.py``).
+    ``per_point`` must treat points independently (no batch statistics): (B, N, C) -> (B, N, F);
+    returns (B, F).
     """
     # (B, F): the winning point of each feature, found a few clouds at a time. ``max(dim).indices`` (the
     # first maximal point, as ``argmax``) reduces over the strided point axis about 1.7x faster on a CPU.
@@ -202,8 +184,7 @@ class MTDAggerPolicy(PreTrainedPolicy):
         Args:
             config: The policy config; an empty ``task_names`` is filled from ``dataset_meta``.
             dataset_meta: LeRobot dataset metadata (passed by ``make_policy``), for the task vocabulary.
-            **kwargs: Other ``make_policy`` arguments (``dataset_stats``), unused: normalisation lives in
-                the processors.
+            **kwargs: Other ``make_policy`` arguments, unused (normalisation lives in the processors).
 
         Raises:
             ValueError: On a config without usable inputs, action or task vocabulary.
@@ -238,16 +219,7 @@ class MTDAggerPolicy(PreTrainedPolicy):
         self.head = mlp(fused, config.head_hidden_dims, action_dim, dropout=config.dropout)
 
     def _migrate_checkpoint(self, state_dict: dict[str, Tensor], prefix: str, *args: Any) -> None:
-        """Renames the weights of a checkpoint written before encoders were keyed by input, in place.
-
-        Before: ``state_encoder`` (one MLP on the concatenated vector inputs), ``image_encoder`` (one
-        CNN shared by every image input) and ``pointcloud_encoders.<i>`` (the i-th point cloud in
-        sorted order). A checkpoint with several vector inputs cannot be mapped: one MLP read their
-        concatenation.
-
-        Raises:
-            ValueError: On such a checkpoint, naming the fix.
-        """
+        """Renames a checkpoint's weights in place to ``encoders.<key>`` (``ValueError`` if unmappable)."""
         renames: dict[str, list[str]] = {}
         if any(name.startswith(f"{prefix}state_encoder.") for name in state_dict):
             if len(self.vector_keys) != 1:
@@ -270,14 +242,7 @@ class MTDAggerPolicy(PreTrainedPolicy):
     # ---------------------------------------------------------------------------------------------
 
     def task_indices(self, batch: dict[str, Any]) -> Tensor:
-        """Task index per sample: from the ``task`` strings when present, else ``task_index``.
-
-        The strings are authoritative: a dataset's own ``task_index`` is numbered in first-seen order
-        and may differ from the policy's vocabulary.
-
-        Raises:
-            ValueError: On a task string not in ``config.task_names`` or no task information at all.
-        """
+        """Task index per sample, from ``task`` strings or ``task_index`` (``ValueError``: unknown, none)."""
         device = self.task_embedding.weight.device
         tasks = batch.get(TASK_KEY)
         if tasks is not None:
@@ -310,11 +275,8 @@ class MTDAggerPolicy(PreTrainedPolicy):
     def predict(self, batch: dict[str, Any], *, task_index: Tensor | None = None) -> Tensor:
         """Normalised action for a normalised observation batch, (B, action_dim).
 
-        Args:
-            batch: Normalised observations, with ``task`` strings or ``task_index``.
-            task_index: (B,) indices into ``config.task_names`` to use instead of the batch's task
-                information. Trusted: not validated, so no host-device sync (the training loop maps
-                and checks the tasks once for the whole data set).
+        ``task_index`` (B,) replaces the batch's task information; it is trusted, not validated, so there
+        is no host-device sync.
         """
         if task_index is None:
             task_index = self.task_indices(batch)
@@ -334,17 +296,10 @@ class MTDAggerPolicy(PreTrainedPolicy):
         return self.head(torch.cat(features, dim=1))
 
     def imitation_loss(self, batch: dict[str, Any], *, task_index: Tensor | None = None) -> Tensor:
-        """Mean squared error to the expert action over the batch: the training objective.
+        """Mean squared error to the expert action over the batch: the training objective (with its graph).
 
-        The lean path of :meth:`forward`: no per-task statistics, no Python numbers, no host-device
-        sync when ``task_index`` is given.
-
-        Args:
-            batch: Normalised observations and ``action``, with ``task`` strings or ``task_index``.
-            task_index: Trusted (B,) task indices, as in :meth:`predict`.
-
-        Returns:
-            The scalar loss (with its autograd graph).
+        The lean path of :meth:`forward`: no per-task statistics and, with ``task_index`` (trusted, as in
+        :meth:`predict`), no host-device sync.
         """
         loss, _ = self._imitation_terms(batch, task_index)
         return loss
@@ -357,12 +312,9 @@ class MTDAggerPolicy(PreTrainedPolicy):
     def forward(self, batch: dict[str, Any]) -> tuple[Tensor, dict[str, Any]]:
         """MSE to the expert action, overall and per task (LeRobot's training entry point).
 
-        The loss is :meth:`imitation_loss`'s; the statistics cost a few host-device syncs, so the
-        plugin's own training loop calls this only at its log intervals.
-
         Returns:
-            The mean loss over the batch, and ``{"loss": float, "per_task_loss": {task: mean loss},
-            "per_task_count": {task: samples}}`` for the tasks present in the batch.
+            The mean loss, and ``{"loss", "per_task_loss": {task: loss}, "per_task_count": {task: samples}}``
+            for the tasks in the batch (a few host-device syncs: the training loop calls it at log intervals).
         """
         indices = self.task_indices(batch)
         loss, prediction = self._imitation_terms(batch, indices)
@@ -386,11 +338,7 @@ class MTDAggerPolicy(PreTrainedPolicy):
 
     @torch.no_grad()
     def select_action(self, batch: dict[str, Any], **kwargs: Any) -> Tensor:
-        """The action for each observation of the batch, (B, action_dim).
-
-        Switches the policy to eval mode first if it is training (``eval()`` walks every module,
-        which costs more than a batched forward of the state network: skipped when already so).
-        """
+        """The action for each observation of the batch, (B, action_dim), in eval mode."""
         if self.training:
             self.eval()
         return self.predict(batch)
@@ -404,16 +352,7 @@ class MTDAggerPolicy(PreTrainedPolicy):
 
 
 def per_task_means(values: Tensor, task_index: Tensor, num_tasks: int) -> tuple[Tensor, Tensor]:
-    """Mean of ``values`` per task and the sample count per task (0 where absent).
-
-    Args:
-        values: (B,) per-sample values.
-        task_index: (B,) task index per sample.
-        num_tasks: Size of the vocabulary.
-
-    Returns:
-        ``(means, counts)``, each (num_tasks,).
-    """
+    """Mean of ``values`` (B,) per task index and the sample count per task, each (num_tasks,)."""
     sums = torch.zeros(num_tasks, device=values.device, dtype=values.dtype).index_add_(0, task_index, values)
     counts = torch.zeros(num_tasks, device=values.device, dtype=values.dtype).index_add_(
         0, task_index, torch.ones_like(values)

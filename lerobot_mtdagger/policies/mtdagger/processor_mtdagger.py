@@ -1,16 +1,8 @@
-"""Pre- and post-processing pipelines of the ``mtdagger`` policy.
+"""Pre- and post-processing pipelines of the ``mtdagger`` policy, as LeRobot's own policies have.
 
-As LeRobot's own policies: rename, add a batch dimension, move to the device, normalise inputs and
-the action; unnormalise the predicted action and move it to the CPU.
-
-Point clouds: LeRobot types an (N, C) feature as STATE, so its normaliser applies the feature's
-statistics elementwise. Points are unordered samples: point k of one frame is not the same quantity
-as point k of the next, so per-point statistics would be meaningless. LeRobot 0.4.4's
-``compute_episode_stats`` already reduces an (N, C) feature to per-channel (C,) statistics (checked on
-a recorded point-cloud dataset); statistics that arrive per point, (N, C) (other writers, hand-made
-stats), are pooled by ``pool_pointcloud_stats`` into per-channel ones (mean, pooled std, min, max;
-quantiles averaged) broadcast back to (N, C). Either way every point is normalised by the same
-per-channel transform, saved with the processor like any other statistics.
+Point clouds: LeRobot types an (N, C) feature as STATE and normalises elementwise, but points are
+unordered, so per-point statistics mean nothing. Statistics that arrive per point are pooled per
+channel (``pool_pointcloud_stats``), so every point is normalised by the same transform.
 """
 
 from __future__ import annotations
@@ -63,15 +55,7 @@ def _pool_channel_stats(stats: dict[str, Any]) -> dict[str, Any]:
 
 
 def pool_pointcloud_stats(config: MTDAggerConfig, dataset_stats: Stats | None) -> Stats | None:
-    """Returns ``dataset_stats`` with every point-cloud feature's statistics pooled per channel.
-
-    Args:
-        config: The policy config (tells which features are point clouds).
-        dataset_stats: LeRobot dataset statistics, or None.
-
-    Returns:
-        A new stats dict (the input is not modified), or None.
-    """
+    """A copy of ``dataset_stats`` (or None) with each point-cloud feature's statistics pooled per channel."""
     if dataset_stats is None:
         return None
     pooled = dict(dataset_stats)
@@ -88,15 +72,7 @@ def make_mtdagger_pre_post_processors(
     PolicyProcessorPipeline[dict[str, Any], dict[str, Any]],
     PolicyProcessorPipeline[PolicyAction, PolicyAction],
 ]:
-    """Creates the pre- and post-processing pipelines of the ``mtdagger`` policy.
-
-    Args:
-        config: The policy configuration.
-        dataset_stats: Dataset statistics for normalisation (point-cloud statistics get pooled).
-
-    Returns:
-        ``(preprocessor, postprocessor)``.
-    """
+    """``(preprocessor, postprocessor)`` of the ``mtdagger`` policy (point-cloud statistics pooled)."""
     stats = pool_pointcloud_stats(config, dataset_stats)
     input_steps = [
         RenameObservationsProcessorStep(rename_map={}),

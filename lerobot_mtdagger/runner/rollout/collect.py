@@ -1,22 +1,10 @@
 """Rollouts with DAgger's beta-mixing, batched over tasks (Algorithm 1, "collect").
 
-At every step of a DAgger rollout the expert labels the state; with probability ``beta`` the
-EXPERT's action is executed, otherwise the learner's: the coin is tossed at every step
-(``mixing="step"``, classic DAgger) or once per episode (``mixing="episode"``: the expert or the
-learner acts throughout). Only the episodes where the learner executed every action measure the
-learner's success (``learner_success_by_task``): under step mixing the expert does part of the work.
-The expert's label is always stored as ``action``; the executed action and whether the learner
-acted are stored beside it. ``beta = 1`` is pure expert demonstration (round 0, BC); evaluation
-runs the pure policy (``beta = 0``, no expert).
-
-The envs live in env workers (``workers.EnvWorkers``: worker processes, one per core by default);
-the policy stays in the main process and is queried once per step for every running episode (a
-batch-1 torch call costs ~0.1-1 ms, a batch of 50 hardly more). Every episode has its own seed, derived from
-``(seed, stream, round, task, episode)``: collection seeds lie in [0, 2^31) and evaluation seeds in
-[2^31, 2^32), so they never overlap, and evaluation uses the same seeds after every round.
-
-An episode ends ``steps_after_success`` steps after its first success (MetaWorld's success does not
-persist), at ``max_steps``, or when the env truncates.
+The expert labels every state; with probability ``beta`` its action is executed (a coin per step or
+per episode: ``mixing``). ``beta = 1`` is pure demonstration (round 0, BC); evaluation runs the pure
+policy. The envs live in env workers; the policy, in the main process, is queried once per step for
+every running episode. Episode seeds derive from ``(seed, stream, round, task, episode)``; collection
+and evaluation seeds never overlap, and evaluation uses the same seeds every round.
 """
 
 from __future__ import annotations
@@ -59,13 +47,12 @@ class _Lane:
 
     Attributes:
         home_task: The task whose episodes the lane runs first.
-        group: The lane's group: the learner acts for one group while the workers step the other.
+        group: The learner acts for one group while the workers step the other.
         task_index: Task of the running episode (None: idle).
         worker: Worker running the episode.
         observation: Its latest observation (None until the worker has reset the env).
         start: The episode to start in the next message (None once started).
-        fresh: Whether the learner has not yet acted in the running episode (its next observation
-            is the episode's first: a policy with per-episode state restarts it).
+        fresh: Whether the learner has not yet acted in the running episode.
     """
 
     home_task: int
@@ -106,19 +93,10 @@ class _Schedule:
 
 @dataclass(frozen=True)
 class EpisodeOptions:
-    """How the episodes of one ``run_episodes`` call run (the same for every episode).
+    """How the episodes of one ``run_episodes`` call run: ``RolloutRules``' options, seeded.
 
-    Attributes:
-        beta: Probability of executing the expert's action (at a step, or for a whole episode).
-        seed: Experiment seed.
-        round_index: DAgger round (part of the episode seeds, written into the recorded frames).
-        stream: ``COLLECT_STREAM`` or ``EVAL_STREAM``.
-        record: Keep the frames (observation, expert label, executed action, learner flag).
-        max_steps: Longest episode (None: the env's own truncation).
-        steps_after_success: Steps kept after the first success.
-        mixing: ``step`` (a beta coin per step) or ``episode`` (one per episode).
-        expert_multiple: Cut a learner's episode at this multiple of the expert's own steps to
-            success from the same reset seed (``RolloutRules.expert_multiple``; None: no such cut).
+    ``seed`` is the experiment's, ``stream`` ``COLLECT_STREAM`` or ``EVAL_STREAM``; the other fields are
+    those of ``RolloutRules`` (``rules`` adds ``learner``).
     """
 
     beta: float
@@ -153,23 +131,12 @@ def run_episodes(
     policy: PolicyFn | None,
     progress: Callable[[Episode], None] | None = None,
 ) -> list[Episode]:
-    """Runs ``episodes_per_task[i]`` episodes of task i on the env workers, in lock-step.
+    """Runs ``episodes_per_task[i]`` episodes of task i on the env workers; ordered by (task, episode).
 
-    There is one lane per task; a lane runs its own task's episodes, then helps the task with most
-    episodes left. The lanes form two groups (even and odd tasks), pipelined: while the workers step
-    one group's episodes, the main process takes the other group's observations and runs the
-    learner once for all of that group's lanes (lane order). Lanes, groups, batches and seeds do
-    not depend on the number of workers, so neither does any result.
-
-    Args:
-        workers: The run's env workers (their suite gives experts and task names).
-        episodes_per_task: Episodes to run per task.
-        options: Beta, seeds, recording and episode cuts (``EpisodeOptions``).
-        policy: The learner (None only when ``options.beta == 1``).
-        progress: Called with each finished episode.
-
-    Returns:
-        The episodes, ordered by (task, episode).
+    One lane per task runs its own task's episodes, then helps the task with most left. The lanes form
+    two groups (even and odd tasks), pipelined: while the workers step one group, the main process runs
+    the learner once for the other. Nothing depends on the number of workers. ``policy`` may be None
+    only when ``options.beta == 1``; ``progress`` is called with each finished episode.
 
     Raises:
         ValueError: If ``policy`` is None while ``beta < 1``, or the counts do not match the tasks.
@@ -247,12 +214,8 @@ def _assign(lanes: list[_Lane], handle: int, schedule: _Schedule, worker_count: 
 def _least_loaded(lanes: list[_Lane], lane: _Lane, worker_count: int) -> int:
     """The worker running the fewest of ``lane``'s group, then the fewest episodes in all.
 
-    Each group's reply waits for its slowest worker, so its lanes are spread evenly; where a group
-    cannot be split evenly (5 lanes on 2 workers), the second key gives the extra lane of the
-    other group to the other worker, so that every worker steps as many episodes per cycle of the
-    two groups. Measured on MT10 with 2 workers (``benchmarks/bench_collect.py``): by group alone
-    one worker ran 6 of the 10 lanes and the other 4; one group per worker made each worker wait
-    for the learner's actions of its group, about 25% slower than this.
+    Each group's reply waits for its slowest worker, so its lanes are spread evenly, and every worker
+    steps as many episodes per cycle of the two groups (``benchmarks/bench_collect.py``).
     """
     group_load = [0] * worker_count
     total_load = [0] * worker_count
@@ -268,8 +231,7 @@ def _learner_actions(
 ) -> dict[int, np.ndarray | None]:
     """The learner's action for each lane of ``members`` with an observation (None: no learner).
 
-    A policy with ``tracks_episodes`` (an action queue per episode, ``ChunkRunner``) is also
-    told each row's lane and whether it is its episode's first observation.
+    A policy with ``tracks_episodes`` (``ChunkRunner``) also gets each row's lane and episode start.
     """
     ready = [handle for handle in members if lanes[handle].observation is not None]
     if policy is None or not ready:
@@ -300,9 +262,5 @@ def success_by_task(episodes: Sequence[Episode], num_tasks: int) -> tuple[list[f
 def learner_success_by_task(
     episodes: Sequence[Episode], num_tasks: int
 ) -> tuple[list[float | None], list[int]]:
-    """Success rate and count per task of the episodes where only the learner acted.
-
-    This is what task need measures: an episode where the expert executed some actions may succeed
-    because of them (under step mixing at beta 0.5 a learner that outputs zeros succeeds on reach).
-    """
+    """Success rate and count per task of the episodes where only the learner acted (what task need reads)."""
     return success_by_task([episode for episode in episodes if episode.learner_only], num_tasks)

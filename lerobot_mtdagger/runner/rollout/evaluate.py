@@ -1,8 +1,7 @@
 """Success per task of a policy, with the pure policy acting (no expert), on evaluation seeds.
 
-``PolicyRunner`` turns a LeRobot pretrained ``mtdagger`` policy and its processors into the batched
-``PolicyFn`` the rollouts use; observations are converted exactly as LeRobot's
-``preprocess_observation`` does (images to float CHW in [0, 1]).
+``PolicyRunner`` turns a policy and its processors into the batched ``PolicyFn`` the rollouts use,
+converting observations as LeRobot's ``preprocess_observation`` does.
 """
 
 from __future__ import annotations
@@ -27,11 +26,7 @@ from lerobot_mtdagger.utils.seeds import EVAL_STREAM
 
 
 class PolicyRunner:
-    """Batched inference: observations + task names -> unnormalised actions (B, action_dim).
-
-    ``make_runner`` picks the runner of a policy: this one for ``mtdagger`` (one action per
-    observation), ``ChunkRunner`` for LeRobot policies that act in chunks from a history.
-    """
+    """Batched inference: observations + task names -> unnormalised actions (B, action_dim)."""
 
     tracks_episodes = False
     """Whether the rollouts must say which running episode each row belongs to (``ChunkRunner``)."""
@@ -50,15 +45,11 @@ class PolicyRunner:
     def from_pretrained(
         cls, path: str | Path, device: str = "cpu", trust_checkpoint: bool = False
     ) -> PolicyRunner:
-        """Loads a pretrained model folder or Hub id with its saved processors (``load_policy``).
-
-        Returns:
-            The runner of its policy type (``make_runner``).
+        """Loads a pretrained folder or Hub id with its processors, as its type's runner.
 
         Raises:
             UntrustedCheckpointError: If a processor config names code and the checkpoint is not trusted.
-            UserError: If the path is not a complete policy folder or a reachable Hub policy, naming
-                the path or file and the fix.
+            UserError: If the path is not a complete policy folder or a reachable Hub policy.
         """
         return make_runner(*load_policy(path, device, trust_checkpoint))
 
@@ -75,18 +66,13 @@ class PolicyRunner:
 
     @property
     def acts_on_unseen_tasks(self) -> bool:
-        """Whether the policy has an input for a task outside ``task_names``.
-
-        An ``mtdagger`` policy has one only when trained with task dropout (its shared embedding); a
-        LeRobot student's one-hot vector is all zeros for such a task (``ChunkRunner``).
-        """
+        """Whether the policy has an input for a task outside ``task_names`` (shared embedding, or zeros)."""
         return getattr(self.policy, "any_task_index", None) is not None
 
     def act_as(self, aliases: dict[str, str]) -> None:
-        """Makes the policy act on each key task with the task input of its value (a training task).
+        """Makes the policy act on each key task with the task input of its value, a training task.
 
-        What ``eval --unseen_rule=nearest`` does for an unseen drawer: the policy sees the task of the
-        training drawer most like it instead of its shared "any task" embedding.
+        What ``eval --unseen_rule=nearest`` does for an unseen drawer.
 
         Raises:
             UserError: If a value is not a task the policy was trained on.
@@ -97,11 +83,7 @@ class PolicyRunner:
         self.task_aliases = dict(aliases)
 
     def check_tasks(self, task_names: Sequence[str]) -> None:
-        """Refuses tasks the policy cannot act on (not trained on them and no shared embedding).
-
-        Raises:
-            UserError: Naming the unknown tasks, the policy's tasks and the options to change.
-        """
+        """Refuses tasks the policy cannot act on (``UserError`` naming them, its tasks and the options)."""
         known = self.task_names
         unknown = [name for name in task_names if name not in known and name not in self.task_aliases]
         if unknown and known and not self.acts_on_unseen_tasks:
@@ -112,11 +94,7 @@ class PolicyRunner:
             )
 
     def check_inputs(self, suite_features: dict[str, dict[str, Any]], obs_mode: str) -> None:
-        """Refuses a suite whose observations do not match the policy's inputs (key and shape).
-
-        Raises:
-            UserError: Naming the input, both shapes and the option to change.
-        """
+        """Refuses a suite whose observations do not match the policy's inputs (``UserError``)."""
         given_features = dataset_to_policy_features(suite_features)  # images channel-first, as trained
         for key in self.input_keys:
             feature, given = self.policy.config.input_features[key], given_features.get(key)
@@ -133,11 +111,7 @@ class PolicyRunner:
                 )
 
     def __call__(self, observations: list[dict[str, np.ndarray]], tasks: list[str]) -> np.ndarray:
-        """Actions for a batch of observations of the given tasks.
-
-        Raises:
-            KeyError: If an observation lacks an input the policy was trained on.
-        """
+        """Actions for a batch of observations of the given tasks (``KeyError`` on a missing input)."""
         inputs = {
             key: torch.from_numpy(np.stack([observation[key] for observation in observations]))
             for key in self.input_keys
@@ -145,15 +119,7 @@ class PolicyRunner:
         return self.predict(inputs, tasks).numpy()
 
     def predict(self, inputs: dict[str, torch.Tensor], tasks: Sequence[str]) -> torch.Tensor:
-        """Unnormalised actions (B, action_dim) on the CPU for batched raw inputs.
-
-        Args:
-            inputs: Raw observation tensors by key, images uint8 (B, H, W, 3) as stored.
-            tasks: Task name of each row.
-
-        Raises:
-            KeyError: If an input the policy was trained on is missing.
-        """
+        """Unnormalised actions (B, action_dim) on the CPU for raw inputs (``KeyError``: an input missing)."""
         with torch.inference_mode():
             action = self.postprocessor(self.policy.select_action(self.preprocess(inputs, tasks)))
         return action.cpu()
@@ -172,13 +138,7 @@ class PolicyRunner:
 
 
 def make_runner(policy: Any, preprocessor: Any, postprocessor: Any) -> PolicyRunner:
-    """The runner of a policy, its student's (``Student.make_runner``).
-
-    ``PolicyRunner`` for ``mtdagger``, ``ChunkRunner`` for LeRobot's.
-
-    Raises:
-        UserError: If no registered student builds policies of its type.
-    """
+    """The runner of a policy's student (``UserError`` if no registered student builds its type)."""
     return student_of_policy(policy).make_runner(policy, preprocessor, postprocessor)
 
 
@@ -217,18 +177,9 @@ def evaluate(
     steps_after_success: int = 0,
     progress: Callable[[Episode], None] | None = None,
 ) -> tuple[EvalResult, list[Episode]]:
-    """Runs ``episodes_per_task`` pure-policy episodes per task on the evaluation seeds.
+    """Runs ``episodes_per_task`` pure-policy episodes per task on the evaluation seeds (same every round).
 
-    Episodes end at the first success or when the env truncates (its max episode length). The
-    evaluation seeds do not depend on the round, so every round is evaluated on the same episodes.
-
-    Args:
-        workers: The env workers (their suite gives the tasks).
-        runner: The policy.
-        episodes_per_task: Episodes per task.
-        seed: Experiment seed (the evaluation seeds derive from it).
-        steps_after_success: Steps run after the first success.
-        progress: Called with each finished episode.
+    Episodes end at the first success (plus ``steps_after_success``) or when the env truncates.
     """
     suite = workers.suite
     options = EpisodeOptions(

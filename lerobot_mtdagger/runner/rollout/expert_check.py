@@ -1,14 +1,8 @@
 """The paper's task rule: keep only the tasks whose expert succeeds often enough (``--expert.min_success``).
 
-The paper trained SAC experts on MetaWorld's 50 tasks and kept the 36 whose expert succeeded on more
-than 80% of episodes. With ``--expert.min_success=0.8`` a run measures each task's expert, as the run
-will use it (the named experts and their noise), on ``--expert.success_episodes`` episodes per task,
-and keeps the tasks at or above the threshold. The episodes' resets come from their own seed stream
-(``EXPERT_CHECK_STREAM``) and their noise from its own key, so they are none of the run's episodes.
-
-The measurement is written into the experiment as ``expert_check.json`` (every task's success, the
-threshold, the kept and the dropped tasks) when the experiment is created, and a resume reads it back
-instead of measuring again; every round's record then holds the kept tasks as its task vocabulary.
+Each task's expert, as the run uses it, is measured on ``--expert.success_episodes`` episodes of its
+own seed stream (``EXPERT_CHECK_STREAM``). The result goes into the experiment as
+``expert_check.json``, which a resume reads back; every round's record holds the kept tasks.
 """
 
 from __future__ import annotations
@@ -37,7 +31,7 @@ class ExpertCheck:
     Attributes:
         min_success: The threshold (``--expert.min_success``).
         episodes: Episodes measured per task.
-        success: Each task's expert success rate over those episodes, in the suite's order.
+        success: Each task's expert success rate, in the suite's order.
         kept: The tasks at or above the threshold, in the suite's order.
     """
 
@@ -57,11 +51,7 @@ class ExpertCheck:
 
     @classmethod
     def read(cls, path: Path) -> ExpertCheck:
-        """Reads ``expert_check.json``.
-
-        Raises:
-            UserError: If the file cannot be read, naming it.
-        """
+        """Reads ``expert_check.json`` (``UserError`` naming it if it cannot be read)."""
         try:
             values = json.loads(path.read_text())
             return cls(
@@ -97,11 +87,7 @@ def expert_success(suite: Any, task_index: int, episodes: int, seed: int) -> flo
 
 
 def measure_expert_check(suite: Any, min_success: float, episodes: int, seed: int) -> ExpertCheck:
-    """Measures every task's expert and keeps those at or above ``min_success``.
-
-    Raises:
-        UserError: If no task is kept (naming the best task's success and the fix).
-    """
+    """Measures every task's expert, keeping those at or above ``min_success`` (``UserError`` if none)."""
     success = {}
     for task_index, task in enumerate(suite.task_names):
         success[task] = expert_success(suite, task_index, episodes, seed)

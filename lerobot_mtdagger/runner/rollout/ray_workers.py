@@ -1,22 +1,8 @@
 """Env workers as Ray actors (``--rollout.worker_backend=ray``): a run's simulators on a Ray cluster.
 
-``RayEnvWorkers`` is ``EnvWorkers`` with each worker a Ray actor instead of a forked process: the
-same ``RolloutWorker`` answers the same commands (``answer``), the main process keeps the policy and
-batches it over the same lanes, and every episode depends only on its seeds and the learner's
-actions, so a run gives the same rounds and evaluations on either backend, at any worker count.
-Actors are spread over the cluster's nodes (Ray's ``SPREAD`` strategy), one CPU each; a pool that
-only runs while the run's own actors wait (the unseen drawers' evaluation) reserves no CPU of its
-own (``reserve_cpus=False``), so a cluster the size of ``--rollout.workers`` never waits on itself.
-Actors that cannot be placed within ``ACTOR_START_TIMEOUT_S`` (a cluster too small, nodes gone) are
-a ``UserError`` naming the CPUs asked for and free, not a silent wait.
-
-The suite travels to each actor pickled (cloudpickle); an expert registered with ``register_expert``
-in the main process does not travel with it (the actor's process has its own registry): give such
-experts with ``suite.with_experts(...)`` or register them in a module the actors import.
-
-An actor that dies (its process killed, its node lost) raises ``WorkerDiedError`` naming the actor
-and its node on the next reply; nothing of the running round is committed, and ``--resume=true``
-continues from the last committed round.
+Each worker is a Ray actor running the same ``RolloutWorker``, one CPU each, spread over the nodes;
+results do not depend on the backend. The suite travels pickled, but an expert registered in the
+main process does not: give it with ``suite.with_experts(...)`` or register it where actors import.
 """
 
 from __future__ import annotations
@@ -36,8 +22,7 @@ from lerobot_mtdagger.utils.ray_session import connect
 logger = logging.getLogger(__name__)
 
 ACTOR_START_TIMEOUT_S = 300.0
-"""Seconds the actors of a pool may take to be placed and to build their envs (importing this package
-on a busy node takes about a minute)."""
+"""Seconds the actors of a pool may take to be placed and to build their envs."""
 
 
 class RolloutActor:
@@ -67,11 +52,7 @@ class RolloutActor:
 
 
 class _ActorConnection:
-    """One actor seen as a pipe: ``send`` submits a command, ``recv`` waits for the oldest reply.
-
-    Several commands may be in flight (rollouts pipeline two groups of episodes); an actor runs one
-    caller's calls in the order they were made, so replies come back in order, as through a pipe.
-    """
+    """One actor seen as a pipe: ``send`` submits a command, ``recv`` waits for the oldest reply."""
 
     def __init__(self, ray: Any, actor: Any) -> None:
         self.ray = ray
@@ -93,16 +74,11 @@ class RayEnvWorkers(EnvWorkers):
     ) -> None:
         """Starts ``workers`` actors (at least one) and waits until each holds the suite.
 
-        Args:
-            suite: The tasks the actors step.
-            workers: How many actors.
-            address: The Ray cluster (None: a local Ray).
-            reserve_cpus: One CPU per actor (False: none, for a pool that runs only while the run's
-                own actors wait, on their CPUs).
+        ``reserve_cpus=False`` reserves no CPU (a pool that runs only while the run's own actors wait).
 
         Raises:
-            UserError: If Ray is missing, there is no cluster at ``address``, or the actors cannot
-                be placed within ``ACTOR_START_TIMEOUT_S``.
+            UserError: If Ray is missing, there is no cluster at ``address``, or the actors cannot be
+                placed within ``ACTOR_START_TIMEOUT_S``.
         """
         self._ray = connect(address)
         self._places: list[str] = []

@@ -1,9 +1,7 @@
 """A rollout worker: its envs and experts, and each episode it runs (reset, label, step, record).
 
-A ``RolloutWorker`` runs each episode of a rollout by the DAgger mixing rules of
-``lerobot_mtdagger.runner.rollout.mixing`` (who acts, when an episode ends); ``workers.EnvWorkers`` drives
-one in the calling process or in each worker process. Everything an episode does depends only on its
-seeds and on the learner's actions, never on which worker ran it or which env of its pool it reused.
+An episode depends only on its seeds and the learner's actions, never on which worker ran it or
+which env of its pool it reused.
 """
 
 from __future__ import annotations
@@ -40,7 +38,7 @@ class Episode:
         frames: Recorded frames (empty when not recording).
         learner_steps: Steps where the learner's action was executed.
         steps: Episode length.
-        progress: Best ``info["progress"]`` of the episode (suites that report a progress score).
+        progress: Best ``info["progress"]`` of the episode (suites with a progress score).
     """
 
     task_index: int
@@ -63,11 +61,11 @@ class EpisodeSpec:
     """What a worker needs to start an episode.
 
     Attributes:
-        handle: The main process's id of the running episode (unique while it runs).
+        handle: The main process's id of the running episode.
         task_index: Task of the episode.
         episode: Index of the episode within its task and round.
         reset_seed: Seed of the env reset.
-        beta_seed: Entropy of the episode's beta coin (expert or learner at each step).
+        beta_seed: Entropy of the episode's beta coin.
     """
 
     handle: int
@@ -120,18 +118,13 @@ class RolloutWorker:
     def iterate(
         self, starts: list[EpisodeSpec], actions: dict[int, np.ndarray | None]
     ) -> tuple[dict[int, dict[str, np.ndarray]], list[tuple[int, Episode]]]:
-        """Steps the episodes in ``actions``, then starts ``starts``.
+        """Steps the episodes in ``actions`` (by handle; None: no learner), then starts ``starts``.
 
-        Without a learner (``rules.learner`` false: the expert acts at every step) nothing depends
-        on the main process, so a started episode runs to its end here, in this one message.
-
-        Args:
-            starts: Episodes to start (their first observation is returned).
-            actions: Learner action per running episode handle (None: no learner this call).
+        Without a learner nothing depends on the main process, so a started episode runs to its end here.
 
         Returns:
-            The observation of every episode still running that was stepped or started, and the
-            finished episodes by handle.
+            The observation of each episode still running that was stepped or started, and the finished
+            episodes by handle.
         """
         observations: dict[int, dict[str, np.ndarray]] = {}
         finished: list[tuple[int, Episode]] = []
@@ -196,21 +189,13 @@ class RolloutWorker:
         )
 
     def _expert_step_limit(self, env: Any, expert: Any, reset_seed: int) -> int | None:
-        """``max_steps`` capped at ``expert_multiple`` times the expert's own steps to success.
-
-        Runs the expert's trial episode on ``env`` and resets ``expert`` after it.
-        """
+        """``max_steps`` capped at ``expert_multiple`` times the expert's steps to success on ``env``."""
         expert_steps = _expert_steps_to_success(env, expert, reset_seed)
         expert.reset()
         return step_limit(self.rules, expert_steps)
 
     def _expert(self, task_index: int) -> Any:
-        """A reset expert of the task that no running episode uses.
-
-        The first one comes from ``make_expert``; more (for episodes of the same task running at
-        once) are deep copies of it, so an expert given as an instance (``suite.with_experts``) is
-        never shared by two episodes.
-        """
+        """A reset expert of the task that no running episode uses (else a deep copy of the first)."""
         free = self.experts[task_index]
         if free:
             expert = free.pop()
@@ -259,9 +244,8 @@ class RolloutWorker:
 def _expert_action(running: _Running) -> tuple[np.ndarray | None, np.ndarray | None]:
     """What the expert would execute at this step, and its label (both None without an expert).
 
-    A perfect expert executes and labels its own action; an imperfect one (``suite.expert_noise``)
-    executes its action plus this episode's noise, and labels the noisy or its own action
-    (``ExpertNoise.labels``). The noise advances at every step the expert is queried, whoever acts.
+    An imperfect expert executes its action plus the episode's noise and labels by ``ExpertNoise.labels``;
+    the noise advances at every step the expert is queried, whoever acts.
     """
     if running.expert is None:
         return None, None
@@ -272,10 +256,7 @@ def _expert_action(running: _Running) -> tuple[np.ndarray | None, np.ndarray | N
 
 
 def _expert_steps_to_success(env: Any, expert: Any, reset_seed: int) -> int | None:
-    """Steps the expert alone takes from ``reset_seed`` to its first success (None: it never succeeds).
-
-    Runs one unrecorded expert episode on ``env`` (the caller resets ``env`` and ``expert`` after it).
-    """
+    """Steps the expert alone takes from ``reset_seed`` to its first success (None: never), unrecorded."""
     _, info = env.reset(seed=reset_seed)
     steps = 0
     while True:

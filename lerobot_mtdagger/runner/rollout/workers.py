@@ -1,21 +1,7 @@
 """Env workers: the simulators of a run stepped in worker processes, one per core by default.
 
-A ``RolloutWorker`` owns envs and experts and runs each episode of a rollout (reset, the expert's
-label, the env step, recording) by the DAgger mixing rules of ``mixing`` (who acts, when an
-episode ends). The main process
-keeps the policy and talks to the workers (see ``collect.run_episodes``): one message per worker
-per step of a group of episodes, carrying the learner's actions for that worker's episodes and the episodes to
-start, one reply carrying the new observations and the finished episodes.
-
-``EnvWorkers(suite, workers=0)`` runs the worker in the calling process (no IPC); ``workers=N >= 1``
-forks N processes that live until ``close``. Everything an episode does depends only on its seeds
-and on the learner's actions, never on which worker ran it or on which env of that worker's pool it
-reused, so the worker count never changes a result.
-
-A worker that dies (killed, out of memory) is noticed on the next reply and raises
-``WorkerDiedError`` in the main process; an exception inside a worker is sent back and re-raised
-in the main process with the worker's traceback. Workers exit when the main process goes away
-(their pipe closes), so a killed run leaves no orphan.
+The main process keeps the policy and sends each worker one message per step of a group of episodes;
+``workers=0`` runs in-process. A worker's death or exception is raised in the main process.
 """
 
 from __future__ import annotations
@@ -45,11 +31,7 @@ logger = logging.getLogger(__name__)
 
 @contextlib.contextmanager
 def limited_torch_threads(threads: int | None) -> Iterator[None]:
-    """Caps torch's intra-op threads inside the block (no-op for None or when torch is not loaded).
-
-    While the env workers keep every core busy, the main process's policy calls would only fight
-    them for the cores.
-    """
+    """Caps torch's intra-op threads inside the block, so the policy leaves the cores to the env workers."""
     torch = sys.modules.get("torch")
     if threads is None or torch is None:
         yield
@@ -81,11 +63,7 @@ class RemoteWorkerError(Exception):
 def _worker_loop(connection: Connection, suite: TaskSuite, inherited: list[Connection]) -> None:
     """Body of a worker process: answers commands until told to close or the main process is gone.
 
-    Args:
-        connection: This worker's end of its pipe.
-        suite: The suite (forked, so registered experts come along).
-        inherited: The main process's ends of this and the earlier workers' pipes, closed here so each
-            pipe closes when the main process dies.
+    ``inherited`` are the main process's pipe ends, closed here so each pipe closes when it dies.
     """
     for other in inherited:
         other.close()
@@ -115,11 +93,7 @@ def answer(worker: RolloutWorker, command: tuple[str, Any]) -> tuple[str, Any]:
 
 
 def reply_payload(reply: tuple[str, Any]) -> Any:
-    """The payload of a worker's ``answer``.
-
-    Raises:
-        Exception: The worker's own exception, with its traceback as the cause.
-    """
+    """The payload of a worker's ``answer``; re-raises the worker's own exception with its traceback."""
     status, payload = reply
     if status == "error":
         error, text = payload
@@ -138,29 +112,17 @@ def _picklable(error: Exception) -> Exception:
 
 @dataclass
 class Ticket:
-    """The replies one ``EnvWorkers.send`` is owed.
-
-    Attributes:
-        busy: Workers that were sent a command.
-        local_replies: The replies already computed in-process (``workers=0``).
-    """
+    """The replies one ``EnvWorkers.send`` is owed: ``busy`` workers', or ``local_replies`` in-process."""
 
     busy: list[int]
     local_replies: list[Any] = field(default_factory=list)
 
 
 class EnvWorkers:
-    """The envs of a run, in ``workers`` processes (0: in the calling process).
-
-    Use as a context manager, or call ``close``.
-    """
+    """The envs of a run, in ``workers`` processes (0: in the calling process); a context manager."""
 
     def __init__(self, suite: TaskSuite, workers: int) -> None:
-        """Starts the worker processes (forked: they inherit the suite and registered experts).
-
-        Raises:
-            ValueError: If ``workers`` is negative.
-        """
+        """Forks the worker processes (they inherit the suite and experts); ``ValueError`` if negative."""
         if workers < 0:
             raise ValueError(f"workers must be >= 0 (0: in this process), got {workers}.")
         self.suite = suite

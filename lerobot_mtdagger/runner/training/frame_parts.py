@@ -1,9 +1,7 @@
 """Per-round tensors of one observation read as one tensor along the frame axis, without joining them.
 
-A run keeps every committed round in memory (``train.RoundCache``) and trains on all of them. Joining
-the rounds' images or point clouds with ``torch.cat`` made a second full copy of the largest inputs
-for the whole phase (about 3 GB of uint8 images by the fifth MT10 pixel round). ``FrameParts`` holds
-the rounds' tensors as they are and gathers only the frames a batch asks for.
+A phase trains on every committed round; ``torch.cat`` of their images or point clouds would hold
+the largest inputs twice. ``FrameParts`` gathers only the frames a batch asks for.
 """
 
 from __future__ import annotations
@@ -13,24 +11,17 @@ from collections.abc import Callable, Sequence
 import torch
 
 ROW_COPY_LIMIT = 512
-"""Up to this many frames a CPU gather copies row by row: for a training batch of 84 px images that
-is about 2x faster than advanced indexing of one tensor, and 4x faster than indexing each part."""
+"""Up to this many frames a CPU gather copies row by row (about 2x faster for a batch of 84 px images)."""
 
 
 class FrameParts:
     """Tensors of the same trailing shape, dtype and device, indexed as their concatenation on dim 0.
 
-    Indexing with an integer tensor (any shape) gives a new tensor of ``index.shape + trailing``, as
-    indexing the concatenated tensor would; nothing else is supported, so no code can copy all the
-    frames by accident (``materialise`` does it on purpose).
+    Only integer-tensor indexing is supported, so nothing copies all frames by accident (``materialise``).
     """
 
     def __init__(self, parts: Sequence[torch.Tensor]) -> None:
-        """Keeps ``parts`` (not copied).
-
-        Raises:
-            ValueError: If ``parts`` is empty or the parts differ in trailing shape, dtype or device.
-        """
+        """Keeps ``parts`` uncopied; ``ValueError`` if empty or unlike in trailing shape, dtype, device."""
         if not parts:
             raise ValueError("FrameParts needs at least one tensor.")
         first = parts[0]
@@ -104,14 +95,7 @@ FrameTensor = torch.Tensor | FrameParts
 
 
 def join_frames(tensors: Sequence[FrameTensor]) -> FrameTensor:
-    """The frames of ``tensors`` (tensors or ``FrameParts``) one after the other, without a copy.
-
-    Empty tensors are dropped; a single tensor left is returned itself, else ``FrameParts`` over all
-    the tensors (those of a ``FrameParts`` taken as they are).
-
-    Raises:
-        ValueError: If ``tensors`` is empty or they differ in trailing shape, dtype or device.
-    """
+    """The frames of ``tensors`` one after the other, without a copy (``ValueError`` if none or unlike)."""
     pieces = [p for t in tensors for p in (t.parts if isinstance(t, FrameParts) else [t])]
     nonempty = [piece for piece in pieces if len(piece)] or pieces[:1]
     if len(nonempty) == 1:

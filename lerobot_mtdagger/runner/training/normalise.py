@@ -1,9 +1,7 @@
 """Normalisation statistics of the training frames and the frames normalised for a phase.
 
-The frames are normalised with LeRobot's own pre-processor built from their statistics, the same
-processor that is saved with the checkpoint; so what is trained, what is rolled out and what
-``lerobot-eval`` loads agree. Statistics and per-task losses read the frames a chunk at a time, so
-their memory is bounded whatever the data's size.
+The frames go through LeRobot's pre-processor, the one saved with the checkpoint, so training,
+rollouts and ``lerobot-eval`` agree. Frames are read a chunk at a time: memory stays bounded.
 """
 
 from __future__ import annotations
@@ -27,19 +25,15 @@ MEASURE_CHUNK = 4096
 
 
 MEASURE_CHUNK_VISUAL = 256
-"""The same with an image or point-cloud input: 4 096 frames of 84 px RGB made about 3 GB of float
-images and convolution activations at once (the pixel run's peak memory)."""
+"""The same with an image or point-cloud input (4 096 frames of 84 px RGB took about 3 GB)."""
 
 
 def compute_stats(
     data: TrainingData, image_keys: Sequence[str], index: torch.Tensor | None = None
 ) -> dict[str, dict[str, np.ndarray]]:
-    """Mean/std/min/max of the vector inputs and the action (point clouds per channel).
+    """Mean/std/min/max of the vector inputs and the action (point clouds per channel) over ``index``.
 
-    Args:
-        data: The frames.
-        image_keys: Inputs without statistics (never read, so never copied).
-        index: The frames the statistics come from (None: all).
+    ``image_keys`` have no statistics and are never read.
     """
     frames = torch.arange(len(data)) if index is None else index
     tensors = {k: v for k, v in data.inputs.items() if k not in image_keys} | {"action": data.action}
@@ -49,9 +43,7 @@ def compute_stats(
 def channel_stats(tensor: FrameTensor, frames: torch.Tensor) -> dict[str, np.ndarray]:
     """Mean/std/min/max over the last axis' channels of ``tensor[frames]``, in float64 then float32.
 
-    Read STATS_CHUNK frames at a time in one pass, each chunk's mean and squared deviations merged
-    into the running ones (Chan et al.'s pairwise update), so a phase's point clouds are never
-    copied whole.
+    Read in chunks merged by Chan et al.'s pairwise update, so point clouds are never copied whole.
     """
     channels = tensor.shape[-1]
     count = 0
@@ -76,19 +68,12 @@ def channel_stats(tensor: FrameTensor, frames: torch.Tensor) -> dict[str, np.nda
 
 
 class NormalisedData:
-    """Training frames normalised once with the policy's pre-processor; batches built on demand.
-
-    Tasks are carried as indices into ``task_names`` (checked once here), never as strings per batch.
-    """
+    """Training frames normalised once with the policy's pre-processor; tasks as ``task_names`` indices."""
 
     def __init__(
         self, data: TrainingData, preprocessor: Any, image_keys: Sequence[str], task_names: Sequence[str]
     ):
-        """Normalises the vector inputs and the action of ``data``.
-
-        Raises:
-            ValueError: If a frame's task index is outside ``task_names``.
-        """
+        """Normalises the vector inputs and the action (``ValueError``: a task outside ``task_names``)."""
         self.data = data
         self.image_keys = list(image_keys)
         self.task_names = list(task_names)
@@ -115,12 +100,7 @@ class NormalisedData:
         return self.preprocessor({**vector, "action": actions.float()})["action"]
 
     def batch(self, index: torch.Tensor) -> dict[str, torch.Tensor]:
-        """The normalised batch at ``index``.
-
-        Returns:
-            The vectors, the images as float CHW in [0, 1] and ``task_index`` (indices into
-            ``task_names``), all on the data's device.
-        """
+        """The normalised batch at ``index``: vectors, images as float CHW in [0, 1], and ``task_index``."""
         index = index.to(self.device)
         batch = {k: v[index] for k, v in self.vector.items()}
         for key in self.image_keys:
@@ -131,13 +111,7 @@ class NormalisedData:
 
 
 def normalise_inputs(preprocessor: Any, vector: dict[str, FrameTensor]) -> dict[str, FrameTensor]:
-    """``vector`` through the pre-processor: tensors at once, ``FrameParts`` part by part (never joined).
-
-    Args:
-        preprocessor: The policy's pre-processor (normalisation of each key is per feature, so parts
-            normalise as the whole would).
-        vector: The action and the non-image inputs by key.
-    """
+    """``vector`` (the action and non-image inputs) through the pre-processor, ``FrameParts`` part by part."""
     whole = {k: v for k, v in vector.items() if not isinstance(v, FrameParts)}
     normalised = preprocessor(dict(whole))
     result: dict[str, FrameTensor] = {k: normalised[k] for k in whole}

@@ -1,19 +1,9 @@
 """A training phase's progress, saved every few minutes so that a cut phase resumes where it was.
 
-A phase of a pixel run trains for hours on a CPU, and a run cut off during one (a stop, ``kill -9``)
-used to take it again from its first step. Every ``every_s`` seconds of training, at the start of a
-log interval, ``StepLoop`` saves what the remaining steps depend on: the weights, the optimiser's and
-the scheduler's state, the batch sampler's generator, the global (and CUDA) random state and the
-random generators of the training seam (a LeRobot student's task dropout), the steps taken, the
-frames drawn per task and the last step losses. A resumed run loads them and takes the remaining
-steps, so its phase equals the uninterrupted one (on the same device and threads, as any resume).
-
-The file sits beside the committed phases (``policies/.progress/round-XXX.pt``), written atomically;
-unlike ``.staging`` it is kept when a run resumes, and it is deleted once its phase commits. Its key
-(the round, the policy type, the steps, seed, batch, learning rate and sampling, and a fingerprint of
-the training frames) must match the phase's; a file that does not match, or cannot be read, is
-discarded with a warning and the phase starts over. A ``plateau`` phase is never saved part-way (its
-held-out curve and best weights would have to be too): it starts over.
+``StepLoop`` saves what the remaining steps depend on (weights, optimiser, scheduler, generators,
+steps and draws) to ``policies/.progress/round-XXX.pt`` atomically; the file is deleted when its
+phase commits, and discarded with a warning if its key or contents do not fit. A resumed phase equals
+the uninterrupted one. A ``plateau`` phase is never saved part-way.
 """
 
 from __future__ import annotations
@@ -53,12 +43,9 @@ class SavedProgress:
 
 
 class PhaseProgress:
-    """Saves and loads one training phase's progress at ``path``.
+    """Saves and loads one training phase's progress at ``path`` every ``every_s`` seconds (0: never).
 
-    Args:
-        path: The progress file (``ExperimentDir.phase_progress_path``).
-        key: What identifies the phase (``phase_key``); a saved file of another key is discarded.
-        every_s: Seconds of training between two saves (0: never save).
+    A saved file of another ``key`` (``phase_key``) is discarded.
     """
 
     def __init__(self, path: Path, key: dict[str, Any], every_s: float) -> None:
@@ -82,11 +69,7 @@ class PhaseProgress:
         logger.info("Saved the phase's progress after %d steps to %s", done, self.path)
 
     def load(self) -> SavedProgress | None:
-        """The saved progress of this phase, or None.
-
-        None where there is no file, and where it is of another phase or unreadable: it is then
-        discarded, with a warning, and the phase starts over.
-        """
+        """The saved progress of this phase, or None (a file of another phase or unreadable is discarded)."""
         if not self.path.exists():
             return None
         try:
@@ -114,14 +97,7 @@ class PhaseProgress:
 
 
 def phase_key(round_index: int, policy_type: str, options: Any, train_index: torch.Tensor) -> dict[str, Any]:
-    """What a saved progress must match to be resumed: the phase, its options and its training frames.
-
-    Args:
-        round_index: The phase's round.
-        policy_type: The student's policy type.
-        options: The phase's ``StepOptions``.
-        train_index: Its training frames (a fingerprint: their number and sums).
-    """
+    """What a saved progress must match: the round, policy type, options, and a fingerprint of the frames."""
     index = train_index.cpu().long()
     return {
         "round": round_index,

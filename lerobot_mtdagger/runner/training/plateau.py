@@ -18,14 +18,9 @@ from lerobot_mtdagger.runner.training.splits import FrameSplit
 class PlateauStop:
     """Ends a phase when the loss on held-out frames stops improving (``steps_rule=plateau``).
 
-    The mean over tasks of the per-task loss on ``index`` is measured before the first step and every
-    ``every`` steps; the phase ends after ``patience`` measurements in a row without a new minimum (or
-    at the step cap) and returns the weights of the minimum.
-
-    Attributes:
-        index: The held-out frames (never trained on).
-        every: Steps between two measurements.
-        patience: Measurements without a new minimum before the phase ends.
+    The mean per-task loss on ``index`` is measured before the first step and every ``every`` steps;
+    after ``patience`` measurements without a new minimum (or at the cap) the phase ends with the
+    weights of the minimum.
     """
 
     index: torch.Tensor

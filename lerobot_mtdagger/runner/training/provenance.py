@@ -14,15 +14,7 @@ ENVIRONMENT_PACKAGES = ("torch", "numpy", "lerobot", "mujoco", "metaworld", "ler
 
 
 def training_environment(device: torch.device) -> dict[str, Any]:
-    """Where a phase trains: what decides its arithmetic, so two trainings can be told apart later.
-
-    Args:
-        device: The device the policy trained on.
-
-    Returns:
-        Package versions (None for one not installed), the CPU, torch's CPU kernel level, torch's
-        thread count, the device (and its name on CUDA) and the Python version.
-    """
+    """Where a phase trains: package versions, CPU, torch's kernel level and threads, device, Python."""
     versions = {}
     for name in ENVIRONMENT_PACKAGES:
         try:

@@ -1,8 +1,7 @@
 """A run's committed rounds as training frames, read once straight from each dataset's parquet files.
 
-Committed rounds are immutable, so a run reads each one once (``load_round``) and keeps it in memory;
-a phase joins them (``TrainingData.concat``: the vectors concatenated, the images and point clouds
-left in their rounds as ``FrameParts``, so the largest inputs are held once).
+A phase joins them (``TrainingData.concat``): vectors concatenated, images and point clouds left in
+their rounds as ``FrameParts``.
 """
 
 from __future__ import annotations
@@ -29,8 +28,8 @@ class TrainingData:
     """Frames of several rounds in memory.
 
     Attributes:
-        inputs: Observation tensors by feature key; images stay uint8 (N, H, W, 3), the rest float32.
-            Images and point clouds of several rounds are ``FrameParts`` (indexed like one tensor).
+        inputs: Observation tensors by key; images uint8 (N, H, W, 3), the rest float32; images and
+            point clouds of several rounds as ``FrameParts``.
         action: Expert labels, (N, action_dim) float32.
         task_index: (N,) int64.
         episode_id: (N,) int64, unique per (round, episode).
@@ -55,14 +54,7 @@ class TrainingData:
 
     @staticmethod
     def concat(parts: Sequence[TrainingData]) -> TrainingData:
-        """The frames of ``parts`` one after the other (e.g. rounds loaded once and kept in memory).
-
-        Vectors (one row per frame) are concatenated; inputs with more dimensions (images, point
-        clouds) are joined without a copy (``join_frames``): a phase holds its rounds' images once.
-
-        Raises:
-            ValueError: If ``parts`` is empty or the parts hold different input keys.
-        """
+        """The frames of ``parts`` one after the other (``ValueError`` if none, or their keys differ)."""
         if not parts:
             raise ValueError("TrainingData.concat needs at least one part.")
         keys = list(parts[0].inputs)
@@ -85,19 +77,8 @@ def _join_input(tensors: Sequence[FrameTensor]) -> FrameTensor:
 def load_round(root: Path, round_position: int, input_keys: Sequence[str]) -> TrainingData:
     """Loads one committed round dataset into memory, straight from its parquet files.
 
-    A LeRobot v3.0 dataset keeps its frames in ``<root>/data/chunk-XXX/file-YYY.parquet``; they are read
-    with pyarrow in the order ``LeRobotDataset`` reads them (sorted paths), which skips building the
-    dataset object and its Arrow cache. Image features (structs of PNG bytes) are decoded with PIL, as
-    ``datasets`` does.
-
-    Args:
-        root: The round dataset folder.
-        round_position: Position of the round among those trained on; offsets the episode ids so they
-            stay unique across rounds.
-        input_keys: Observation keys the policy reads.
-
-    Returns:
-        The round's frames.
+    The frames are read with pyarrow in ``LeRobotDataset``'s order, images decoded with PIL.
+    ``round_position`` offsets the episode ids so they stay unique across rounds.
 
     Raises:
         FileNotFoundError: If the folder holds no parquet file.

@@ -17,13 +17,7 @@ LOSS_SAMPLES_PER_TASK = 1024
 
 @dataclass(frozen=True)
 class FrameSplit:
-    """Which frames a phase trains on, measures the per-task loss on, and holds out.
-
-    Attributes:
-        train: Frames to train on.
-        loss: Frames the per-task loss (performance gain) is measured on.
-        heldout: Frames of the held-out episodes (empty when nothing is held out).
-    """
+    """Which frames a phase trains on, measures the per-task loss on, and holds out (empty: none)."""
 
     train: torch.Tensor
     loss: torch.Tensor
@@ -35,12 +29,9 @@ def split_frames(
 ) -> FrameSplit:
     """Splits the frames of D(k) into training, loss-measurement and held-out frames.
 
-    Episodes are held out (``heldout_episodes``) when ``gain_split == "heldout"`` or ``hold_out`` (a
-    plateau stop needs them); they are never trained on. The per-task loss is measured on them with
-    ``gain_split == "heldout"``, else on up to LOSS_SAMPLES_PER_TASK training frames per task. The
-    choice depends only on ``seed`` and the episodes, so an episode held out in one phase is held out
-    in every later phase (pass the experiment's seed, not a per-phase one): a warm-started policy never
-    trained on it.
+    Episodes are held out (``heldout_episodes``) when ``gain_split == "heldout"`` or ``hold_out``; the
+    loss is measured on them then, else on up to LOSS_SAMPLES_PER_TASK training frames per task. Pass
+    the experiment's seed: an episode held out once stays held out in every later phase.
     """
     all_index = torch.arange(len(data))
     held = torch.zeros(len(data), dtype=torch.bool)
@@ -63,12 +54,9 @@ def split_frames(
 def heldout_episodes(data: TrainingData, heldout_fraction: float, seed: int) -> list[int]:
     """Episode ids held out: systematic sampling over each task's episodes in round order.
 
-    A task's episodes are taken in id order (round, then episode). Its first one is always trained on
-    (a task never loses all its frames); of the others, the one at position ``j`` (0-based) is held
-    out when ``floor(f * (j + 1) + u)`` steps up at ``j``, with one uniform offset ``u`` per
-    (seed, task). So a task's first ``n`` episodes hold ``floor(f (n - 1))`` or ``ceil(f (n - 1))``
-    held-out ones however they are split into rounds (BC's one round and DAgger's many hold out the
-    same share), and a new round never moves an earlier episode to the other side.
+    A task's first episode is always trained on; of the others, the one at position ``j`` is held out
+    when ``floor(f * (j + 1) + u)`` steps up at ``j`` (one offset ``u`` per seed and task). So any split
+    into rounds holds out the same share, and a new round never moves an earlier episode.
     """
     episode_ids = data.episode_id.numpy()
     task_index = data.task_index.numpy()

@@ -1,15 +1,8 @@
 """A phase's optimiser steps through the student's seam (``phase_ops``), and what they record.
 
-Each step samples ``batch_size`` frames of the training frames with replacement (uniformly, or with
-``sampling="balanced"`` a task uniformly and then one of its frames uniformly) and takes one
-optimiser step on the student's loss: for ``mtdagger`` an AdamW step on ``policy.imitation_loss``
-with the gradient norm clipped to ``config.optimizer_grad_clip_norm`` (the first step of each
-interval calls the full ``policy.forward``, same loss and gradient, and logs its per-task losses at
-debug level; ``students.mtdagger.MTDAggerOps``); for a LeRobot student
-(``students.lerobot.LeRobotOps``) its ``forward`` loss with its config's optimiser and scheduler
-presets. Tasks are indices mapped once, and the losses stay on the device: they are read back only
-every ``log_interval`` steps and after the last one, where they are checked for NaN/inf and
-reported.
+Each step samples ``batch_size`` training frames with replacement (``uniform``, or ``balanced``: a
+task, then one of its frames) and takes one optimiser step on the student's loss. The losses stay
+on the device and are read back, checked for NaN/inf and reported every ``log_interval`` steps.
 """
 
 from __future__ import annotations
@@ -52,15 +45,13 @@ class PhaseResult:
         gain: ``max(0, loss_start - loss_end)`` per task.
         train_loss: The last FINAL_LOSSES step losses.
         loss_samples: Frames per task behind the losses.
-        steps: Optimiser steps taken (fewer than asked where a plateau stopped the phase).
+        steps: Optimiser steps taken (fewer where a plateau stopped the phase).
         best_step: With a plateau stop, the step whose weights are returned (0: the initial ones).
         heldout_loss: With a plateau stop, ``[step, mean held-out loss]`` at every measurement.
-        steps_s: Seconds spent in the optimiser steps (the bare training).
-        task_loss_s: Seconds spent measuring the per-task loss before and after them.
-        passes_per_task: Per task, the frames its steps drew divided by its training frames: how
-            many times over its data the phase went (None where a task had no training frame).
-        resumed_after_steps: The steps after which the phase was resumed from its saved progress,
-            in order (empty: trained in one go). ``steps_s`` counts every process's steps.
+        steps_s: Seconds spent in the optimiser steps (of every process, if resumed).
+        task_loss_s: Seconds spent measuring the per-task loss.
+        passes_per_task: Per task, frames drawn over training frames (None: no training frame).
+        resumed_after_steps: The steps after which the phase was resumed (empty: in one go).
         earlier_steps_s: Of ``steps_s``, the seconds of the processes before the last resume.
     """
 
@@ -80,14 +71,7 @@ class PhaseResult:
 
 
 def phase_ops(policy: Any, data: NormalisedData, options: StepOptions, student: Student | None = None) -> Any:
-    """The training seam of ``policy``: ``Student.phase_ops`` (``MTDAggerOps`` for ``mtdagger``).
-
-    Args:
-        policy: The policy to train.
-        data: The phase's normalised frames.
-        options: How the phase steps.
-        student: The run's student (None: the student registered for the policy's type).
-    """
+    """The training seam of ``policy``: ``student.phase_ops`` (None: the one registered for its type)."""
     student = student_of_policy(policy) if student is None else student
     return student.phase_ops(policy, data, options)
 
@@ -126,14 +110,11 @@ class StepOptions:
         lr: AdamW learning rate.
         seed: Seed of the batch sampling.
         sampling: ``uniform`` over frames or ``balanced`` over tasks.
-        lr_schedule: ``constant`` or ``cosine`` over ``steps`` (``mtdagger``; a LeRobot student
-            follows its config's scheduler preset).
-        plateau: End the phase when the held-out loss stops improving and keep the weights of its
-            minimum (None: train all ``steps``).
+        lr_schedule: ``constant`` or ``cosine`` over ``steps`` (``mtdagger`` only).
+        plateau: Stop at the held-out loss's plateau, keeping its best weights (None: all ``steps``).
         log_interval: Steps between two reads of the loss.
         task_dropout: A LeRobot student's task dropout (``mtdagger``'s is in its config).
-        progress: Where the phase's progress is saved every few minutes and resumed from
-            (``phase_progress.PhaseProgress``; None: never saved, a cut phase starts over).
+        progress: Where the phase's progress is saved and resumed from (None: never saved).
     """
 
     steps: int
@@ -157,25 +138,11 @@ def train_phase(
     on_step: Callable[[int, float], None] | None = None,
     student: Student | None = None,
 ) -> PhaseResult:
-    """Trains ``policy`` for ``options.steps`` steps (or until a plateau); measures the per-task loss drop.
+    """Trains ``policy`` in place for ``options.steps`` steps (or to a plateau); measures the loss drop.
 
-    How each step samples and updates is the module's docstring; the result depends only on the
-    inputs and ``options.seed`` (not on ``log_interval``).
-
-    Args:
-        policy: The policy to train, in place: ``mtdagger`` (its ``task_names`` must be
-            ``data.task_names``) or a LeRobot student reading a one-hot vector over them.
-        data: The normalised frames.
-        train_index: Frames to train on.
-        loss_index: Frames the per-task loss is measured on, before and after.
-        options: Steps, batch size, learning rate, sampling seed and rule, plateau stop.
-        on_step: Progress callback ``on_step(steps_done, mean_loss)``, every ``log_interval`` steps
-            and after the last one (the mean training loss over the steps since the previous call).
-        student: The run's student, whose seam trains (None: the one registered for the policy's type).
-
-    Returns:
-        The per-task losses at the start and at the end, the gain, the last FINAL_LOSSES step
-        losses and the steps taken (with ``plateau``, the held-out curve and the step kept).
+    ``loss_index`` frames measure the loss before and after. ``on_step(steps_done, mean_loss)`` is
+    called every ``log_interval`` steps and after the last. The result depends only on the inputs and
+    ``options.seed``.
 
     Raises:
         ValueError: If the policy's task vocabulary differs from the data's, log_interval < 1,
@@ -236,10 +203,9 @@ class StepLoop:
         self.resumed_after_steps: list[int] = []
 
     def run(self) -> int:
-        """Takes the steps (until the cap or a plateau, whose best weights it restores); the steps taken.
+        """Takes the steps (to the cap or a plateau, restoring its best weights); returns the steps taken.
 
-        Resumes from the phase's saved progress where there is some, and saves it every
-        ``progress.every_s`` seconds at the start of an interval.
+        Resumes from and saves the phase's progress (``progress.every_s``).
         """
         steps, log_interval = self.options.steps, self.options.log_interval
         stopped = self.tracker is not None and self.tracker.measure(0)
@@ -333,12 +299,8 @@ def batch_sampler(
 ) -> Callable[[tuple[int, int]], torch.Tensor]:
     """A function drawing frame indices of ``train_index`` in a given shape, with replacement.
 
-    ``uniform``: every frame equally likely. ``balanced``: a task uniformly among those with
-    training frames, then one of its frames uniformly (each task gets the same share of every batch
-    in expectation, however many frames it has).
-
-    Raises:
-        ValueError: If ``sampling`` is unknown.
+    ``uniform``: every frame equally likely; ``balanced``: a task with training frames uniformly, then
+    one of its frames (``ValueError`` for another ``sampling``).
     """
     if sampling == "uniform":
         return lambda shape: train_index[torch.randint(len(train_index), shape, generator=generator)]

@@ -1,10 +1,4 @@
-"""Performance gain: what a phase's training did to each task's imitation loss.
-
-Algorithm 1, "Train Policy": each task's imitation loss (the student's ``task_losses``; for
-``mtdagger``, ``students.mtdagger.per_task_loss``) is recorded at the start and at the end of the
-phase, on the training data itself or on a held-out split of episodes; the gain is
-``max(0, L_start - L_end)`` per task.
-"""
+"""Performance gain: what a phase's training did to each task's loss (Algorithm 1, "Train Policy")."""
 
 from __future__ import annotations
 

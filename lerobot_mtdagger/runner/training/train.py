@@ -1,11 +1,4 @@
-"""One training phase of a run: the student built or warm-started, trained on D(k), saved and recorded.
-
-Algorithm 1, "Train Policy": ``train_on_rounds`` trains on D(k) (all committed rounds so far, read
-once each: ``round_data``), normalised with LeRobot's pre-processor (``normalise``), on the frames
-``splits`` chooses, through the student's steps (``steps``), with the per-task losses performance
-gain needs (``task_loss``), and saves the policy folder and its record (``PhaseRecord``) with where
-it ran (``provenance``).
-"""
+"""One training phase of a run: the student built or warm-started, trained on D(k), saved and recorded."""
 
 from __future__ import annotations
 
@@ -57,11 +50,7 @@ class RoundCache:
 def student_config(
     config: RunConfig, features: dict[str, Any], task_names: Sequence[str], unseen: bool
 ) -> Any:
-    """The student's policy config for a run on a suite's ``features`` (``unseen``: it has held-out tasks).
-
-    ``Student.policy_config`` of the run's student: an ``MTDAggerConfig`` for ``--policy.type=mtdagger``,
-    a ``students.lerobot.LeRobotStudentConfig`` for a LeRobot student.
-    """
+    """The run's student's policy config on a suite's ``features`` (``unseen``: it has held-out tasks)."""
     return config.student.policy_config(config.policy, features, task_names, unseen)
 
 
@@ -70,14 +59,14 @@ class TrainedPhase:
     """A trained student with its processors and what its phase measured.
 
     Attributes:
-        policy: The trained policy (its weights are the phase's result).
-        preprocessor: Its LeRobot pre-processor (normalisation statistics of the phase's frames).
+        policy: The trained policy.
+        preprocessor: Its pre-processor (normalisation statistics of the phase's frames).
         postprocessor: Its post-processor.
         result: The per-task losses and steps of the phase.
-        loss_previous: The previous phase's policy's per-task loss on this phase's loss frames (None
-            in round 0): the loss performance gain is measured from.
+        loss_previous: The previous phase's policy's per-task loss on this phase's loss frames (None in
+            round 0): what performance gain starts from.
         frames: Frames of D(k).
-        prepare_s: Seconds spent before the first step (statistics, previous policy, its losses).
+        prepare_s: Seconds spent before the first step.
         train_s: Seconds spent training.
     """
 
@@ -139,21 +128,11 @@ def train_on_rounds(
     show_progress: bool = False,
     progress_path: Path | None = None,
 ) -> TrainedPhase:
-    """Algorithm 1's "Train Policy" for round ``round_index`` of a run: trains a student on D(k).
+    """Algorithm 1's "Train Policy" for round ``round_index`` (k) of a run: trains a student on D(k).
 
-    Splits the frames (``split_frames``), normalises them with statistics of the run's rule, builds
-    the student (warm-started from ``previous`` when the run says so), measures the previous
-    policy's per-task loss for performance gain and trains for the run's steps.
-
-    Args:
-        config: The run's config (training options, seed, split and step rules).
-        policy_cfg: The student's config (``student_config``).
-        data: D(k), the frames of rounds 0..k.
-        round_index: k.
-        previous: The folder of round k-1's policy (None in round 0).
-        show_progress: Show a progress bar over the steps.
-        progress_path: Where the phase's progress is saved every ``training.progress_every_s``
-            seconds and resumed from (``phase_progress``; None: never saved).
+    Splits and normalises the frames, builds the student (warm-started from round k-1's policy folder
+    ``previous`` if the run says so), measures the previous policy's per-task loss and trains.
+    ``progress_path``: where the phase's progress is saved (None: never).
     """
     start = time.perf_counter()
     image_keys = list(policy_cfg.image_features)
@@ -217,11 +196,7 @@ def train_on_rounds(
 
 
 def check_heldout(config: RunConfig, num_tasks: int) -> None:
-    """Refuses ``training.steps_rule=plateau`` when round 0 would hold no episode out, before anything runs.
-
-    Raises:
-        UserError: With the numbers and the fix.
-    """
+    """Refuses ``steps_rule=plateau`` where round 0 holds no episode out (``UserError`` with the numbers)."""
     training, demos = config.training, config.dagger.initial_demos
     if training.steps_rule != "plateau":
         return
