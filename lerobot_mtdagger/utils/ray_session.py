@@ -1,9 +1,7 @@
 """Joining (or starting) a Ray cluster for ``compare --launcher=ray`` and ``--rollout.worker_backend=ray``.
 
-Ray is an optional dependency (``pip install -e ".[ray]"``). ``connect(address)`` joins the cluster at
-``address`` (``auto``: the one ``ray start`` left on this machine; ``ray://host:10001``: a Ray client)
-or, without one, starts a local Ray on this machine's cores. A process joins at most once; later calls
-reuse the connection.
+Ray is optional (``pip install -e ".[ray]"``). A process joins at most once; later calls reuse the
+connection.
 """
 
 from __future__ import annotations
@@ -21,11 +19,7 @@ RAY_MISSING = 'Ray is not installed: pip install -e ".[ray]" (or pip install "ra
 
 
 def import_ray() -> ModuleType:
-    """The ``ray`` module.
-
-    Raises:
-        UserError: If Ray is not installed, naming the install command.
-    """
+    """The ``ray`` module (a ``UserError`` naming the install command if Ray is missing)."""
     try:
         import ray
     except ImportError:
@@ -34,9 +28,7 @@ def import_ray() -> ModuleType:
 
 
 def check_ray_address(address: str | None, option: str) -> None:
-    """Refuses a ``ray://`` address when the Ray Client's dependency (grpcio) is not installed.
-
-    Ray raises this only when it connects, after a run has started; checked here with the options.
+    """Refuses a ``ray://`` address without the Ray Client's grpcio now (Ray would fail only on connecting).
 
     Raises:
         UserError: Naming the option and both fixes.
@@ -51,7 +43,9 @@ def check_ray_address(address: str | None, option: str) -> None:
 
 
 def connect(address: str | None) -> ModuleType:
-    """The ``ray`` module, connected to the cluster at ``address`` (None: a local Ray on this machine).
+    """The ``ray`` module, connected to ``address`` (None: a local Ray on this machine's cores).
+
+    ``auto`` joins the cluster ``ray start`` left on this machine; ``ray://host:10001`` a Ray client.
 
     Raises:
         UserError: If Ray is missing, or there is no cluster at ``address``.
