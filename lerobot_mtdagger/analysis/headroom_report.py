@@ -1,8 +1,7 @@
 """The headroom section of a report: what the best split of the same demos could gain, per budget.
 
-Built from a results table's rows (``analysis/headroom.py`` does the maths): the curves come from the
-BC runs and every DAgger run's round 0 when there are any BC runs, else from every evaluated phase.
-Writes ``headroom.json`` and ``headroom.png`` beside ``report.md`` and returns its markdown lines.
+The curves come from the BC runs and DAgger's round 0 when there are BC runs, else from every
+evaluated phase; writes ``headroom.json`` and ``headroom.png`` beside ``report.md``.
 """
 
 from __future__ import annotations
@@ -135,8 +134,7 @@ def write_headroom(
 ) -> tuple[list[str], Path | None]:
     """Writes ``headroom.json`` and ``headroom.png``; returns the report lines and the figure.
 
-    Rows that cannot give every task a curve (for example one budget only) give one line saying why
-    instead of the section.
+    Rows that cannot give every task a curve give one line saying why instead.
     """
     try:
         summary = headroom_summary(rows, task_names)
