@@ -5,11 +5,7 @@ Allocation", its appendix "Two important techniques of Performance-aware Schedul
 allocation of "Implementation details": per task, a metric from the last round (Kalman-filtered
 success for Task Need, the imitation-loss drop for Performance Gain) is rank-normalised to [0, 1] and
 turned into a split of the budget by a temperature softmax with at least ``n_min`` episodes per task.
-
-Each method is one ``SchedulerConfig`` subclass (``--scheduler.type``) that declares the measurements
-it needs and computes its metric; filtering, ranking, softmax, rounding and the ``Allocation`` record
-are shared. ``recompute_allocation`` rebuilds an allocation from its record alone, so a stored round
-can be audited. Pure numpy (plus draccus for the configs).
+Each method is one ``SchedulerConfig`` subclass (``--scheduler.type``); the rest is shared. Pure numpy.
 """
 
 from __future__ import annotations
@@ -34,11 +30,7 @@ ArrayLike = Sequence[float] | np.ndarray
 
 
 def _as_vector(values: ArrayLike, name: str, num_tasks: int | None = None) -> np.ndarray:
-    """``values`` as a new 1-D float64 array of one value per task (``num_tasks`` long unless None).
-
-    Raises:
-        ValueError: If ``values`` is not 1-D, is empty, or has the wrong length (``name`` says which).
-    """
+    """``values`` as a new non-empty 1-D float64 array, ``num_tasks`` long (ValueError naming ``name``)."""
     array = np.array(values, dtype=np.float64, copy=True)
     if array.ndim != 1:
         raise ValueError(f"{name} must be a 1-D sequence with one value per task, got shape {array.shape}.")
@@ -83,12 +75,10 @@ def _require_positive(value: float, name: str) -> float:
 
 
 class KalmanSuccessEstimator:
-    """One scalar Kalman filter per task over the policy's success probability.
+    """One scalar Kalman filter per task over the policy's success probability ``p`` (variance ``P``).
 
-    The state is constant between rounds. Each round predicts ``P <- P + Q`` and, for a task with
-    ``n > 0`` rollouts and measured success rate ``s``, updates with ``R = R0 / (n + 1)``,
-    ``K = P / (P + R)``, ``p <- p + K (s - p)``, ``P <- (1 - K) P``; a task without rollouts is only
-    predicted.
+    Each round predicts ``P <- P + Q``; a task with ``n > 0`` rollouts of success rate ``s`` is then
+    updated with ``R = R0 / (n + 1)``, ``K = P / (P + R)``, ``p <- p + K (s - p)``, ``P <- (1 - K) P``.
 
     Args:
         num_tasks: Number of tasks (>= 1).
@@ -96,10 +86,6 @@ class KalmanSuccessEstimator:
         P0: Initial variance (>= 0).
         Q: Process noise added at every predict step (>= 0).
         R0: Measurement noise scale (> 0).
-
-    Attributes:
-        p: Estimated success probability per task, shape (num_tasks,).
-        P: Variance of the estimate per task, shape (num_tasks,).
     """
 
     def __init__(
@@ -120,8 +106,7 @@ class KalmanSuccessEstimator:
         """Runs one predict and one update step per task (ValueError on a bad measurement).
 
         Args:
-            success_rate: Measured success rate per task in [0, 1]; ignored (may be NaN) where
-                ``episodes`` is 0.
+            success_rate: Measured success rate per task in [0, 1] (ignored, may be NaN, at 0 episodes).
             episodes: Number of rollouts behind each measurement (integers >= 0).
         """
         rate, counts = check_measurements(success_rate, episodes, self.num_tasks)
@@ -148,9 +133,7 @@ class KalmanSuccessEstimator:
 def check_measurements(
     success_rate: ArrayLike, episodes: ArrayLike, num_tasks: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Validates one round's ``(success_rate, episodes)`` and returns them as float64 arrays.
-
-    NaN success is allowed only where a task had 0 episodes; episodes are integers >= 0.
+    """``(success_rate, episodes)`` checked and as float64 arrays (NaN success only at 0 episodes).
 
     Raises:
         ValueError: With the offending task index and value.
@@ -180,10 +163,8 @@ def check_measurements(
 def rank_normalize(values: ArrayLike) -> np.ndarray:
     """Rank-normalises a metric to [0, 1]: ``(rank - 1) / (N - 1)``, shape (N,).
 
-    Rank 1 is the lowest value; tied values share their average rank; a single task gets 0.
-
-    Raises:
-        ValueError: If ``values`` is empty, not 1-D or holds a NaN or infinity.
+    Rank 1 is the lowest value; tied values share their average rank; a single task gets 0. Raises a
+    ValueError if ``values`` is empty, not 1-D or not finite.
     """
     array = _as_vector(values, "values")
     _require_finite(array, "values")
@@ -203,11 +184,7 @@ def rank_normalize(values: ArrayLike) -> np.ndarray:
 
 
 def softmax(scores: ArrayLike, temperature: float) -> np.ndarray:
-    """Returns ``exp(score / T) / sum(exp(score / T))``, computed stably.
-
-    Raises:
-        ValueError: If a score is not finite or ``temperature`` is not a finite number > 0.
-    """
+    """``exp(score / T) / sum(exp(score / T))``, computed stably (ValueError on a non-finite input)."""
     temperature = _require_positive(temperature, "temperature")
     array = _as_vector(scores, "scores")
     _require_finite(array, "scores")
@@ -233,9 +210,6 @@ def allocate(scores: ArrayLike, budget: int, temperature: float, n_min: int) -> 
 
     Returns:
         Episodes per task, int64 array of shape (num_tasks,).
-
-    Raises:
-        ValueError: On a bad argument, or if the budget cannot give every task ``n_min``.
     """
     probability = softmax(scores, temperature)
     return allocate_probabilities(probability, budget, n_min, np.asarray(scores, dtype=np.float64))
@@ -246,11 +220,8 @@ def allocate_probabilities(
 ) -> np.ndarray:
     """Turns probabilities (shape (num_tasks,), summing to 1) into episode counts (see ``allocate``).
 
-    ``scores`` break ties between probabilities equal in floating point (so a higher score never gets
-    fewer episodes); without them ties go to the lower task index.
-
-    Raises:
-        ValueError: On a bad budget or n_min.
+    ``scores`` break ties between probabilities equal in floating point, so a higher score never gets
+    fewer episodes; without them ties go to the lower task index.
     """
     budget = _require_integer(budget, "budget", 0)
     n_min = _require_integer(n_min, "n_min", 0)
@@ -475,11 +446,7 @@ class SchedulerConfig(draccus.ChoiceRegistry):
         raise NotImplementedError(f"{type(self).__name__} must implement metric(state).")
 
     def split(self, state: SchedulerState, metric: np.ndarray, budget: int) -> tuple[np.ndarray, ...]:
-        """Scores, probabilities and episodes per task, each of shape (num_tasks,).
-
-        The default is the normalised metric, its softmax and ``allocate``; a method that splits otherwise
-        overrides this.
-        """
+        """Scores, probabilities and episodes per task: the normalised metric, softmax, ``allocate``."""
         if self.normalization == "rank":
             score = rank_normalize(metric)
         else:
@@ -570,9 +537,8 @@ class LearnabilitySchedulerConfig(SchedulerConfig):
 class CurveSchedulerConfig(SchedulerConfig):
     """Learning curves fitted online: the round's demos go where success is expected to rise most.
 
-    Fits each task's success against its demos (``learning_curve.fit_logistic_curves``), then splits the
-    budget greedily by expected gain per demo after ``n_min`` each (``learning_curve.greedy_split``);
-    ``temperature`` and ``normalization`` play no part. Before the first measurement the split is even.
+    Fits each task's success against its demos (``learning_curve``), then splits the budget greedily
+    by expected gain per demo after ``n_min`` each; ``temperature`` and ``normalization`` play no part.
 
     Attributes:
         prior_scale: Scale of a task's intercept around the common one (logits, > 0).
@@ -642,11 +608,7 @@ def scheduling_methods() -> tuple[str, ...]:
 
 
 def scheduler_config_class(method: str) -> type[SchedulerConfig]:
-    """The registered config class of ``method``.
-
-    Raises:
-        ValueError: On an unknown method (or ``bc``, a run mode), naming the known ones.
-    """
+    """The registered config class of ``method`` (ValueError naming the known ones, and ``bc``'s run mode)."""
     known = scheduling_methods()
     if method == "bc":
         raise ValueError(
@@ -665,12 +627,11 @@ STATE_FORMAT_VERSION = 1
 class Allocation:
     """One allocation and everything it was computed from (JSON-ready through ``to_dict``).
 
-    Lists are in the experiment's task order; a measurement is None until the scheduler has received it.
+    Lists are in task order; a measurement is None until the scheduler has received it.
 
     Attributes:
         success_rate: Last measured raw success rate per task (NaN where a task had no rollouts).
         episodes: Rollouts behind ``success_rate``.
-        gain: Last performance gain per task.
         raw_success: Latest raw success rate per task over all updates (``p0`` if never measured).
         kalman_prior: Kalman state ``{"p", "P"}`` before the last success update.
         kalman_posterior: Kalman state after it (the one ``need`` uses).
@@ -750,16 +711,12 @@ class Scheduler:
     """Allocates each DAgger round's demonstration budget across tasks.
 
     Every method tracks the same measurements (Kalman and raw success from rollouts, gain from training);
-    only the metric, from the method's config class, differs. Before any measurement every metric is
+    only the metric, from the method's ``config``, differs. Before any measurement every metric is
     constant, so the first allocation is uniform.
 
-    Args:
-        config: A registered method's config (``make_scheduler`` builds one by name).
-        num_tasks: Number of tasks (>= 1).
-
     Raises:
-        ValueError: On a bad hyperparameter.
-        TypeError: If ``config`` is not a ``SchedulerConfig``.
+        ValueError: On a bad hyperparameter or ``num_tasks`` < 1.
+        TypeError: If ``config`` is not a ``SchedulerConfig`` (``make_scheduler`` builds one by name).
     """
 
     def __init__(self, config: SchedulerConfig, num_tasks: int) -> None:
@@ -797,8 +754,7 @@ class Scheduler:
             success_rate: Raw success rate per task (NaN where a task had 0 rollouts); with ``episodes``.
             episodes: Rollouts per task behind ``success_rate``.
             gain: Per-task loss drop ``L_start - L_end`` of the round's training, clipped to >= 0.
-            demos: Expert demos per task of the policy behind ``success_rate`` (required with it by a
-                method that reads ``DEMOS``).
+            demos: Expert demos per task behind ``success_rate`` (required by methods that read ``DEMOS``).
             demos_so_far: Expert demos per task collected so far (the next allocation adds to them).
         """
         if (success_rate is None) != (episodes is None):
@@ -928,11 +884,7 @@ class Scheduler:
         return state
 
     def load_state_dict(self, state: Mapping[str, Any]) -> None:
-        """Restores a state written by ``state_dict``.
-
-        Raises:
-            ValueError: If the state belongs to another method, task count or format version.
-        """
+        """Restores a ``state_dict`` (ValueError if of another method, task count or format version)."""
         if state.get("format_version") != STATE_FORMAT_VERSION:
             raise ValueError(
                 f"Scheduler state has format_version={state.get('format_version')!r}; this version "
@@ -966,11 +918,7 @@ class Scheduler:
 
 
 def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int | None) -> Scheduler:
-    """Creates a scheduler by method name (``scheduling_methods()``) and ``SchedulerConfig`` fields.
-
-    Raises:
-        ValueError: On an unknown method, an unknown hyperparameter or a bad value.
-    """
+    """Creates a scheduler by method name and ``SchedulerConfig`` fields (ValueError on a bad one)."""
     config_class = scheduler_config_class(method)
     known = {f.name for f in dataclasses.fields(config_class)}
     unknown = sorted(set(hyperparameters) - known)
@@ -982,11 +930,8 @@ def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int |
 def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
     """Recomputes an ``Allocation.to_dict()`` record from its inputs alone, through the method's config.
 
-    The Kalman posterior is recomputed from the stored prior and measurements, so a tampered metric or
-    Kalman state is detected too.
-
-    Raises:
-        ValueError: If the record is incomplete, of an unknown method or inconsistent with itself.
+    The Kalman posterior too, from the stored prior and measurements, so a tampered Kalman state is
+    detected. Raises a ValueError on an incomplete or inconsistent record or an unknown method.
     """
     stored = Allocation.from_dict(record)
     config = stored.config()
@@ -1022,10 +967,7 @@ def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
 
 
 def allocation_mismatches(record: Mapping[str, Any], rtol: float = 1e-9) -> list[str]:
-    """One message per field of an ``Allocation.to_dict()`` record that its inputs do not reproduce.
-
-    Float fields are compared with relative tolerance ``rtol``; an empty list: the record checks out.
-    """
+    """Messages on the fields of an ``Allocation.to_dict()`` record its inputs do not reproduce."""
     recomputed = recompute_allocation(record)
     problems = []
     for name in ("metric", "score", "probability"):
