@@ -1,10 +1,9 @@
 """Loading policy folders safely: a checkpoint never names Python code to import.
 
-LeRobot's processor loader builds each step of ``policy_preprocessor.json`` /
-``policy_postprocessor.json`` from its step registry (``"registry_name"``) or by importing and calling
-any ``"class"`` the file names (``{"class": "os.system", ...}`` runs a shell command on load). Unless
-the checkpoint is trusted, every step must name a registered processor step. The safetensors weights
-and the config's registry-resolved ``type`` cannot run code.
+LeRobot's processor loader builds each step of ``policy_preprocessor.json`` and
+``policy_postprocessor.json`` from its registry or by importing any ``"class"`` the file names
+(``{"class": "os.system", ...}`` runs a command on load). Unless the checkpoint is trusted, every
+step must name a registered processor step.
 """
 
 from __future__ import annotations
@@ -97,12 +96,7 @@ def check_policy_path(path: str | Path) -> None:
 
 
 def check_local_policy(folder: Path) -> None:
-    """Checks that a folder is a complete policy of a student's type with readable safetensors files.
-
-    Raises:
-        UserError: If it is a file, a dataset, an experiment, another policy type, or a file of it is
-            missing or unreadable, naming it.
-    """
+    """Checks that a folder is a complete policy of a student's type, its files readable (``UserError``)."""
     if not folder.is_dir():
         raise UserError(f"{folder} is a file: --policy_path takes a policy folder or a Hub id owner/name.")
     if (folder / "policies").is_dir():
@@ -153,11 +147,7 @@ def load_policy(
 ) -> tuple[Any, Any, Any]:
     """Loads a policy folder or Hub id (a student's type) with its saved processors, after the checks above.
 
-    Args:
-        path: A local policy folder or a Hub repo id.
-        device: Torch device.
-        trust_checkpoint: Let the processor configs name Python classes to import (LeRobot's loader
-            imports and calls them).
+    ``trust_checkpoint`` lets the processor configs name Python classes to import.
 
     Returns:
         The policy (in eval mode, on ``device``), its pre-processor and its post-processor.

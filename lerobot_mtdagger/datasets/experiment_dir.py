@@ -91,9 +91,7 @@ class ExperimentLockedError(UserError):
 DATASET_FPS = 80
 
 VIDEO_BACKEND = "pyav"
-"""The decoder named when a round is created: rounds hold no video, and naming one keeps LeRobot >= 0.5
-from probing torchcodec (a multi-line warning per dataset where FFmpeg's libraries are absent).
-"""
+"""The decoder named when a round (no video) is created: LeRobot >= 0.5 then probes no torchcodec."""
 
 
 def writer_lock_holder(root: Path) -> str | None:
@@ -127,8 +125,8 @@ def write_json_atomic(path: Path, payload: Any) -> None:
 def write_record_files(root: Path, record: dict[str, Any]) -> None:
     """Writes a dataset's record (``meta/mtdagger.json``) and, on LeRobot 0.4, its ``meta/info.json`` mirror.
 
-    LeRobot 0.6 warns of unknown ``info.json`` keys on every load, so there the mirror is left out (and
-    removed). Each file is written anew, so a hard link to the former file is left intact.
+    Each file is written anew (a hard link to the former one is left intact); LeRobot 0.6, which warns
+    of unknown ``info.json`` keys, gets no mirror.
     """
     info_path = root / INFO_FILE
     info = json.loads(info_path.read_text())
@@ -149,10 +147,7 @@ def read_committed_json(path: Path, fix: str) -> Any:
 
 
 def fill_added_options(stored: dict[str, Any], given: Mapping[str, Any], added: Mapping[str, Any]) -> None:
-    """Gives ``stored`` each option of ``added`` it lacks where ``given`` holds that default.
-
-    ``added`` maps an option's dotted path to its value before the option existed.
-    """
+    """Gives ``stored`` each option of ``added`` it lacks where ``given`` holds that former value."""
     for key, default in added.items():
         if key in given and key not in stored and given[key] == default:
             stored[key] = default
@@ -229,10 +224,7 @@ class ExperimentDir:
         return self.root.exists() and any(self.root.iterdir())
 
     def initialise(self, config: dict[str, Any], extra: Mapping[str, Any] | None = None) -> None:
-        """Creates the experiment atomically: built beside ``root``, then renamed onto it.
-
-        ``extra`` maps file names to JSON content (``expert_check.json``). A start that fails before the
-        rename leaves nothing at ``root``.
+        """Creates the experiment (``extra``: JSON files by name) beside ``root``, then renames it there.
 
         Raises:
             UserError: If the directory exists and is not empty.
@@ -259,10 +251,7 @@ class ExperimentDir:
 
     @contextlib.contextmanager
     def writer_lock(self, record_pid: bool = True) -> Iterator[None]:
-        """Holds the folder's writer lock (``flock`` on ``<root>/.lock``): one run writes at a time.
-
-        The OS releases it however the process exits. The file holds the writer's pid for a second
-        writer's message (not rewritten with ``record_pid=False``).
+        """Holds the writer lock (``flock`` on ``<root>/.lock``, holding the pid): one writer at a time.
 
         Raises:
             ExperimentLockedError: At once, if another process holds the lock, naming it.
@@ -293,9 +282,8 @@ class ExperimentDir:
     ) -> None:
         """Checks that ``root`` holds an experiment started with the same config, option by option.
 
-        May differ: options in ``ignore`` (they never change a result); a larger ``dagger.rounds`` of a
-        DAgger run (no round depends on how many follow; see ``extend_rounds``); an option the stored config
-        lacks, when ``config`` gives it its default in ``added_defaults`` (by dotted path).
+        May differ: options in ``ignore``; a larger ``dagger.rounds`` of a DAgger run (``extend_rounds``);
+        an option the stored config lacks, given its default in ``added_defaults`` (by dotted path).
 
         Raises:
             NotAnExperimentError: If there is no experiment to resume.
@@ -419,11 +407,7 @@ class ExperimentDir:
 
     @staticmethod
     def read_round_record_at(path: Path) -> RoundRecord:
-        """The record of the round dataset at ``path`` (``meta/mtdagger.json``, else ``meta/info.json``).
-
-        Raises:
-            CorruptExperimentError: If ``path`` holds no readable round record.
-        """
+        """The record of the round at ``path`` (``CorruptExperimentError`` if it holds no readable one)."""
         if (path / RECORD_FILE).is_file():
             fix = "restore it, or move the round out of the experiment directory"
             return round_record_from(read_committed_json(path / RECORD_FILE, fix), path, path / RECORD_FILE)
@@ -464,15 +448,14 @@ class ExperimentDir:
     ) -> LeRobotDataset:
         """Creates a round dataset in staging and writes all its episodes in one go.
 
-        Equivalent to :meth:`create_round` and ``add_frame``/``save_episode`` per frame and episode, but
-        much cheaper. Commit the returned (not finalised) dataset with :meth:`commit_round`.
+        As :meth:`create_round` and ``add_frame``/``save_episode`` per frame and episode would, but much
+        cheaper. Commit the returned (not finalised) dataset with :meth:`commit_round`.
 
         Args:
             round_index: Index of the round.
             features: The round's LeRobot features (``records.round_features``).
             task_names: The experiment's task vocabulary, in task-index order.
-            episodes: ``(task, frames)`` per episode, in order; a frame maps every non-default feature to
-                its value (as for ``LeRobotDataset.add_frame``, without ``task``).
+            episodes: ``(task, frames)`` per episode; a frame maps each non-default feature to its value.
 
         Raises:
             ValueError: If a frame does not match the features or an episode has no frame.
@@ -580,11 +563,7 @@ class ExperimentDir:
         Ledger(self.root).append(self.committed_record_files(), write_json_atomic)
 
     def ledger_problems(self, resuming: bool = False) -> list[str]:
-        """Records that differ from the ledger.
-
-        ``resuming`` accepts what a resume mends: the last records deleted to be redone, and records
-        committed by a run cut off before it reached the ledger.
-        """
+        """Records that differ from the ledger (``resuming``: but what a resume mends)."""
         records = self.committed_record_files()
         ledger = Ledger(self.root)
         if not ledger.exists():
@@ -593,10 +572,7 @@ class ExperimentDir:
         return [p for p in problems if "is committed but not in" not in p] if resuming else problems
 
     def _missing_ledger_problems(self, records: Sequence[Path], resuming: bool) -> list[str]:
-        """A missing ledger, named when a record says it was committed into one.
-
-        A resume accepts the experiment's first record committed just before the ledger was started.
-        """
+        """A missing ledger, named when a record says it was committed into one."""
         ledgered = [path for path in records if committed_into_ledger(path)]
         if not ledgered or (resuming and ledgered == list(records[-1:]) and len(records) == 1):
             return []
@@ -631,14 +607,12 @@ SAVED_INFO_FILE = "info.json"
 class SavedRunRecords(ExperimentDir):
     """A run's small JSON records, saved apart from its datasets and weights, read as a run is read.
 
-    The layout ``lerobot-mtdagger records --action=save`` writes::
+    The layout ``lerobot-mtdagger records --action=save`` writes; enough to report the run, not to
+    verify, resume, merge or push it::
 
         <run>/config.json                       the run's options
         <run>/rounds/round-000/mtdagger.json    the round's record (or info.json with it)
         <run>/policies/round-000/training.json  the phase's training record, evaluation included
-
-    Enough to tabulate and report the run, not to verify, resume, merge or push it (no frames, no
-    weights; a round's frames are known only in total).
     """
 
     @staticmethod
@@ -664,10 +638,7 @@ def open_run(root: Path) -> ExperimentDir:
 
 
 def sort_stats_file(root: Path) -> None:
-    """Rewrites a dataset's ``meta/stats.json`` with sorted keys, so a round's bytes are reproducible.
-
-    LeRobot's key order follows Python's per-process string hashing; readers look keys up by name.
-    """
+    """Rewrites ``meta/stats.json`` with sorted keys, so a round's bytes are reproducible."""
     path = root / STATS_FILE
     if path.is_file():
         stats = json.loads(path.read_text())
@@ -680,11 +651,7 @@ RENUMBERED_COLUMNS = ("episode_index", "index", "task_index")
 
 @contextlib.contextmanager
 def _data_files_merged_in_arrow(features: Mapping[str, Mapping[str, Any]]) -> Iterator[None]:
-    """Lets LeRobot 0.4's ``aggregate_datasets`` merge data files with multi-dimensional features.
-
-    Its pandas round trip fails on a 2-D feature such as an (N, 3) point cloud; while this context is
-    open such data files are merged in Arrow (``_append_data_file``). ``features``: the rounds' features.
-    """
+    """Lets LeRobot 0.4's ``aggregate_datasets`` merge data files with 2-D features, in Arrow."""
     from lerobot.datasets import aggregate
     from lerobot.datasets.utils import DEFAULT_DATA_PATH
 
@@ -713,16 +680,8 @@ def _append_data_file(
 ) -> tuple[dict[str, int], tuple[int, int]]:
     """``append_or_create_parquet_file`` for data files, in Arrow (same file rotation rule).
 
-    Args:
-        df: The source file's frames as LeRobot renumbered them (``RENUMBERED_COLUMNS`` are taken).
-        src_path: The source data file.
-        idx: The destination's current ``chunk`` and ``file`` (updated on rotation).
-        max_mb: Size at which a destination file is closed.
-        chunk_size: Files per chunk.
-        path_format: Destination path with ``{chunk_index}`` and ``{file_index}``.
-
     Returns:
-        ``idx`` and the (chunk, file) the frames were written to.
+        ``idx`` (the destination's ``chunk`` and ``file``, updated) and the (chunk, file) written to.
     """
     table = pq.read_table(src_path)
     for name in RENUMBERED_COLUMNS:
@@ -749,11 +708,10 @@ def merge_rounds(
     repo_id: str = "local/merged",
     unverified: Sequence[str] = (),
 ) -> Path:
-    """Merges round datasets into one LeRobotDataset with LeRobot's own aggregation.
+    """Merges round datasets into one LeRobotDataset with LeRobot's own aggregation, task indices kept.
 
-    Task indices are preserved. The merged dataset's ``mtdagger`` record lists the rounds' records and
-    ``unverified``, the verification problems the caller read past (else a changed round is refused).
-    It is written beside ``output`` and renamed onto it when complete.
+    Its ``mtdagger`` record lists the rounds' records and ``unverified`` (problems the caller read
+    past). It is written beside ``output`` and renamed onto it when complete.
 
     Raises:
         UserError: If ``output`` exists.

@@ -1,15 +1,10 @@
 """Pushing a Multitask DAgger experiment to the Hugging Face Hub, one git revision per round.
 
-Round k is uploaded to the dataset repo as one commit holding exactly round k's dataset files and a
-card (``README.md``) of rounds 0..k, tagged ``round-{k:03d}``: ``LeRobotDataset(repo_id,
-revision="round-002")`` loads round 2, and ``main`` ends at the last pushed round. Training phase k
-goes to an optional model repo, tagged the same way.
-
-Uploads delete only remote files of the dataset (``data/``, ``meta/``, ``videos/``) or model
-(``*.json``, ``*.safetensors``) that the round lacks; other files in the repo are kept. Round folders
-are never written to (the card comes through a temporary folder of symlinks). Re-pushing is allowed:
-an existing tag stays on its first commit, which holds the same files, since a committed round and
-the card of rounds 0..k never change.
+Round k is one commit of the dataset repo holding exactly round k's files and a card (``README.md``)
+of rounds 0..k, tagged ``round-{k:03d}``: ``LeRobotDataset(repo_id, revision="round-002")`` loads
+round 2. Training phase k goes to an optional model repo, tagged the same way. Other files in the
+repos are kept. Re-pushing is allowed: an existing tag stays on its first commit, which holds the
+same files, since committed rounds never change.
 """
 
 from __future__ import annotations
@@ -94,10 +89,7 @@ def allocation_table(task_names: Sequence[str], records: Sequence[RoundRecord]) 
 
 
 def eval_table(task_names: Sequence[str], evals: dict[int, dict[str, Any] | None]) -> str:
-    """Success per task (rows) of the policy trained on rounds 0..k (columns), with a mean row.
-
-    ``evals`` maps a round index to its phase record's ``eval`` (None: missing or not evaluated).
-    """
+    """Success per task (rows) of the policy of rounds 0..k (columns, from ``evals``), with a mean row."""
     if not any(evals.values()):
         return "No evaluation was recorded for these rounds."
     rounds = sorted(evals)
@@ -127,11 +119,7 @@ def _phase_eval(experiment: ExperimentDir, round_index: int) -> dict[str, Any] |
 
 
 def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: int | None = None) -> str:
-    """Fills the dataset-card template for ``repo_id`` with the rounds 0..``up_to_round`` (None: all).
-
-    Raises:
-        ValueError: If the experiment has no committed round or ``up_to_round`` is not committed.
-    """
+    """The dataset card of ``repo_id`` for rounds 0..``up_to_round`` (None: all; ValueError if absent)."""
     committed = experiment.committed_rounds()
     if not committed:
         raise UserError(f"{experiment.root} has no committed round to describe.")
@@ -171,11 +159,7 @@ def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: in
 
 @contextlib.contextmanager
 def folder_with_card(folder: Path, card: str) -> Iterator[Path]:
-    """A temporary folder of file symlinks mirroring ``folder`` (never written), plus ``card`` as README.md.
-
-    Files are linked one by one (``upload_folder`` does not descend into linked directories), copied
-    where symlinks are not available; the folder is deleted on exit.
-    """
+    """A temporary folder of file symlinks (or copies) mirroring ``folder``, plus ``card`` as README.md."""
     with tempfile.TemporaryDirectory(prefix="mtdagger-push-") as tmp:
         staged = Path(tmp) / folder.name
         staged.mkdir()
@@ -202,11 +186,7 @@ def upload_and_tag(
     commit_message: str,
     delete_patterns: Sequence[str],
 ) -> str:
-    """Uploads ``folder`` as one commit (deleting remote files matching ``delete_patterns``) and tags it.
-
-    Returns:
-        The commit id ``tag`` names (an existing tag is left as it is).
-    """
+    """Uploads ``folder`` as one commit (deleting remote ``delete_patterns``); returns the tag's commit."""
     info = api.upload_folder(
         repo_id=repo_id,
         repo_type=repo_type,
@@ -264,11 +244,7 @@ def push_phases(api: HfApi, experiment: ExperimentDir, repo_id: str, phases: Seq
 
 
 def _pushable(experiment: ExperimentDir, with_policies: bool) -> tuple[list[int], list[int]]:
-    """The committed rounds (and phases, if wanted) to push, checked before anything is sent.
-
-    Raises:
-        UserError: If there is no experiment, no committed round, or no phase while policies are wanted.
-    """
+    """The committed rounds (and phases, if wanted) to push, checked before anything is sent."""
     if not (experiment.root / CONFIG_FILE).exists():
         raise UserError(
             f"{experiment.root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}): pass the "
@@ -286,11 +262,7 @@ def _pushable(experiment: ExperimentDir, with_policies: bool) -> tuple[list[int]
 
 
 def check_hub_access(api: HfApi) -> str:
-    """Checks that the Hub answers and accepts the token; returns the token's user name.
-
-    Raises:
-        UserError: With no token, a rejected token, or no connection, saying how to fix it.
-    """
+    """The token's user name, once the Hub answers and accepts it (else a ``UserError`` saying the fix)."""
     from huggingface_hub.errors import HfHubHTTPError, LocalTokenNotFoundError
 
     try:
@@ -323,13 +295,11 @@ def push_experiment(
 ) -> dict[str, dict[str, str]]:
     """Pushes every committed round (and optionally every training phase) to the Hub, one tag per round.
 
-    Creates the repos if needed; see the module docstring for the commits and tags.
-
     Args:
         experiment_dir: Output directory of a ``lerobot-mtdagger run``.
-        dataset_repo_id: Hub dataset repo, ``owner/name``.
+        dataset_repo_id: Hub dataset repo, ``owner/name`` (created if needed).
         policy_repo_id: Hub model repo for the trained policies (None: policies are not pushed).
-        private: Whether repos created by this call are private (existing ones are left as they are).
+        private: Whether repos created by this call are private.
         api: The Hub client (default: a new ``HfApi()``, authenticated as usual, e.g. by ``HF_TOKEN``).
         added_defaults: ``RunConfig.option_defaults``, for the verification.
 

@@ -35,8 +35,7 @@ def digest_mismatches(
 ) -> list[str]:
     """One message per file of ``folder`` missing, changed or not in ``recorded`` (path -> sha256).
 
-    ``exclude`` are paths not hashed; ``added_ok`` leaves files not recorded unnamed (a policy folder
-    outside its experiment, where a Hub download adds ``.gitattributes`` and ``.cache/``).
+    ``exclude``: paths not hashed; ``added_ok``: files not recorded are fine (a Hub download adds some).
     """
     folder = Path(folder)
     present = folder_digests(folder, exclude)

@@ -1,7 +1,6 @@
 """The experiment's ledger: a hash chain over every committed record, so an edited number is named.
 
-``ledger.json`` at the experiment's root lists every record (round and phase records, which hold the
-numbers ``report``, ``compare`` and a resume read) in commit order with its sha256 and the hash of
+``ledger.json`` lists every round and phase record in commit order with its sha256 and the hash of
 the entry before it::
 
     {"entries": [
@@ -9,9 +8,7 @@ the entry before it::
       {"record": "policies/round-000/training.json", "sha256": "...", "previous": "<entry 0's hash>"},
       ...]}
 
-An edited record no longer matches its entry, an edited entry breaks the chain, a ledger none of
-whose entries matches was replaced; every record committed with a ledger says so (``ledger: true``),
-so a deleted ledger is named. ``docs/reliability.md`` describes the checks and older experiments.
+``docs/reliability.md`` describes what is checked and when.
 """
 
 from __future__ import annotations
@@ -86,10 +83,7 @@ class Ledger:
             write(self.path, {"entries": entries})
 
     def problems(self, records: Sequence[Path], deleted_tail_ok: bool = False) -> list[str]:
-        """What differs between the committed records (in commit order) and the ledger (nothing without one).
-
-        ``deleted_tail_ok`` accepts entries at the end whose records were deleted for a resume to redo.
-        """
+        """What differs between the records and the ledger (``deleted_tail_ok``: bar deleted last ones)."""
         if not self.exists():
             return []
         try:

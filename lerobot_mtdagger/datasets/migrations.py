@@ -1,10 +1,7 @@
 """The rules about runs stored by earlier versions of the toolkit: one ordered list of migrations.
 
 Every change to what a stored run config holds or means is one ``Migration`` in ``MIGRATIONS``,
-oldest first (``docs/changes.md`` describes each). A migration may rewrite a stored config into the
-newer layout (``migrate_run_config`` applies every rewrite in order), name what an option it added
-was before it existed (``former_option_values``), and explain why a resume is refused
-(``resume_hint``, newest migration first). No other module keeps rules about older runs.
+oldest first (``docs/changes.md`` describes each); no other module keeps rules about older runs.
 """
 
 from __future__ import annotations
@@ -27,11 +24,9 @@ class Migration:
         name: A short identifier.
         since: The date of the change (``docs/changes.md`` has the entry).
         summary: What changed, in one sentence.
-        rewrite: Turns a config stored before the change into the newer layout (a copy); None when the
-            layout did not change.
+        rewrite: Turns a config stored before the change into the newer layout (a copy), or None.
         former_values: Options the change added, by dotted path, and the value runs made before had.
-        resume_hint: ``hint(stored_config, differing, stored_options)`` (as ``resume_hint``): a
-            parenthesised sentence on how to resume a run made before the change, or ``""``.
+        resume_hint: A ``resume_hint`` function: how to resume a run made before the change, or ``""``.
     """
 
     name: str
@@ -135,10 +130,7 @@ def rescaled_preset_hint(
 def pixels_preset_hint(
     stored_config: Mapping[str, Any], differing: Sequence[str], stored: Mapping[str, Any]
 ) -> str:
-    """Names the options that keep a ``metaworld-pixels`` run made before the preset changed them.
-
-    The date named is that of the earliest change among the differing options.
-    """
+    """Names the options (and the earliest date) that keep a ``metaworld-pixels`` run made before a change."""
     if stored_config.get("preset") != "metaworld-pixels" or not differing:
         return ""
     former = {key: value for _, values in PIXELS_FORMER_VALUES for key, value in values.items()}

@@ -161,22 +161,20 @@ def allocation_view(allocation: dict[str, Any] | None) -> dict[str, Any]:
 class RoundRecord:
     """The record of one committed round (``meta/mtdagger.json``).
 
+    An optional field is None (``ledger`` False) where the record does not hold it.
+
     Attributes:
         task_names: The experiment's task vocabulary (task index i is ``task_names[i]``).
         round: Round index k (0: expert demonstrations).
         method: ``bc`` or the scheduling method.
         beta: Probability of executing the expert's action at a step (1 in round 0).
-        seed: Experiment seed.
         budget: Episodes collected in the round.
-        temperature: The scheduler's softmax temperature.
-        n_min: The scheduler's minimum episodes per task.
         episodes_per_task: Episodes collected per task.
         demos_so_far: Expert-labelled episodes per task in rounds 0..k.
         rollout_success: Success rate per task of this round's rollouts, whoever acted (None in
             round 0 and where a task had no episode); ``rollout_episodes``: the episodes behind it.
         expert_success: Round 0 only: the experts' success rate per task.
         learner_steps: Steps where the learner's action was executed.
-        frames: Frames stored.
         config: The run config (``RunConfig.to_dict``).
         success_rate: Scheduler input: the measured success rate (the previous round's); ``episodes``:
             the rollouts behind it; ``gain``: the previous training phase's performance gain.
@@ -187,8 +185,6 @@ class RoundRecord:
         eval_success: Evaluation success per task of the policy that collected this round.
         allocation: The full ``Allocation.to_dict()`` (None in round 0); ``verify`` recomputes it.
         scheduler_state: ``Scheduler.state_dict()`` after this round's allocation (resume restores it).
-        notes: Human-readable remarks.
-        format_version: ``FORMAT_VERSION``.
         committed: True once the round is committed (a record without it is never read).
         learner_success: Success rate per task of this round's episodes where only the learner acted
             (the next round's task need measurement); ``learner_episodes``: the episodes behind it.
@@ -246,6 +242,8 @@ class RoundRecord:
 @dataclass
 class PhaseRecord:
     """The record of one committed training phase (``policies/round-XXX/training.json``).
+
+    An optional field is None (``ledger`` False) where the record does not hold it.
 
     Attributes:
         round: k: the policy was trained on rounds 0..k (``trained_on_rounds``).

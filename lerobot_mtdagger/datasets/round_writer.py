@@ -35,20 +35,17 @@ EpisodeFrames = tuple[str, Sequence[Mapping[str, Any]]]
 def write_round_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFrames]) -> None:
     """Writes episodes into a new, empty LeRobotDataset as LeRobot's own recording loop would.
 
-    The files are those of ``add_frame`` per frame and ``save_episode`` per episode (data, per-episode
-    statistics, ``meta/episodes``, ``tasks.parquet``, ``info.json``, ``stats.json``) but for the random
-    ``datasets`` fingerprint in the schema metadata, from one Arrow conversion per round and fewer
-    statistics passes (6-10 times faster for vector features; the fast statistics are checked against
-    LeRobot's on each round's first episode). A new data file starts where the next episode would pass
-    ``data_files_size_in_mb`` (uncompressed Arrow size). Image and video rounds take LeRobot's own path.
+    The same files as ``add_frame``/``save_episode`` (but for a random ``datasets`` fingerprint), from
+    one Arrow conversion per round and fewer statistics passes, checked against LeRobot's on the first
+    episode; 6-10 times faster for vector features. Image and video rounds take LeRobot's own path.
 
     Args:
         dataset: A dataset just created (``LeRobotDataset.create``), without episodes.
         episodes: ``(task, frames)`` per episode (see :meth:`ExperimentDir.write_round`).
 
     Raises:
-        ValueError: If the dataset already holds episodes, a frame does not match the features, or an
-            episode has no frame.
+        ValueError: If the dataset holds episodes, a frame does not match the features, or an episode
+            has no frame.
     """
     if dataset.meta.total_episodes != 0 or unsaved_frames(dataset) > 0:
         raise ValueError(
@@ -93,9 +90,8 @@ def save_episode_with_success(dataset: LeRobotDataset, frames: Sequence[Mapping[
 def save_episode_with_scalar_columns(dataset: LeRobotDataset, frames: Sequence[Mapping[str, Any]]) -> None:
     """``save_episode_with_success`` with each one-value feature's column handed on as scalars.
 
-    LeRobot's ``save_episode`` stacks a ``(1,)`` feature into an ``(N, 1)`` column, which ``datasets``
-    converts row by row with ``int()``/``float()`` (an error from numpy 2.5); the column is flattened to
-    ``(N,)`` just for that conversion (same values and schema; the statistics still see ``(N, 1)``).
+    ``datasets`` would convert LeRobot's ``(N, 1)`` column row by row with ``int()``/``float()`` (an
+    error from numpy 2.5); it is flattened to ``(N,)`` just for that (the statistics see ``(N, 1)``).
     """
     owner = episode_data_writer(dataset)
     save_data = owner._save_episode_data
@@ -159,11 +155,7 @@ def _arrow_table(columns: Mapping[str, np.ndarray], hf_features: datasets.Featur
 
 
 class _FastQuantileStats(RunningQuantileStats):
-    """LeRobot's ``RunningQuantileStats`` with cheaper histogram and quantile loops, same results bit for bit.
-
-    ``_update_histograms`` runs ``np.histogram``'s algorithm for explicit edges without its per-call
-    checks (bools as uint8, without its warning); ``_compute_quantiles`` sums each histogram once.
-    """
+    """LeRobot's ``RunningQuantileStats`` with cheaper histogram and quantile loops, same results."""
 
     def _update_histograms(self, batch: np.ndarray) -> None:
         if batch.dtype == np.bool_:
@@ -238,10 +230,7 @@ def _same_stats(ours: Mapping[str, Any], theirs: Mapping[str, Any]) -> bool:
 def _checked_fast_stats(
     buffer: Mapping[str, np.ndarray], dataset: LeRobotDataset
 ) -> tuple[dict[str, Any], Callable[..., dict[str, Any]]]:
-    """The first episode's statistics and the statistics function for the round's other episodes.
-
-    The fast one if it matches LeRobot's ``compute_episode_stats`` on this episode, else LeRobot's.
-    """
+    """The first episode's statistics and the fast statistics function if it matched, else LeRobot's."""
     reference = compute_episode_stats(buffer, dataset.features)
     try:
         fast = _vector_episode_stats(buffer, dataset.features)

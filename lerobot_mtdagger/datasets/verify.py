@@ -1,10 +1,8 @@
 """Audits an experiment folder: every committed round and policy against its files and its record.
 
-For each committed round ``verify_round`` checks the files against the sha256 recorded at commit,
-the episodes per task and frames in the data files against the record, the task vocabulary, the
-demonstration counts, and for DAgger rounds that the allocation recomputes from the record alone
-and chains with the previous round and phase. ``verify_policy`` checks a policy's files and that it
-loads; ``check_before_reading`` is what every reader runs first.
+A round's files against their sha256, its episodes, frames and tasks against its record, and a
+DAgger round's allocation recomputed and chained with the previous round and phase; a policy's
+files, and that it loads. ``check_before_reading`` is what every reader runs first.
 """
 
 from __future__ import annotations
@@ -36,11 +34,7 @@ logger = logging.getLogger(__name__)
 
 
 def stored_tasks(root: Path, num_tasks: int) -> tuple[list[str], list[int], int]:
-    """A round dataset's task vocabulary, episodes per task index and frames, counted in its files.
-
-    Raises:
-        CorruptExperimentError: Naming the file that cannot be read.
-    """
+    """A round's task vocabulary, episodes per task and frames, counted in its files."""
     tasks_table = read_parquet(root / "meta" / "tasks.parquet").to_pandas()
     order = [str(task) for task in tasks_table.sort_values("task_index").index]
     paths = sorted((root / "data").glob("*/*.parquet"))
@@ -65,11 +59,7 @@ def read_parquet(path: Path, columns: list[str] | None = None) -> pa.Table:
 def expert_mismatches(
     run_config: dict, record: RoundRecord, added_defaults: Mapping[str, Any] | None = None
 ) -> list[str]:
-    """Whether a round was collected with the run's experts (``--expert.*``, the same in every round).
-
-    An option one side does not store is taken at its default from ``added_defaults`` (by dotted path),
-    else not compared.
-    """
+    """How a round's experts differ from the run's ``--expert.*`` (missing options: ``added_defaults``)."""
     stored, recorded = run_config.get("expert") or {}, record.config.get("expert") or {}
     defaults = {
         path.split(".", 1)[1]: v for path, v in (added_defaults or {}).items() if path.startswith("expert.")
@@ -93,17 +83,10 @@ def verify_round(
     committed_phases: set[int],
     added_defaults: Mapping[str, Any] | None = None,
 ) -> list[str]:
-    """Checks one committed round against its data and its own record.
+    """Checks one committed round against its data and record; one message per problem.
 
-    Args:
-        experiment: The experiment folder.
-        record: The round's record.
-        previous: The previous round's record (None for round 0).
-        committed_phases: Indices of the committed training phases.
-        added_defaults: Defaults by dotted path of options the run's config lacks.
-
-    Returns:
-        One message per problem, prefixed by the round's name.
+    ``previous`` is the previous round's record (None for round 0); ``added_defaults`` the defaults by
+    dotted path of options the run's config lacks.
     """
     name = round_name(record.round)
     problems = experiment.round_file_problems(record)
@@ -159,10 +142,7 @@ def _chain_mismatches(
 
 
 def verify_policy(experiment: ExperimentDir, round_index: int, load: bool = True) -> list[str]:
-    """Checks one committed policy folder's files against its checksums, and that it loads (``load``).
-
-    Loading never runs code named by the checkpoint. Returns one message per problem.
-    """
+    """Checks a committed policy folder's files and, with ``load``, that it loads (running no named code)."""
     prefix = f"policies/{round_name(round_index)}"
     try:
         record = experiment.read_phase_record(round_index)
@@ -188,14 +168,10 @@ def _load_problems(folder: Path) -> list[str]:
 def verify_experiment(
     experiment: ExperimentDir, added_defaults: Mapping[str, Any] | None = None, reading: bool = False
 ) -> tuple[int, int, list[str]]:
-    """Verifies every committed round and policy of an experiment.
+    """Verifies every committed round and policy; returns the rounds and policies verified and the problems.
 
-    ``added_defaults`` (``RunConfig.option_defaults``) fills options the run's config lacks, as a resume
-    does. ``reading=True`` (``check_before_reading``) skips loading the policies and takes the ledger as
-    a resume does.
-
-    Returns:
-        The numbers of rounds and of policies verified, and every problem found.
+    ``added_defaults`` (``RunConfig.option_defaults``) fills options the run's config lacks.
+    ``reading=True`` skips loading the policies and takes the ledger as a resume does.
 
     Raises:
         NotAnExperimentError: If the folder is missing or holds no experiment.
@@ -254,15 +230,8 @@ def check_before_reading(
 ) -> list[str]:
     """What every reader (``merge``, ``report``, ``push``, ``eval``, ``shift``, ``plan``) checks first.
 
-    The experiment is verified as ``verify`` does, without loading its policies.
-
-    Args:
-        experiment: The experiment to read.
-        unverified: Read it even if it fails (``--unverified=true``), with a logged warning.
-        added_defaults: ``RunConfig.option_defaults``, as ``verify`` passes it.
-
-    Returns:
-        The problems read past (empty unless ``unverified``), for the reader's output to name.
+    The experiment is verified as ``verify`` does, without loading its policies; with ``unverified``
+    (``--unverified=true``) a failure is logged and its problems returned for the output to name.
 
     Raises:
         NotAnExperimentError: If the folder holds no experiment.
@@ -280,11 +249,7 @@ def check_before_reading(
 
 
 def _refused_or_read(what: str, problems: list[str], fix: str, unverified: bool) -> list[str]:
-    """Refuses ``problems`` in one line, or with ``unverified`` logs a warning and returns them.
-
-    Raises:
-        CorruptExperimentError: If there is a problem and ``unverified`` is false.
-    """
+    """Refuses ``problems`` in one line, or with ``unverified`` logs a warning and returns them."""
     if not problems:
         return []
     shown = "; ".join(problems[:SHOWN_PROBLEMS])
@@ -311,15 +276,9 @@ def check_policy_folder(
 ) -> list[str]:
     """What ``eval``, ``shift`` and ``plan`` check of a policy folder before loading it, wherever it lives.
 
-    A folder of an experiment: the experiment, as ``check_before_reading``. Any other folder: its files
-    against the checksums its ``training.json`` carries (files added beside them, such as a Hub
-    download's ``.gitattributes``, left out); one without checksums is read, with an info line.
-
-    Returns:
-        The problems read past (empty unless ``unverified``).
-
-    Raises:
-        CorruptExperimentError: In one line naming the changed files and the fix.
+    A folder of an experiment: the experiment. Another: its files against its ``training.json``'s
+    checksums (files a Hub download adds are left out), or an info line without them. With
+    ``unverified`` the problems are returned, else raised (``CorruptExperimentError``).
     """
     folder = Path(folder)
     experiment = experiment_of(folder)
@@ -337,11 +296,7 @@ def check_policy_folder(
 
 
 def carried_checksums(folder: Path) -> dict[str, str] | None:
-    """The checksums a policy folder's ``training.json`` carries (None: none).
-
-    Raises:
-        CorruptExperimentError: If ``training.json`` is there but unreadable.
-    """
+    """The checksums a policy folder's ``training.json`` carries (None: none; unreadable: raises)."""
     path = Path(folder) / TRAINING_FILE
     if not path.is_file():
         return None
