@@ -9,10 +9,8 @@ options, in its own folder::
         compare.json              what was asked (methods, seeds, budgets, run options)
         results.csv, results.json one row per run x evaluated round (``results.py``)
 
-BC's default budgets are DAgger's cumulative demos per task after each round, BC at round k's budget
-being ``run --mode=bc --dagger.rounds=k``. A finished run is skipped and a cut-off one resumed, so
-``compare`` itself resumes; asked again with more ``--dagger.rounds`` it extends the DAgger runs and
-adds BC at the new budgets.
+Finished runs are skipped and cut-off ones resumed; with more ``--dagger.rounds`` the DAgger runs
+are extended and BC added at the new budgets.
 """
 
 from __future__ import annotations
@@ -53,11 +51,9 @@ class CompareConfig:
         launcher: ``local`` (each run a process on this machine) or ``ray`` (each run a Ray task).
         ray_address: The Ray cluster of ``launcher=ray`` (``auto``, ``ray://host:10001``; None: a local Ray).
         ray_cpus_per_run: CPUs each run holds with ``launcher=ray`` (its threads and env workers).
-        ray_gpus_per_run: GPUs each run holds with ``launcher=ray`` (0: none; use with
-            ``--policy.device=cuda``).
-        share_round0: A DAgger run copies the round 0 and phase 0 a run of its seed, differing only in
-            the scheduler, committed before it started (they are the same to the bit); false: every run
-            makes its own.
+        ray_gpus_per_run: GPUs each run holds with ``launcher=ray`` (0: none; with ``--policy.device=cuda``).
+        share_round0: A DAgger run copies round 0 and phase 0 from a run of its seed that differs only in
+            the scheduler (they are the same to the bit); false: every run makes its own.
     """
 
     HELP_FOOTER: ClassVar[str] = (
@@ -151,11 +147,7 @@ def jobs_for(compare: CompareConfig, run_args: Sequence[str], num_tasks: int) ->
 
 
 def runs_not_started(compare_dir: Path) -> list[str]:
-    """The runs ``compare.json`` plans that have no folder under ``runs/`` yet (none without the file).
-
-    Raises:
-        UserError: If ``compare.json`` is not a compare plan.
-    """
+    """The runs ``compare.json`` plans without a folder under ``runs/`` (``UserError`` if not a plan)."""
     path = Path(compare_dir) / COMPARE_FILE
     if not path.is_file():
         return []
@@ -169,17 +161,12 @@ def runs_not_started(compare_dir: Path) -> list[str]:
 def run_resources(
     compare_config: CompareConfig, run_args: Sequence[str], environ: Mapping[str, str]
 ) -> tuple[int, int, int | None]:
-    """Runs at once, torch threads per run and env workers per run of a local ``compare``.
+    """Runs at once, torch threads and env workers per run of a local ``compare``.
 
     The cores (``--cores``, else those ``taskset`` allows) are split among the ``--jobs``, fewer threads
-    if ``OMP_NUM_THREADS`` says so: a run with more threads than cores trains many times slower. Env
-    workers match the threads (0 below 2) unless the run options set ``--rollout.workers``.
-
-    Returns:
-        ``(parallel, threads, workers)``; ``workers`` is None when the run options choose it.
-
-    Raises:
-        UserError: If ``OMP_NUM_THREADS`` is not a positive whole number.
+    if ``OMP_NUM_THREADS`` says so (a ``UserError`` if it is not a positive whole number): more threads
+    than cores train many times slower. Returns ``(parallel, threads, workers)``; workers match the
+    threads (0 below 2), None where the run options set ``--rollout.workers``.
     """
     cores = compare_config.cores or default_worker_count()
     parallel = compare_config.jobs or cores

@@ -55,11 +55,7 @@ def curves_from_rows(rows: Sequence[Mapping]) -> list[CurvePoint]:
 
 
 def average_runs(runs: Sequence[RunPoints]) -> list[CurvePoint]:
-    """Averages the runs of each method over seeds, round by round (mean and sample std).
-
-    Raises:
-        ValueError: If two runs of one method have the same seed, or no run has an evaluated point.
-    """
+    """Averages each method's runs over seeds, round by round (ValueError on a repeated seed or no point)."""
     grouped: dict[str, dict[int, list[tuple[int, float, float]]]] = defaultdict(dict)
     for method, seed, points in runs:
         if seed in grouped[method]:

@@ -63,10 +63,7 @@ def runs_by_method(rows: Sequence[Row]) -> dict[str, dict[int, list[Row]]]:
 
 
 def point_columns(seeds: dict[int, list[Row]]) -> list[list[Row]]:
-    """The seeds' rows grouped point by point: one column per (round, mean demos per task), in order.
-
-    A run still being written, or BC at fewer budgets for one seed, leaves its columns fewer seeds.
-    """
+    """The seeds' rows grouped by point (round, mean demos per task), in order."""
     columns: dict[tuple[int, float], list[Row]] = defaultdict(list)
     for curve in seeds.values():
         for row in curve:
@@ -84,10 +81,7 @@ def curve_points(seeds: dict[int, list[Row]], x_key: str, y_of=None) -> list[tup
 
 
 def seed_reach(curve: Sequence[Row], level: float, x_values) -> float | None:
-    """The demos, frames or seconds at which one seed's curve first reaches ``level``.
-
-    Interpolated where x increases along the curve, else the smallest x of the points that reach it.
-    """
+    """The demos, frames or seconds at which one seed's curve first reaches ``level`` (interpolated)."""
     xs = list(x_values(curve))
     success = [row["eval_success_mean"] for row in curve]
     if all(b > a for a, b in zip(xs, xs[1:], strict=False)):
@@ -143,10 +137,7 @@ def plot_success(
     y_key: str = "eval_success_mean",
     title: str | None = None,
 ) -> Path:
-    """Figure 1 (and 5 with ``methods``): success against demos or frames, one curve per method.
-
-    ``y_key="unseen_success_mean"`` draws the success on the unseen tasks instead.
-    """
+    """Figure 1 (and 5 with ``methods``): ``y_key`` against demos or frames, one curve per method."""
     rows = [row for row in rows if row.get(y_key) is not None]
     plt = _pyplot()
     figure, axis = plt.subplots(figsize=(7, 4.5))
@@ -251,10 +242,7 @@ def plot_metrics(rows: Sequence[Row], path: Path) -> tuple[Path, dict[str, float
 
 
 def hardest_tasks(rows: Sequence[Row], count: int = 2) -> list[int]:
-    """Task indices with the lowest BC success (``bc``, else any BC variant) at the largest budget.
-
-    Without BC runs: the lowest final success.
-    """
+    """Task indices with the lowest BC success at the largest budget (without BC: final success)."""
     names = bc_methods(rows)
     bc = [row for row in rows if names and row["method"] == names[0]]
     if bc:

@@ -29,8 +29,6 @@ class TaskPoint:
     """One measured point of one task's learning curve.
 
     Attributes:
-        task: Task index.
-        seed: Seed of the run that measured it.
         demos: Expert demonstrations of this task the policy was trained on.
         success: Evaluation success rate of the task, in [0, 1].
         episodes: Evaluation episodes behind ``success`` (its weight).
@@ -76,8 +74,8 @@ def fit_curves(points: Sequence[TaskPoint], task_names: Sequence[str]) -> Learni
     """Estimates every task's curve from measured points, on the integer demos every task covers.
 
     Raises:
-        UserError: If a task has no point or fewer than two measured budgets, a point is out of range,
-            or the tasks' measured ranges overlap in fewer than two demos.
+        UserError: If a task lacks two measured budgets, a point is out of range, or the tasks'
+            measured ranges overlap in fewer than two demos.
     """
     by_task = _points_by_task(points, len(task_names), task_names)
     knots, fitted = [], []
@@ -226,7 +224,6 @@ class Headroom:
     Attributes:
         even: Mean success of the even split; ``best``: of the best split; ``gain``: ``best - even``.
         demos_to_match: Demos per task the best split needs to match ``even`` (None: not in range).
-        split: Demos per task of the best split.
     """
 
     demos_per_task: int
@@ -286,7 +283,7 @@ class HeldOutHeadroom:
 def held_out_headroom(
     points: Sequence[TaskPoint], task_names: Sequence[str], budgets: Sequence[int]
 ) -> list[HeldOutHeadroom]:
-    """Leave-one-seed-out headroom at each even ``budgets`` (demos per task) every fold's curves cover.
+    """Leave-one-seed-out headroom at each of ``budgets`` (demos per task) that every fold covers.
 
     Raises:
         UserError: With fewer than two seeds, or as ``fit_curves`` for any fold.

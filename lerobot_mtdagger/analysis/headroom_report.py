@@ -39,11 +39,7 @@ READ_ME = (
 
 
 def headroom_summary(rows: Sequence[Row], task_names: Sequence[str]) -> dict[str, Any]:
-    """The headroom at every measured even budget, in sample and held out (with two or more seeds).
-
-    Raises:
-        UserError: As ``headroom.fit_curves`` when the rows cannot give a curve for every task.
-    """
+    """The headroom at every measured even budget, in sample and held out (raising as ``fit_curves``)."""
     source = BC_CURVES if any(is_bc(row) for row in rows) else ALL_CURVES
     points = points_from_rows(list(rows), source)
     curves = fit_curves(points, task_names)
@@ -132,10 +128,7 @@ def plot_headroom(summary: dict[str, Any], path: Path) -> Path:
 def write_headroom(
     rows: Sequence[Row], task_names: Sequence[str], folder: Path
 ) -> tuple[list[str], Path | None]:
-    """Writes ``headroom.json`` and ``headroom.png``; returns the report lines and the figure.
-
-    Rows that cannot give every task a curve give one line saying why instead.
-    """
+    """Writes ``headroom.json`` and ``headroom.png``; returns the report lines (or one saying why not)."""
     try:
         summary = headroom_summary(rows, task_names)
     except UserError as error:

@@ -1,9 +1,8 @@
 """Launchers of a ``compare`` grid: each planned run as a process on this machine, or as a Ray task.
 
-Both pools skip finished runs, resume cut-off ones, let one failed run stop none of the others, and
-on Ctrl-C start no further run and end the running ones. Several ``compare`` processes may share one
-folder: each skips the runs another has finished or is writing (their writer lock), and one that
-skipped a run being written ends with an error naming it, having written no table.
+Both skip finished runs, resume cut-off ones, let one failed run stop none of the others, and on
+Ctrl-C end the running ones. Several ``compare`` processes may share one folder: each skips the runs
+another has finished or is writing, and then ends with an error naming those, having written no table.
 """
 
 from __future__ import annotations
@@ -82,10 +81,7 @@ def is_finished(folder: Path, last_phase: int) -> bool:
 def job_command(
     job: Job, folder: Path, threads: int, workers: int | None
 ) -> tuple[list[str], dict[str, str]]:
-    """One job's ``lerobot-mtdagger run`` command (resumed if started) and its thread-count variables.
-
-    ``workers`` None leaves ``--rollout.workers`` to the job's own options.
-    """
+    """One job's ``run`` command (resumed if started) and thread variables (``workers`` None: the job's)."""
     from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE
 
     resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []
@@ -105,9 +101,7 @@ def run_arguments(job: Job, folder: Path, workers: int | None) -> list[str]:
 
 
 def start_from_shared_round_zero(job: Job, folder: Path, workers: int | None) -> None:
-    """Copies into a job not started yet the round 0 and phase 0 of a run beside it that made the same.
-
-    See ``analysis/round_zero.py``; the job then starts as a resume, at round 1.
+    """Copies into a job not started yet a shared round 0 and phase 0 (``analysis/round_zero.py``).
 
     Raises:
         UserError: On bad run options, or if another process started writing ``folder`` meanwhile.
@@ -205,10 +199,7 @@ class RunPool:
 
 
 def run_job_process(command: list[str], variables: dict[str, str], log_path: str) -> int:
-    """Runs one job's command to its end, output appended to ``log_path``; returns its exit code.
-
-    The body of a ``RayRunPool`` task: the run ends with this process, so a cancelled task leaves none.
-    """
+    """Runs one job's command, output appended to ``log_path``, ending with it; returns its exit code."""
     env = {**os.environ, **variables, PARENT_PID_ENV: str(os.getpid())}
     with open(log_path, "a") as log:
         process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env)
@@ -229,11 +220,8 @@ class RayRunPool:
         runs_dir: The compare folder's ``runs/``.
         cpus: CPUs per run (its torch threads and, from 2, its env workers).
         gpus: GPUs per run (0: none; a fraction shares one).
-        address: The Ray cluster (None: a local Ray on this machine).
+        address: The Ray cluster (None: a local Ray; ``UserError`` if there is none).
         share_round0: Start a DAgger run from a shared round 0 committed before this ``compare``.
-
-    Raises:
-        UserError: If Ray is missing or there is no cluster at ``address``.
     """
 
     def __init__(

@@ -48,10 +48,7 @@ def run_record_files(run: Path) -> dict[str, Path]:
 
 
 def save_runs(runs: Path, dest: Path) -> list[str]:
-    """Copies the records of every run under ``runs`` into ``dest/<run>/``, each replaced whole.
-
-    Returns:
-        The names of the runs saved.
+    """Copies the records of every run under ``runs`` into ``dest/<run>/``, each replaced whole; the names.
 
     Raises:
         UserError: If ``runs`` is not a folder of runs.
@@ -102,8 +99,7 @@ def compact_folder(folder: Path) -> Path:
     """Packs every subfolder of ``folder`` into ``folder/runs-records.tar.gz`` and removes them.
 
     Raises:
-        UserError: If the archive exists, or does not list every file of the subfolders (then nothing
-            is removed).
+        UserError: If the archive exists, or lacks a file of the subfolders (nothing is removed).
     """
     archive = folder / ARCHIVE_NAME
     if archive.exists():
@@ -142,9 +138,8 @@ def compact(root: Path) -> list[Path]:
 def save_compares(outputs: Path, dest: Path) -> list[str]:
     """Saves each compare folder under ``outputs`` into ``dest/<folder>/``; one line each on what was kept.
 
-    Archived runs ``outputs`` no longer holds stay; a run it holds replaces its archived records. Where
-    the archive then holds runs the folder did not run, its ``results.csv`` is not saved (``report
-    --records`` makes the table of every archived run).
+    Archived runs ``outputs`` no longer holds stay; where the archive then holds runs the folder did not
+    run, its ``results.csv`` is not saved (``report --records`` tabulates every archived run).
     """
     if not outputs.is_dir():
         raise UserError(f"records: {outputs} is not a folder: give a study's outputs folder (outputs/STUDY).")

@@ -79,12 +79,9 @@ class ReplaySetting:
 
 @dataclass(frozen=True)
 class ReplayCurves:
-    """Curves on every integer demos from ``initial_demos`` to the most a task can reach.
+    """Curves on every integer demos from ``low`` (column 0) to the most a task can reach.
 
-    Attributes:
-        low: Demos of column 0.
-        success: Success of task i at ``low + j`` demos, shape (num_tasks, width).
-        measured_high: The largest demos every curve was measured at (beyond: extrapolated).
+    ``success`` has shape (num_tasks, width); beyond ``measured_high`` demos it is extrapolated.
     """
 
     low: int
@@ -201,7 +198,6 @@ class ArmOutcome:
     Attributes:
         success: Expected mean success after each phase, shape (replicates, rounds + 1).
         demos: Demos per task after each phase, shape (replicates, rounds + 1, num_tasks).
-        seconds: Wall time of the arm.
     """
 
     label: str
@@ -281,8 +277,7 @@ def replay_uniform(curves: ReplayCurves, setting: ReplaySetting) -> ArmOutcome:
 def replay_static_oracle(curves: ReplayCurves, setting: ReplaySetting) -> ArmOutcome:
     """At each phase, the best split of all demos so far (the ceiling; not reachable round by round).
 
-    A task gets at most ``STATIC_ORACLE_SHARE`` times the last phase's even demos (with flat
-    extrapolation, none past its measured demos).
+    A task gets at most ``STATIC_ORACLE_SHARE`` times the last phase's even demos.
     """
     start = time.perf_counter()
     even_last = setting.initial_demos + setting.rounds * setting.budget_per_round / curves.num_tasks
@@ -327,7 +322,6 @@ class ArmSummary:
         share: ``(mean, low, high)`` share of the online oracle's headroom (bootstrap 95%).
         replicate_sd: SD over replicates of arm - uniform, evaluation noise included (no training noise).
         demos_to_reach: Demos per task at which the mean success first reaches each level (None: never).
-        seconds: Wall time of the arm.
     """
 
     label: str
@@ -392,11 +386,7 @@ def _share_of_headroom(
 
 
 def _evaluation_noise_sd(outcome: ArmOutcome, uniform: ArmOutcome, curves, setting: ReplaySetting) -> float:
-    """SD of the difference of two arms' measured (not expected) mean success over the budgets.
-
-    Evaluations are binomial, independent across phases and arms; the arm's mean demos stand for its
-    replicates (0 for the static oracle).
-    """
+    """SD of the difference of two arms' measured (binomial) mean success over the budgets."""
     variance = 0.0
     for arm in (outcome, uniform):
         if np.isnan(arm.demos).any():

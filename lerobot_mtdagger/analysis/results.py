@@ -1,10 +1,8 @@
 """The results table of a set of experiments: one row per experiment and committed training phase.
 
-A row describes the policy trained on rounds 0..k of one run: method and seed, the expert data
-behind it (cumulative demos and expert-labelled frames per task), its evaluation success, the
-scheduler's signals and the round's wall time. ``read_results`` and ``merge_tables`` read saved tables
-back, so a report can be drawn when the run folders are gone; ``curves``, ``figures`` and ``summary``
-work from the rows::
+A row describes the policy trained on rounds 0..k of one run: method and seed, the cumulative expert
+demos and labelled frames per task, its evaluation success, the scheduler's signals and the round's
+wall time. Saved tables read back (``read_results``, ``merge_tables``) when the runs are gone::
 
     <folder>/
         results.csv         one row per run x evaluated phase, list columns as JSON
@@ -68,12 +66,9 @@ def round_frames_per_task(root: Path, num_tasks: int) -> list[int]:
 
 
 def experiment_rows(root: Path, label: str | None = None) -> list[dict[str, Any]]:
-    """The rows of one experiment, one per committed training phase with an evaluation.
+    """One row per evaluated phase of the experiment at ``root`` (ValueError if it has no round).
 
     ``label`` is the rows' method name (default: the run's method, ``bc`` for BC).
-
-    Raises:
-        ValueError: If ``root`` is not an experiment with committed rounds.
     """
     experiment = open_run(root)
     rounds = experiment.committed_rounds()
@@ -166,21 +161,15 @@ def write_results(
     unfinished: Sequence[str] = (),
     verification: Sequence[str] = (),
 ) -> tuple[Path, Path]:
-    """Writes ``results.csv``, ``results.json`` and ``results_meta.json`` into ``folder``.
+    """Writes ``results.csv``, ``results.json``, ``results_meta.json`` into ``folder``; returns the first two.
 
     Args:
-        rows: The rows (``results_rows``).
+        rows: The rows (``results_rows``); a ``UserError`` without one.
         folder: Where they go (made if missing).
         task_names: The suite's task names in task-index order (the per-task columns' order).
         configs: The config each method's runs share (``check_comparable``).
         unfinished: One line per unfinished run of a study in progress (``RunProgress.describe``).
         verification: One line per run left out for failing verification, or read unverified.
-
-    Returns:
-        The paths of ``results.csv`` and ``results.json``.
-
-    Raises:
-        UserError: If there is no row.
     """
     if not rows:
         raise UserError("No evaluated training phase in these experiments: nothing to tabulate.")
@@ -205,7 +194,6 @@ class SavedTable:
     """A results table read back from disk (``read_results``) or joined from several (``merge_tables``).
 
     Attributes:
-        rows: One row per run and evaluated phase.
         task_names: The task of each per-task column, in task-index order.
         unfinished: One line per run that was unfinished when the table was written.
         configs: The config each method's runs share (None: not saved with the table).
@@ -222,11 +210,7 @@ class SavedTable:
 
 
 def read_results(path: Path) -> SavedTable:
-    """Reads a saved ``results.json`` (or the folder holding it with its ``results_meta.json``).
-
-    Raises:
-        UserError: If a file is missing or is not what ``write_results`` writes, naming it and the fix.
-    """
+    """Reads a saved ``results.json`` or its folder (``UserError`` naming a missing or foreign file)."""
     path = Path(path)
     json_path = path / RESULTS_FILE if path.is_dir() else path
     meta_path = json_path.parent / META_FILE
@@ -264,11 +248,10 @@ def read_results(path: Path) -> SavedTable:
 
 
 def merge_tables(tables: Sequence[SavedTable]) -> SavedTable:
-    """Joins tables made apart (other seeds, other machines) into one, refusing what would mislead.
+    """Joins tables made apart (other seeds, other machines), refusing what would mislead (``UserError``).
 
-    Raises:
-        UserError: If the tables name different tasks, lack or differ in a method's config, or two
-            hold the same point (method, seed, demos per task, round), which the mean would count twice.
+    Refused: different tasks, a method's config lacking or differing, and a point (method, seed, demos
+    per task, round) in two tables, which the mean would count twice.
     """
     if len(tables) == 1:
         return tables[0]
@@ -406,8 +389,8 @@ def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = N
     """Groups experiments by method (or ``labels``) and averages their curves over seeds, round by round.
 
     Raises:
-        ValueError: If two runs of one method used the same seed, their configs differ in more than the
-            seed (``check_comparable``), or no run has an evaluated phase.
+        ValueError: On a repeated seed of one method, configs that differ beyond the seed, or no
+            evaluated phase.
     """
     labels = labels or {}
     check_comparable(roots, labels)
@@ -415,15 +398,10 @@ def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = N
 
 
 def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> dict[str, dict]:
-    """Refuses to group runs of one method (or label) whose configs differ beyond ``PER_RUN_FIELDS``.
+    """The options each method's runs share, refusing runs that differ beyond ``PER_RUN_FIELDS``.
 
-    BC runs may also differ in ``BC_BUDGET_FIELDS``.
-
-    Returns:
-        The options each method's runs share (by dotted path, without those fields), by method name.
-
-    Raises:
-        ValueError: Naming the method, the differing fields with their values and two such runs.
+    BC runs may also differ in ``BC_BUDGET_FIELDS``; a ``labels`` entry groups a run under its label.
+    The ValueError names the method, the differing fields with their values and two such runs.
     """
     first_of_method: dict[str, tuple[Path, dict]] = {}
     for root in roots:

@@ -1,14 +1,11 @@
 """Round 0 shared between the DAgger methods of one seed: ``compare`` copies it instead of redoing it.
 
-Round 0 (the initial expert demonstrations) and phase 0 (the first policy) come before the scheduler
-acts, and every random draw derives from the seed and the round; so DAgger runs whose options differ
-only in the scheduler, ``--dagger.rounds`` or result-neutral options make the same round 0 and phase
-0, to the bit. Before ``compare`` starts another method of a seed, it copies them from a run that has
-committed them, and the new run resumes at round 1 (``--share_round0=false``: each makes its own).
-
-The copy is a run of its own: its ``config.json``, round-0 record (naming the source in its notes)
-and ledger are its own; the round's data, the policy and the phase's training record are the
-source's files, hard-linked where possible, else copied.
+Round 0 and phase 0 come before the scheduler acts, and every random draw derives from the seed and
+the round; so DAgger runs differing only in the scheduler, ``--dagger.rounds`` or result-neutral
+options make them the same, to the bit. A run started beside one that has committed them copies
+them and resumes at round 1 (``--share_round0=false``: each makes its own). The copy's config,
+round-0 record (naming its source) and ledger are its own; the data, policy and training record are
+the source's files, hard-linked where possible.
 """
 
 from __future__ import annotations
@@ -90,7 +87,7 @@ def link_or_copy(source: str, destination: str) -> None:
 def copy_round_zero(source: Path, target: Path, config: RunConfig) -> None:
     """Makes ``target`` a new experiment of ``config`` holding ``source``'s round 0 and phase 0.
 
-    Each is committed as a run commits it, so a copy cut off half-way leaves a run that resumes.
+    Each is committed as a run commits it (a copy cut off half-way leaves a run that resumes).
 
     Raises:
         UserError: If ``target`` exists and is not empty, or another process is writing it.
@@ -131,12 +128,8 @@ def own_round_zero_record(origin: ExperimentDir, config: RunConfig, source_name:
 def share_round_zero(folder: Path, run_args: Sequence[str]) -> Path | None:
     """Gives a run not started yet the round 0 and phase 0 of a run beside it that made the same ones.
 
-    Args:
-        folder: The run's folder (its siblings are the other runs of the compare).
-        run_args: The run's ``lerobot-mtdagger run`` options, ``--output_dir`` included.
-
-    Returns:
-        The run it was copied from, or None (a run already started, a BC run, or no such run yet).
+    ``folder`` is the run's folder, ``run_args`` its ``run`` options (``--output_dir`` included).
+    Returns the source run, or None (already started, a BC run, or no source yet).
 
     Raises:
         UserError: On bad run options, or if another process started writing ``folder`` meanwhile.

@@ -1,12 +1,10 @@
 """Covariate shift of a policy: its action error on the states it reaches against on the expert's states.
 
-``measure_shift`` runs, on the evaluation reset seeds, the policy's own rollouts with the expert
-labelling every state, and the expert's rollouts from the same seeds; the squared action error
-``|clip(pi(s)) - pi*(s)|^2`` per frame on each gives, per task, the covariate shift factor own /
-expert. Near 1 the policy meets no state it has not learnt to act in (relabelled rollouts add little
-over more demonstrations); well above 1 its own states are where it goes wrong. Actions are clipped
-to the action space as the env clips them, since a policy thrown far off its data may output any
-size. Episodes end at the first success, as in evaluation.
+``measure_shift`` runs, on the evaluation reset seeds, the policy with the expert labelling every
+state, and the expert from the same seeds; the mean squared action error ``|clip(pi(s)) - pi*(s)|^2``
+per frame gives, per task, the shift factor own / expert. Near 1 relabelled rollouts add little over
+more demonstrations; well above 1 the policy's own states are where it goes wrong. Actions are
+clipped as the env clips them; episodes end at the first success, as in evaluation.
 """
 
 from __future__ import annotations
@@ -31,14 +29,10 @@ class ShiftResult:
 
     Attributes:
         success: The policy's success rate per task on the measured episodes.
-        own_error: Error on the policy's own states.
-        own_error_succeeded: The same on its successful episodes only (None: none succeeded).
+        own_error_succeeded: ``own_error`` on its successful episodes only (None: none succeeded).
         own_error_failed: The same on its failed episodes only (None: none failed).
-        expert_error: Error on the expert's states.
         own_error_by_dimension: ``own_error`` per action dimension (it sums to ``own_error``).
-        expert_error_by_dimension: ``expert_error`` per action dimension.
         episodes: Episodes per task, of the policy and of the expert each.
-        seed: Seed of the evaluation episodes.
     """
 
     task_names: list[str]

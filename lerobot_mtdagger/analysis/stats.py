@@ -69,9 +69,7 @@ def paired_difference(
 
 
 def demos_to_reach(demos: Sequence[float], success: Sequence[float], level: float) -> float | None:
-    """Expert demos at which one seed's curve first reaches ``level``, linearly interpolated.
-
-    ``demos[0]`` if the first point reaches it; None if the curve never does.
+    """Expert demos at which one seed's curve first reaches ``level``, linearly interpolated (None: never).
 
     Raises:
         ValueError: On sequences of different lengths or demos that do not increase.

@@ -312,15 +312,12 @@ def write_report(
     """Writes every figure and ``report.md`` into ``folder``; returns the markdown path.
 
     Args:
-        rows: The results rows (``results.results_rows``).
+        rows: The results rows (``results.results_rows``); a ValueError without one.
         task_names: The suite's task names, in task-index order.
         folder: Where the figures and ``report.md`` go.
         levels: Success levels of the reach tables and figures.
         unfinished: One line per unfinished run; the report then says it is interim and lists them.
         verification: One line per run left out for failing verification or read unverified.
-
-    Raises:
-        ValueError: If there is no row.
     """
     if not rows:
         raise UserError("No evaluated round in these experiments: nothing to report.")
