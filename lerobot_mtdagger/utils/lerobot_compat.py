@@ -65,11 +65,7 @@ def unsaved_frames(dataset: Any) -> int:
 
 
 def episode_data_writer(dataset: Any) -> Any:
-    """The object whose ``_save_episode_data`` LeRobot's ``save_episode`` calls for ``dataset``.
-
-    LeRobot 0.4: the dataset itself (its ``writer`` is a ``ParquetWriter`` or None); from 0.5.1 its
-    episode writer (``writer``, kept as ``_writer``).
-    """
+    """The object whose ``_save_episode_data`` LeRobot's ``save_episode`` calls (0.4: the dataset itself)."""
     for name in ("writer", "_writer"):
         writer = getattr(dataset, name, None)
         if writer is not None and hasattr(writer, "_save_episode_data"):

@@ -18,14 +18,10 @@ PARENT_POLL_S = 0.5
 
 
 def follow_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread | None:
-    """Ends this process (SIGTERM) once the ``compare`` that started it has ended.
+    """Ends this process (SIGTERM) once the ``compare`` that started it has ended, as a killed run ends.
 
-    Without it, runs of a killed ``compare`` would go on writing into folders that a new ``compare``
-    resumes. The run ends as a killed run does (committed rounds and phases stay). Does nothing when
-    ``PARENT_PID_ENV`` is not set.
-
-    Returns:
-        The daemon thread that watches the parent, or None when there is no parent to follow.
+    Else a killed ``compare``'s runs would write on into folders a new ``compare`` resumes. Returns the
+    watching daemon thread, or None without ``PARENT_PID_ENV`` (a run started by hand).
     """
     expected = os.environ.get(PARENT_PID_ENV)
     if not expected:

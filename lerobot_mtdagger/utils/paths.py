@@ -25,11 +25,7 @@ def _writable(folder: Path) -> bool:
 
 
 def check_output_dir(path: Path | str, option: str) -> None:
-    """Refuses a folder that cannot be created or written (a file, or under a file or a read-only folder).
-
-    Raises:
-        ValueError: Naming ``option``, the path and the fix.
-    """
+    """Refuses a folder that cannot be created or written, with a ValueError naming ``option`` and the fix."""
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise ValueError(f"{option}={path} is a file: give a folder path.")
@@ -37,11 +33,7 @@ def check_output_dir(path: Path | str, option: str) -> None:
 
 
 def check_output_file(path: Path | str, option: str) -> None:
-    """Refuses a file path that cannot be written (a folder, or under a file or a read-only folder).
-
-    Raises:
-        ValueError: Naming ``option``, the path and the fix.
-    """
+    """Refuses a file path that cannot be written, with a ValueError naming ``option`` and the fix."""
     path = Path(path)
     if path.is_dir():
         raise ValueError(f"{option}={path} is a folder: give a file path.")

@@ -1,19 +1,15 @@
 """Silencing the third-party console noise of LeRobot calls, narrowly and only around our calls.
 
-While :func:`quiet_third_party` is active (the user's logging configuration, progress-bar setting and
-warning filters are restored on exit):
+While :func:`quiet_third_party` is active (all restored on exit):
 
-- the ``datasets`` "Map" progress bars of ``save_episode`` are disabled and put back to their previous
-  state (LeRobot's ``SuppressProgressBars`` re-enables them after every load, so a global switch at
-  start-up does not hold);
+- the ``datasets`` "Map" progress bars of ``save_episode`` are disabled (LeRobot's
+  ``SuppressProgressBars`` re-enables them after every load, so a switch at start-up does not hold);
 - LeRobot's "Using video codec" line and ``aggregate_datasets``' step messages are dropped by a
-  :class:`logging.Filter` on the root logger (LeRobot 0.4) and on the named loggers (0.6), so nothing
-  else reaching the same handlers is affected;
+  :class:`logging.Filter` on the root logger (LeRobot 0.4) and on the named loggers (0.6);
 - PyOpenGL's "No OpenGL_accelerate module loaded" INFO line: its logger is raised to WARNING;
-- numpy's "Converting input from bool" ``RuntimeWarning`` from LeRobot 0.4's ``compute_stats`` on our
-  bool ``learner_acted`` feature is ignored by message, category and module;
-- the "Loading weights from local directory" print of ``from_pretrained`` is dropped from
-  ``sys.stdout`` by a proxy that passes everything else through.
+- numpy's "Converting input from bool" ``RuntimeWarning`` (LeRobot 0.4's statistics of our bool
+  ``learner_acted``) is ignored by message, category and module;
+- the "Loading weights from local directory" print of ``from_pretrained`` is dropped from stdout.
 
 Example::
 
@@ -179,12 +175,7 @@ def root_messages_filtered(
     messages: Mapping[str, Iterable[str]] = ROOT_MESSAGES,
     named: Mapping[str, Iterable[str]] = NAMED_MESSAGES,
 ) -> Iterator[RootMessageFilter]:
-    """Drops matching LeRobot records while active, on the root logger and on the named loggers.
-
-    Args:
-        messages: Root-logger message starts by module (LeRobot 0.4).
-        named: Message starts by logger name (LeRobot 0.6).
-    """
+    """Drops LeRobot records while active: root ``messages`` by module, ``named`` by logger name."""
     root = logging.getLogger()
     message_filter = RootMessageFilter(messages)
     root.addFilter(message_filter)

@@ -28,11 +28,7 @@ def import_ray() -> ModuleType:
 
 
 def check_ray_address(address: str | None, option: str) -> None:
-    """Refuses a ``ray://`` address without the Ray Client's grpcio now (Ray would fail only on connecting).
-
-    Raises:
-        UserError: Naming the option and both fixes.
-    """
+    """Refuses a ``ray://`` address without the Ray Client's grpcio now, not on connecting."""
     if address is None or not address.startswith("ray://"):
         return
     if importlib.util.find_spec("grpc") is None:
@@ -43,9 +39,7 @@ def check_ray_address(address: str | None, option: str) -> None:
 
 
 def connect(address: str | None) -> ModuleType:
-    """The ``ray`` module, connected to ``address`` (None: a local Ray on this machine's cores).
-
-    ``auto`` joins the cluster ``ray start`` left on this machine; ``ray://host:10001`` a Ray client.
+    """The ``ray`` module, connected to ``address`` (``auto``, ``ray://host:10001``; None: a local Ray).
 
     Raises:
         UserError: If Ray is missing, or there is no cluster at ``address``.
