@@ -30,7 +30,7 @@ ArrayLike = Sequence[float] | np.ndarray
 
 
 def _as_vector(values: ArrayLike, name: str, num_tasks: int | None = None) -> np.ndarray:
-    """``values`` as a new non-empty 1-D float64 array, ``num_tasks`` long (ValueError naming ``name``)."""
+    """``values`` as a new non-empty 1-D float64 array, ``num_tasks`` long if given (else ValueError)."""
     array = np.array(values, dtype=np.float64, copy=True)
     if array.ndim != 1:
         raise ValueError(f"{name} must be a 1-D sequence with one value per task, got shape {array.shape}.")

@@ -48,7 +48,7 @@ def run_record_files(run: Path) -> dict[str, Path]:
 
 
 def save_runs(runs: Path, dest: Path) -> list[str]:
-    """Copies the records of every run under ``runs`` into ``dest/<run>/``, each replaced whole; the names.
+    """Copies the records of every run under ``runs`` into ``dest/<run>/`` (each replaced whole); their names.
 
     Raises:
         UserError: If ``runs`` is not a folder of runs.
@@ -127,7 +127,7 @@ def _holds_runs(folder: Path) -> bool:
 
 
 def compact(root: Path) -> list[Path]:
-    """Compacts a study's records (``root`` if it holds runs, else each subfolder that does); the archives."""
+    """Archives a study's records: ``root`` if it holds runs, else each subfolder that does (the archives)."""
     if not root.is_dir():
         raise UserError(f"records: {root} is not a folder: give a study's records folder.")
     if _holds_runs(root):

@@ -61,7 +61,7 @@ def round_zero_differences(source: Mapping[str, Any], target: Mapping[str, Any])
 
 
 def round_zero_source(runs_dir: Path, config: RunConfig, exclude: Path) -> Path | None:
-    """The first run under ``runs_dir`` but ``exclude`` with the round 0 and phase 0 ``config`` would make."""
+    """The first run under ``runs_dir`` but ``exclude`` that committed ``config``'s round 0 and phase 0."""
     target = config.to_dict()
     for folder in sorted(path for path in Path(runs_dir).iterdir() if path.is_dir() and path != exclude):
         experiment = ExperimentDir(folder)

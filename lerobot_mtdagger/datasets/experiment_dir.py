@@ -91,7 +91,9 @@ class ExperimentLockedError(UserError):
 DATASET_FPS = 80
 
 VIDEO_BACKEND = "pyav"
-"""The decoder named when a round (no video) is created: LeRobot >= 0.5 then probes no torchcodec."""
+"""The decoder named when a round is created: rounds hold no video, and naming one keeps LeRobot >= 0.5
+from probing torchcodec (a warning per dataset where FFmpeg's libraries are absent).
+"""
 
 
 def writer_lock_holder(root: Path) -> str | None:
@@ -147,7 +149,10 @@ def read_committed_json(path: Path, fix: str) -> Any:
 
 
 def fill_added_options(stored: dict[str, Any], given: Mapping[str, Any], added: Mapping[str, Any]) -> None:
-    """Gives ``stored`` each option of ``added`` it lacks where ``given`` holds that former value."""
+    """Gives ``stored`` each option of ``added`` it lacks where ``given`` holds that option's former value.
+
+    ``added`` maps an option's dotted path to its value before the option existed.
+    """
     for key, default in added.items():
         if key in given and key not in stored and given[key] == default:
             stored[key] = default
@@ -563,7 +568,7 @@ class ExperimentDir:
         Ledger(self.root).append(self.committed_record_files(), write_json_atomic)
 
     def ledger_problems(self, resuming: bool = False) -> list[str]:
-        """Records that differ from the ledger (``resuming``: but what a resume mends)."""
+        """Records that differ from the ledger, less what a resume mends when ``resuming``."""
         records = self.committed_record_files()
         ledger = Ledger(self.root)
         if not ledger.exists():

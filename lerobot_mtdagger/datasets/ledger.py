@@ -83,7 +83,10 @@ class Ledger:
             write(self.path, {"entries": entries})
 
     def problems(self, records: Sequence[Path], deleted_tail_ok: bool = False) -> list[str]:
-        """What differs between the records and the ledger (``deleted_tail_ok``: bar deleted last ones)."""
+        """What differs between the committed records and the ledger (nothing without a ledger).
+
+        ``deleted_tail_ok`` accepts entries at the end whose records were deleted for a resume to redo.
+        """
         if not self.exists():
             return []
         try:

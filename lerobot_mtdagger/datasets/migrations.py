@@ -26,7 +26,8 @@ class Migration:
         summary: What changed, in one sentence.
         rewrite: Turns a config stored before the change into the newer layout (a copy), or None.
         former_values: Options the change added, by dotted path, and the value runs made before had.
-        resume_hint: A ``resume_hint`` function: how to resume a run made before the change, or ``""``.
+        resume_hint: ``hint(stored_config, differing, stored_options)`` as for ``resume_hint``: how to
+            resume a run made before the change, or ``""`` when the change does not explain ``differing``.
     """
 
     name: str

@@ -296,7 +296,7 @@ def check_policy_folder(
 
 
 def carried_checksums(folder: Path) -> dict[str, str] | None:
-    """The checksums a policy folder's ``training.json`` carries (None: none; unreadable: raises)."""
+    """The checksums a policy folder's ``training.json`` carries (None: none; raises if it is unreadable)."""
     path = Path(folder) / TRAINING_FILE
     if not path.is_file():
         return None

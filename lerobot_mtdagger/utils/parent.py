@@ -20,8 +20,8 @@ PARENT_POLL_S = 0.5
 def follow_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread | None:
     """Ends this process (SIGTERM) once the ``compare`` that started it has ended, as a killed run ends.
 
-    Else a killed ``compare``'s runs would write on into folders a new ``compare`` resumes. Returns the
-    watching daemon thread, or None without ``PARENT_PID_ENV`` (a run started by hand).
+    Without it, a killed ``compare``'s runs would write on into folders a new ``compare`` resumes.
+    Returns the watching daemon thread, or None without ``PARENT_PID_ENV`` (a run started by hand).
     """
     expected = os.environ.get(PARENT_PID_ENV)
     if not expected:

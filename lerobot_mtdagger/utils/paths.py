@@ -16,7 +16,7 @@ def _nearest_existing(path: Path) -> Path:
 
 
 def _writable(folder: Path) -> bool:
-    """Whether a file can be created in ``folder``, by a real probe (root passes ``os.access`` anywhere)."""
+    """Whether a file can be created in ``folder``, probed for real (``os.access`` lies for root)."""
     try:
         with tempfile.TemporaryFile(dir=folder):
             return True
