@@ -1,18 +1,8 @@
 """Per-task learning curves fitted online, and the split that follows their expected gain per demo.
 
-The model of the learning-curve scheduler: task i's success after ``n`` expert demos is
-``sigmoid(a_i + b_i * log n)``. Each task's intercept and slope are shrunk toward the tasks' common
-ones (normal priors of scale ``prior_scale`` and ``task_slope_scale``; the common slope toward
-``slope_mean``, scale ``slope_scale``), so that the first rounds, where every task sits at the same
-demos, still give a curve. The fit is the penalised maximum of the binomial likelihood: damped Newton
-over ``2 * num_tasks + 2`` unknowns, each step solved in O(num_tasks).
-
-``greedy_split`` hands a budget out where the expected gain in success per demo is largest: every
-task first gets ``n_min``, then the demos go to the largest next gains of each task's least concave
-majorant (so a curve that is flat before it rises is valued by its best average rise). On concave
-curves this is the exact optimum of the mean success.
-
-Pure numpy.
+The model of the ``curve`` scheduler: task i's success after ``n`` expert demos is
+``sigmoid(a_i + b_i * log n)``, each task's intercept and slope shrunk toward the tasks' common ones
+so that the first rounds, where every task sits at the same demos, still give a curve. Pure numpy.
 """
 
 from __future__ import annotations
@@ -22,19 +12,18 @@ from dataclasses import dataclass
 import numpy as np
 
 NEWTON_STEPS = 25
-"""Newton iterations of the curve fit (it converges in under ten on every case tested)."""
+"""Newton iterations of the curve fit (at most; it stops when converged)."""
 
 
 @dataclass(frozen=True)
 class CurvePrior:
-    """The shrinkage of the curve fit.
+    """The shrinkage of the curve fit (standard deviations of normal priors).
 
     Attributes:
-        prior_scale: Standard deviation of a task's intercept around the common one (logits).
+        prior_scale: A task's intercept around the common one (logits).
         slope_mean: Prior mean of the tasks' common slope on log demos.
-        slope_scale: Prior standard deviation of that common slope.
-        task_slope_scale: Standard deviation of a task's slope around the common one (small: one
-            slope for all tasks).
+        slope_scale: That common slope's prior standard deviation.
+        task_slope_scale: A task's slope around the common one (small: one slope for all tasks).
     """
 
     prior_scale: float = 1.5
@@ -69,19 +58,16 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 def fit_logistic_curves(
     demos: np.ndarray, success: np.ndarray, episodes: np.ndarray, prior: CurvePrior
 ) -> FittedCurves:
-    """Fits the logistic curves, shrunk toward the tasks' common curve, to a history of measurements.
+    """Fits the shrunk logistic curves to a history of measurements (penalised maximum likelihood).
 
-    Unknowns: each task's intercept and slope, and the common intercept and slope they are shrunk
-    toward (``2 * num_tasks + 2``); damped Newton ascent of the penalised binomial log-likelihood.
+    Damped Newton ascent of the penalised binomial log-likelihood over each task's intercept and slope
+    and the common two (``2 * num_tasks + 2`` unknowns), each step in O(num_tasks).
 
     Args:
         demos: Expert demos per task behind each measurement, shape (rounds, num_tasks).
         success: Measured success rate, shape (rounds, num_tasks); ignored where ``episodes`` is 0.
         episodes: Episodes behind each rate, shape (rounds, num_tasks).
         prior: The shrinkage.
-
-    Returns:
-        The penalised maximum-likelihood curves.
     """
     demos, success, episodes = (np.asarray(a, dtype=np.float64) for a in (demos, success, episodes))
     data = _Data(
@@ -137,10 +123,9 @@ def _objective(theta: np.ndarray, data: _Data, prior: CurvePrior) -> float:
 
 
 def _newton_step(theta: np.ndarray, data: _Data, prior: CurvePrior) -> np.ndarray:
-    """The Newton step of the penalised log-likelihood at ``theta``, in O(num_tasks).
+    """The Newton step at ``theta``, in O(num_tasks) by the Schur complement of the two common parameters.
 
-    The negative Hessian is block-diagonal over tasks (each task's intercept and slope) bordered by
-    the two common parameters; the step solves it by the Schur complement of those two.
+    The negative Hessian is block-diagonal over tasks (intercept and slope) bordered by those two.
     """
     intercept, slope, common, common_slope = _split(theta)
     tau2, sigma2, slope2 = prior.prior_scale**2, prior.task_slope_scale**2, prior.slope_scale**2
@@ -185,14 +170,13 @@ def _newton_step(theta: np.ndarray, data: _Data, prior: CurvePrior) -> np.ndarra
 def greedy_split(curve: np.ndarray, budget: int, n_min: int) -> tuple[np.ndarray, np.ndarray]:
     """Splits ``budget`` demos where each task's curve rises most per demo.
 
-    Every task first gets ``n_min``; then the demos go, one by one, to the largest next gain per demo
-    of each task's least concave majorant (so a curve that is flat before it rises is valued by its
-    best average rise, not passed over). On concave curves this is the exact optimum of the mean
-    success; demos that no curve values any more are spread evenly.
+    Every task first gets ``n_min``; then the demos go, one by one, to the largest next gain per demo of
+    each task's least concave majorant (a curve flat before it rises is valued by its best average rise).
+    On concave curves this is the exact optimum of the mean success; demos no curve values any more are
+    spread evenly.
 
     Args:
-        curve: Success of task i after ``j`` more demos, shape (num_tasks, budget + 1); ``curve[:, 0]``
-            is each task's success now.
+        curve: Success of task i after ``j`` more demos, shape (num_tasks, budget + 1).
         budget: Demos to hand out (>= n_min * num_tasks).
         n_min: Demos every task gets first.
 
@@ -217,11 +201,7 @@ def greedy_split(curve: np.ndarray, budget: int, n_min: int) -> tuple[np.ndarray
 
 
 def _majorant_slopes(marginals: np.ndarray) -> np.ndarray:
-    """Each row's slopes of the least concave majorant of its cumulative sum (non-increasing rows).
-
-    The antitonic regression of the row's gains (``isotonic`` of the negated gains); rows already
-    non-increasing are returned as they are.
-    """
+    """Each row's slopes of the least concave majorant of its cumulative sum (antitonic fit of its gains)."""
     slopes = marginals.copy()
     ones = np.ones(marginals.shape[1])
     for row in np.flatnonzero(np.any(np.diff(marginals, axis=1) > 1e-15, axis=1)):
@@ -230,15 +210,7 @@ def _majorant_slopes(marginals: np.ndarray) -> np.ndarray:
 
 
 def isotonic(values: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """Weighted least-squares non-decreasing fit (pool adjacent violators).
-
-    Args:
-        values: Values in order of their abscissa, shape (K,).
-        weights: Positive weights, shape (K,).
-
-    Returns:
-        The fitted non-decreasing values, shape (K,).
-    """
+    """Weighted least-squares non-decreasing fit of ``values`` (shape (K,)) by pool adjacent violators."""
     blocks: list[list[float]] = []  # [weighted mean, weight, count]
     for value, weight in zip(values.tolist(), weights.tolist(), strict=True):
         blocks.append([value, weight, 1])

@@ -1,25 +1,11 @@
 """Performance-aware scheduling of expert demonstrations across tasks.
 
 Implements the paper's Method section "Performance-Aware Scheduling via Adaptive Filtering and
-Allocation", the appendix "Two important techniques of Performance-aware Scheduling" and the
-softmax allocation of "Implementation details":
-
-1. Measure, per task, the raw success rate of the previous round's DAgger rollouts (Task Need) or
-   the drop of the per-task imitation loss during the round's training (Performance Gain).
-2. Smooth the success rates with one scalar Kalman filter per task (``KalmanSuccessEstimator``):
-   predict ``P += Q``, then update with the adaptive measurement noise ``R = R0 / (n + 1)``.
-3. Rank-normalise the chosen metric to [0, 1] (``rank_normalize``).
-4. Turn the scores into a budget split with a temperature softmax, give every task at least
-   ``n_min`` episodes and repair the total to exactly the budget (``allocate``).
-
-Each method is one registered config class (``SchedulerConfig`` subclass, selected with
-``--scheduler.type``) that declares the measurements it needs and computes its metric from the
-scheduler's state; everything else (filtering, ranking, softmax, rounding, records) is shared.
-Every allocation returns an ``Allocation`` record with the measurements, the Kalman state, the
-metric, the scores and the probabilities it used; ``recompute_allocation`` rebuilds an allocation
-from such a record alone, through the same config class, so a stored round can be audited.
-
-This module is pure numpy (plus draccus for the command-line configs): no torch, no environment.
+Allocation", its appendix "Two important techniques of Performance-aware Scheduling" and the softmax
+allocation of "Implementation details": per task, a metric from the last round (Kalman-filtered
+success for Task Need, the imitation-loss drop for Performance Gain) is rank-normalised to [0, 1] and
+turned into a split of the budget by a temperature softmax with at least ``n_min`` episodes per task.
+Each method is one ``SchedulerConfig`` subclass (``--scheduler.type``); the rest is shared. Pure numpy.
 """
 
 from __future__ import annotations
@@ -44,19 +30,7 @@ ArrayLike = Sequence[float] | np.ndarray
 
 
 def _as_vector(values: ArrayLike, name: str, num_tasks: int | None = None) -> np.ndarray:
-    """Converts ``values`` to a 1-D float64 array, checking its length.
-
-    Args:
-        values: One value per task.
-        name: The argument's name, for error messages.
-        num_tasks: The required length, or None to only require a non-empty vector.
-
-    Returns:
-        A new float64 array of shape (num_tasks,).
-
-    Raises:
-        ValueError: If ``values`` is not 1-D, is empty, or has the wrong length.
-    """
+    """``values`` as a new non-empty 1-D float64 array, ``num_tasks`` long if given (else ValueError)."""
     array = np.array(values, dtype=np.float64, copy=True)
     if array.ndim != 1:
         raise ValueError(f"{name} must be a 1-D sequence with one value per task, got shape {array.shape}.")
@@ -101,36 +75,22 @@ def _require_positive(value: float, name: str) -> float:
 
 
 class KalmanSuccessEstimator:
-    """One scalar Kalman filter per task over the policy's success probability.
+    """One scalar Kalman filter per task over the policy's success probability ``p`` (variance ``P``).
 
-    The state is assumed constant between rounds. Each round:
+    Each round predicts ``P <- P + Q``; a task with ``n > 0`` rollouts of success rate ``s`` is then
+    updated with ``R = R0 / (n + 1)``, ``K = P / (P + R)``, ``p <- p + K (s - p)``, ``P <- (1 - K) P``.
 
-    - predict: ``P <- P + Q`` (``p`` unchanged);
-    - update, for each task with ``n > 0`` rollouts and measured success rate ``s``:
-      ``R = R0 / (n + 1)``, ``K = P / (P + R)``, ``p <- p + K (s - p)``, ``P <- (1 - K) P``.
-
-    A task with no rollouts this round has no measurement and is only predicted.
-
-    Attributes:
-        p: Estimated success probability per task, shape (num_tasks,).
-        P: Variance of the estimate per task, shape (num_tasks,).
+    Args:
+        num_tasks: Number of tasks (>= 1).
+        p0: Initial success estimate, in [0, 1].
+        P0: Initial variance (>= 0).
+        Q: Process noise added at every predict step (>= 0).
+        R0: Measurement noise scale (> 0).
     """
 
     def __init__(
         self, num_tasks: int, p0: float = 0.5, P0: float = 0.25, Q: float = 0.03, R0: float = 0.5
     ) -> None:
-        """Initialises every task at ``(p0, P0)``.
-
-        Args:
-            num_tasks: Number of tasks (>= 1).
-            p0: Initial success estimate, in [0, 1].
-            P0: Initial variance (>= 0).
-            Q: Process noise added at every predict step (>= 0).
-            R0: Measurement noise scale (> 0); a round with n rollouts has noise R0 / (n + 1).
-
-        Raises:
-            ValueError: On a bad hyperparameter.
-        """
         self.num_tasks = _require_integer(num_tasks, "num_tasks", 1)
         if not (math.isfinite(p0) and 0.0 <= p0 <= 1.0):
             raise ValueError(f"p0 must be a success probability in [0, 1], got {p0}.")
@@ -143,16 +103,11 @@ class KalmanSuccessEstimator:
         self.P = np.full(self.num_tasks, self.P0)
 
     def update(self, success_rate: ArrayLike, episodes: ArrayLike) -> None:
-        """Runs one predict and one update step per task.
+        """Runs one predict and one update step per task (ValueError on a bad measurement).
 
         Args:
-            success_rate: Measured success rate per task in [0, 1]; ignored (may be NaN) where
-                ``episodes`` is 0.
+            success_rate: Measured success rate per task in [0, 1] (ignored, may be NaN, at 0 episodes).
             episodes: Number of rollouts behind each measurement (integers >= 0).
-
-        Raises:
-            ValueError: On mismatched lengths, negative or fractional episode counts, or a
-                success rate that is NaN or outside [0, 1] for a task with rollouts.
         """
         rate, counts = check_measurements(success_rate, episodes, self.num_tasks)
         measured = counts > 0
@@ -167,11 +122,7 @@ class KalmanSuccessEstimator:
         return {"p": self.p.tolist(), "P": self.P.tolist()}
 
     def load_snapshot(self, snapshot: Mapping[str, Sequence[float]]) -> None:
-        """Restores an estimate written by ``snapshot``.
-
-        Raises:
-            ValueError: If the snapshot has the wrong length or non-finite values.
-        """
+        """Restores a ``snapshot`` (ValueError on a wrong length or non-finite values)."""
         p = _as_vector(snapshot["p"], "kalman p", self.num_tasks)
         P = _as_vector(snapshot["P"], "kalman P", self.num_tasks)
         _require_finite(p, "kalman p")
@@ -182,15 +133,7 @@ class KalmanSuccessEstimator:
 def check_measurements(
     success_rate: ArrayLike, episodes: ArrayLike, num_tasks: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Validates one round of per-task success measurements.
-
-    Args:
-        success_rate: Measured success rate per task; NaN is allowed only where episodes is 0.
-        episodes: Rollouts per task, integers >= 0.
-        num_tasks: The required length of both.
-
-    Returns:
-        ``(success_rate, episodes)`` as float64 arrays.
+    """``(success_rate, episodes)`` checked and as float64 arrays (NaN success only at 0 episodes).
 
     Raises:
         ValueError: With the offending task index and value.
@@ -218,19 +161,10 @@ def check_measurements(
 
 
 def rank_normalize(values: ArrayLike) -> np.ndarray:
-    """Rank-normalises a metric to [0, 1]: ``(rank - 1) / (N - 1)``.
+    """Rank-normalises a metric to [0, 1]: ``(rank - 1) / (N - 1)``, shape (N,).
 
-    Rank 1 is the lowest value; tied values share their average rank; a single task gets 0.
-    Costs O(N log N).
-
-    Args:
-        values: One finite metric value per task.
-
-    Returns:
-        The normalised scores, shape (N,).
-
-    Raises:
-        ValueError: If ``values`` is empty, not 1-D or holds a NaN or infinity.
+    Rank 1 is the lowest value; tied values share their average rank; a single task gets 0. Raises a
+    ValueError if ``values`` is empty, not 1-D or not finite.
     """
     array = _as_vector(values, "values")
     _require_finite(array, "values")
@@ -250,11 +184,7 @@ def rank_normalize(values: ArrayLike) -> np.ndarray:
 
 
 def softmax(scores: ArrayLike, temperature: float) -> np.ndarray:
-    """Returns ``exp(score / T) / sum(exp(score / T))``, computed stably.
-
-    Raises:
-        ValueError: If a score is not finite or ``temperature`` is not a finite number > 0.
-    """
+    """``exp(score / T) / sum(exp(score / T))``, computed stably (ValueError on a non-finite input)."""
     temperature = _require_positive(temperature, "temperature")
     array = _as_vector(scores, "scores")
     _require_finite(array, "scores")
@@ -264,34 +194,22 @@ def softmax(scores: ArrayLike, temperature: float) -> np.ndarray:
 
 
 def allocate(scores: ArrayLike, budget: int, temperature: float, n_min: int) -> np.ndarray:
-    """Splits ``budget`` episodes across tasks by ``softmax(scores / T)``.
+    """Splits ``budget`` episodes across tasks by ``softmax(scores / T)``, at least ``n_min`` each.
 
-    The paper writes ``n_i = max(n_min, rho_i * B)`` "with minor adjustments" so the total is about
-    B, and says the floor applies "for tasks with non-zero scores". We give EVERY task at least
-    ``n_min`` (a task at the lowest rank has score 0 and would otherwise be starved) and make the
-    total exactly B:
-
-    1. Water-filling: the lowest-probability tasks whose share would fall below ``n_min`` get
-       exactly ``n_min``; the rest of the budget is split among the others in proportion to their
-       probabilities. These floored tasks are always a prefix of the tasks sorted by probability.
-    2. Largest remainder: the others get the floor of their share, and the units left over go to
-       the largest fractional parts (ties: higher probability first, then lower task index).
-
-    Guarantees: integers >= n_min summing to ``budget``; a task with a higher score never gets
-    fewer episodes; where no floor binds, every task is within 1 of ``softmax * budget``.
-    Costs O(N log N).
+    Every task, including the lowest-ranked one (score 0), gets ``n_min``, by water-filling: the
+    lowest-probability tasks whose share would fall below ``n_min`` get exactly ``n_min``, the others
+    share the rest in proportion to their probability, and largest-remainder rounding makes the total
+    exactly ``budget``. A higher score never gets fewer episodes; where no floor binds, every task is
+    within 1 of ``softmax * budget``. ``docs/scheduler.md`` explains this reading of the paper.
 
     Args:
         scores: One finite priority score per task (higher = more episodes).
-        budget: Episodes to hand out this round, an integer >= n_min * num_tasks.
+        budget: Episodes to hand out, an integer >= n_min * num_tasks.
         temperature: Softmax temperature T > 0 (lower = sharper).
         n_min: Minimum episodes per task, an integer >= 0.
 
     Returns:
         Episodes per task, int64 array of shape (num_tasks,).
-
-    Raises:
-        ValueError: On a bad argument, or if the budget cannot give every task ``n_min``.
     """
     probability = softmax(scores, temperature)
     return allocate_probabilities(probability, budget, n_min, np.asarray(scores, dtype=np.float64))
@@ -300,21 +218,10 @@ def allocate(scores: ArrayLike, budget: int, temperature: float, n_min: int) -> 
 def allocate_probabilities(
     probability: np.ndarray, budget: int, n_min: int, scores: np.ndarray | None = None
 ) -> np.ndarray:
-    """Turns allocation probabilities into integer episode counts (see ``allocate``).
+    """Turns probabilities (shape (num_tasks,), summing to 1) into episode counts (see ``allocate``).
 
-    Args:
-        probability: Non-negative probabilities summing to 1, shape (num_tasks,).
-        budget: Episodes to hand out, an integer >= n_min * num_tasks.
-        n_min: Minimum episodes per task, an integer >= 0.
-        scores: The scores behind ``probability``; they break ties between probabilities that are
-            equal in floating point although their scores differ (tiny score gaps), so that a higher
-            score never gets fewer episodes. None: no tie-break beyond the task index.
-
-    Returns:
-        Episodes per task, int64 array of shape (num_tasks,).
-
-    Raises:
-        ValueError: On a bad budget or n_min.
+    ``scores`` break ties between probabilities equal in floating point, so a higher score never gets
+    fewer episodes; without them ties go to the lower task index.
     """
     budget = _require_integer(budget, "budget", 0)
     n_min = _require_integer(n_min, "n_min", 0)
@@ -344,19 +251,10 @@ def allocate_probabilities(
 
 
 def _num_floored_tasks(sorted_probability: np.ndarray, budget: int, n_min: int) -> int:
-    """Number of lowest-probability tasks pinned to ``n_min`` by water-filling.
+    """Number k in [0, N - 1] of lowest-probability tasks that water-filling pins to ``n_min``.
 
-    With the k lowest tasks pinned, the others share ``budget - k * n_min`` in proportion to their
-    probability. Pinning a task whose share is below ``n_min`` only shrinks the others' shares, so
-    the answer is the smallest k at which the lowest unpinned task's share reaches ``n_min``.
-
-    Args:
-        sorted_probability: Probabilities in ascending order, shape (N,).
-        budget: Total episodes (>= n_min * N).
-        n_min: Minimum per task.
-
-    Returns:
-        k in [0, N - 1].
+    Pinning a task whose share is below ``n_min`` only shrinks the others' shares, so k is the smallest
+    count at which the lowest unpinned task's share of ``budget - k * n_min`` reaches ``n_min``.
     """
     n = sorted_probability.size
     if n_min == 0:
@@ -426,11 +324,7 @@ class CurveHistory:
 
     @classmethod
     def from_dict(cls, record: Mapping[str, Any], num_tasks: int) -> CurveHistory:
-        """Reads ``to_dict`` output.
-
-        Raises:
-            ValueError: If the rows do not have one value per task.
-        """
+        """Reads ``to_dict`` output (ValueError unless every row has one value per task)."""
         arrays = []
         for key in ("demos", "success", "episodes"):
             rows = [[math.nan if v is None else float(v) for v in row] for row in record[key]]
@@ -477,10 +371,10 @@ class SchedulerState:
 class SchedulerConfig(draccus.ChoiceRegistry):
     """A scheduling method and its hyperparameters; select it with ``--scheduler.type=<method>``.
 
-    Each method is ONE subclass registered under its name. It declares the measurements its metric
-    needs (``measurements``, a subset of ``SUCCESS`` and ``GAIN``) and computes the metric from the
-    scheduler's state (``metric``; higher = more episodes). ``make_scheduler``, the runner and the
-    recomputation behind ``verify`` all go through that class, so adding a method is::
+    Each method is one registered subclass that declares the measurements its metric needs
+    (``measurements``, from ``SUCCESS``, ``GAIN``, ``DEMOS``) and computes the metric from the
+    scheduler's state (higher = more episodes). ``make_scheduler``, the runner and ``verify`` all go
+    through that class, so adding a method is::
 
         @SchedulerConfig.register_subclass("my_method")
         @dataclass
@@ -494,15 +388,13 @@ class SchedulerConfig(draccus.ChoiceRegistry):
 
     Attributes:
         temperature: Softmax temperature T > 0.
-        n_min: Minimum episodes per task per round; None: the run preset's (1 for MetaWorld, 5 for
-            the drawers), or ``DEFAULT_N_MIN`` outside a run.
+        n_min: Minimum episodes per task per round; None: the run preset's, or ``DEFAULT_N_MIN``.
         p0: Initial Kalman success estimate.
         P0: Initial Kalman variance.
         Q: Kalman process noise per round.
         R0: Kalman measurement noise scale; a round of n rollouts has noise R0 / (n + 1).
-        normalization: How the metric becomes softmax scores: ``rank`` (the paper's: ranks in [0, 1],
-            the same tilt whatever the spread of the tasks) or ``none`` (the metric itself, so a wider
-            spread of difficulty gives a wider split; the metric's units then set the tilt with T).
+        normalization: How the metric becomes softmax scores: ``rank`` (the paper's ranks in [0, 1]) or
+            ``none`` (the metric itself, so a wider spread of difficulty gives a wider split).
     """
 
     measurements: ClassVar[tuple[str, ...]] = ()
@@ -554,13 +446,7 @@ class SchedulerConfig(draccus.ChoiceRegistry):
         raise NotImplementedError(f"{type(self).__name__} must implement metric(state).")
 
     def split(self, state: SchedulerState, metric: np.ndarray, budget: int) -> tuple[np.ndarray, ...]:
-        """Scores, probabilities and episodes per task: normalised metric, softmax, ``allocate``.
-
-        A method that splits otherwise (for example by expected gain per demo) overrides this.
-
-        Returns:
-            ``(score, probability, counts)``, each of shape (num_tasks,).
-        """
+        """Scores, probabilities and episodes per task: the normalised metric, softmax, ``allocate``."""
         if self.normalization == "rank":
             score = rank_normalize(metric)
         else:
@@ -571,11 +457,7 @@ class SchedulerConfig(draccus.ChoiceRegistry):
         return score, probability, counts
 
     def hyperparameters(self) -> dict[str, Any]:
-        """The fields as a plain dict (``make_scheduler`` keyword arguments), n_min resolved.
-
-        ``normalization`` is left out at its default, so that the records of runs that never set it
-        read as before.
-        """
+        """The fields as ``make_scheduler`` arguments (n_min resolved; ``normalization`` only if not rank)."""
         values = {**dataclasses.asdict(self), "n_min": self.min_episodes}
         if values["normalization"] == "rank":
             del values["normalization"]
@@ -640,8 +522,7 @@ class GainSchedulerConfig(SchedulerConfig):
 class LearnabilitySchedulerConfig(SchedulerConfig):
     """Learnability ``p_hat (1 - p_hat)``: most episodes to tasks near even odds (curriculum baseline).
 
-    The score of prioritised level replay and of "learnability" curricula (Tzannetos et al. 2023):
-    a task already solved or not yet learnable at all gets little.
+    The score of prioritised level replay and "learnability" curricula (Tzannetos et al. 2023).
     """
 
     measurements: ClassVar[tuple[str, ...]] = (SUCCESS,)
@@ -656,12 +537,8 @@ class LearnabilitySchedulerConfig(SchedulerConfig):
 class CurveSchedulerConfig(SchedulerConfig):
     """Learning curves fitted online: the round's demos go where success is expected to rise most.
 
-    Each task's success against its own expert demos is fitted from every measurement so far
-    (``learning_curve.fit_logistic_curves``: a logistic in log demos, each task's intercept and slope
-    shrunk toward the tasks' common ones), then the budget is split greedily by expected gain in
-    success per demo (``learning_curve.greedy_split``) after ``n_min`` each. ``temperature`` and
-    ``normalization`` play no part. Needs the demos behind each measurement (``DEMOS``): before
-    the first measurement the split is even.
+    Fits each task's success against its demos (``learning_curve``), then splits the budget greedily
+    by expected gain per demo after ``n_min`` each; ``temperature`` and ``normalization`` play no part.
 
     Attributes:
         prior_scale: Scale of a task's intercept around the common one (logits, > 0).
@@ -686,10 +563,7 @@ class CurveSchedulerConfig(SchedulerConfig):
             raise ValueError(f"scheduler.slope_mean must be finite, got {self.slope_mean}.")
 
     def fitted(self, state: SchedulerState) -> FittedCurves | None:
-        """The curves fitted to the state's history (None before any measurement).
-
-        The last fit is kept: ``metric`` and ``split`` of one allocation fit once.
-        """
+        """The curves fitted to the state's history (None before any measurement); the last fit is cached."""
         if state.history is None or state.history.rounds == 0:
             return None
         history = state.history
@@ -734,11 +608,7 @@ def scheduling_methods() -> tuple[str, ...]:
 
 
 def scheduler_config_class(method: str) -> type[SchedulerConfig]:
-    """The registered config class of ``method``.
-
-    Raises:
-        ValueError: On an unknown method, naming the known ones (and the BC run mode for ``bc``).
-    """
+    """The registered config class of ``method`` (ValueError naming the known ones, and ``bc``'s run mode)."""
     known = scheduling_methods()
     if method == "bc":
         raise ValueError(
@@ -757,33 +627,21 @@ STATE_FORMAT_VERSION = 1
 class Allocation:
     """One allocation and everything it was computed from (JSON-ready through ``to_dict``).
 
-    List fields are aligned with the experiment's task order. Measurement fields are None when the
-    scheduler has not received that measurement yet (for example before the first policy rollouts).
+    Lists are in task order; a measurement is None until the scheduler has received it.
 
     Attributes:
-        method: Scheduling method.
-        budget: Episodes handed out.
-        temperature: Softmax temperature.
-        n_min: Minimum episodes per task.
         success_rate: Last measured raw success rate per task (NaN where a task had no rollouts).
         episodes: Rollouts behind ``success_rate``.
-        gain: Last performance gain per task.
-        raw_success: Latest raw success rate per task over all updates (``p0`` for a task never
-            measured); the ``need_raw`` metric is ``1 - raw_success``.
-        kalman_prior: Kalman state before the last success update ({"p", "P"}).
-        kalman_posterior: Kalman state after it (the state used by ``need``).
-        metric: The method's metric per task (need, gain, or zeros for uniform).
-        score: Rank-normalised metric.
-        probability: ``softmax(score / T)``.
-        episodes_per_task: The allocation.
-        kalman: Hyperparameters of the Kalman filter ({"p0", "P0", "Q", "R0"}).
+        raw_success: Latest raw success rate per task over all updates (``p0`` if never measured).
+        kalman_prior: Kalman state ``{"p", "P"}`` before the last success update.
+        kalman_posterior: Kalman state after it (the one ``need`` uses).
+        metric: The method's metric per task; ``score`` is it as softmax scores (ranks by default).
+        probability: ``softmax(score / T)``; ``episodes_per_task`` is the allocation.
+        kalman: The Kalman filter's hyperparameters ``{"p0", "P0", "Q", "R0"}``.
         notes: Human-readable remarks (for example "no rollouts measured yet: the prior decides").
         options: The method's hyperparameters beyond the shared ones (``SchedulerConfig.options``).
-        history: The learning-curve history (``CurveHistory.to_dict``) of a method that reads ``DEMOS``.
+        history: The learning-curve history of a method that reads ``DEMOS``.
         demos_so_far: Expert demos per task when the allocation was made (methods that read ``DEMOS``).
-
-    The last three are left out of ``to_dict`` when empty, so that records of methods without them
-    read as before.
     """
 
     method: str
@@ -818,11 +676,7 @@ class Allocation:
 
     @classmethod
     def from_dict(cls, record: Mapping[str, Any]) -> Allocation:
-        """Rebuilds an ``Allocation`` from ``to_dict`` output (extra keys are ignored).
-
-        Raises:
-            ValueError: If a required key is missing.
-        """
+        """Reads ``to_dict`` output (extra keys ignored; ValueError if a required key is missing)."""
         names = [f.name for f in dataclasses.fields(cls)]
         missing = [n for n in names if n not in record and n not in ("notes", *OPTIONAL_ALLOCATION_FIELDS)]
         if missing:
@@ -833,18 +687,14 @@ class Allocation:
         return cls(**values)
 
     def config(self) -> SchedulerConfig:
-        """The scheduler config this allocation was made with.
-
-        Raises:
-            ValueError: If the method is not registered.
-        """
+        """The scheduler config this allocation was made with (ValueError if the method is not registered)."""
         return scheduler_config_class(self.method)(
             temperature=self.temperature, n_min=self.n_min, **self.kalman, **self.options
         )
 
 
 OPTIONAL_ALLOCATION_FIELDS = ("options", "history", "demos_so_far")
-"""``Allocation`` fields a record leaves out when empty (records written before they existed lack them)."""
+"""``Allocation`` fields a record leaves out when empty (a record may lack them)."""
 
 
 def _allocation_notes(config: SchedulerConfig, measured: set[str]) -> list[str]:
@@ -860,23 +710,16 @@ def _allocation_notes(config: SchedulerConfig, measured: set[str]) -> list[str]:
 class Scheduler:
     """Allocates each DAgger round's demonstration budget across tasks.
 
-    Every method tracks the same measurements (so every record can show them): the Kalman filter and
-    the raw success rates from rollouts, the performance gain from training. Only the metric differs;
-    it comes from the method's config class (``SchedulerConfig.metric``). Before any measurement every
-    metric is constant across tasks, so the first allocation is uniform: the prior decides.
+    Every method tracks the same measurements (Kalman and raw success from rollouts, gain from training);
+    only the metric, from the method's ``config``, differs. Before any measurement every metric is
+    constant, so the first allocation is uniform.
+
+    Raises:
+        ValueError: On a bad hyperparameter or ``num_tasks`` < 1.
+        TypeError: If ``config`` is not a ``SchedulerConfig`` (``make_scheduler`` builds one by name).
     """
 
     def __init__(self, config: SchedulerConfig, num_tasks: int) -> None:
-        """Creates a scheduler.
-
-        Args:
-            config: A registered method's config (``make_scheduler`` builds one by name).
-            num_tasks: Number of tasks (>= 1).
-
-        Raises:
-            ValueError: On a bad hyperparameter.
-            TypeError: If ``config`` is not a ``SchedulerConfig``.
-        """
         if not isinstance(config, SchedulerConfig):
             raise TypeError(
                 f"Scheduler needs a SchedulerConfig, got {type(config).__name__}; build one by name with "
@@ -905,20 +748,14 @@ class Scheduler:
         demos: ArrayLike | None = None,
         demos_so_far: ArrayLike | None = None,
     ) -> None:
-        """Feeds one round's measurements.
+        """Feeds one round's measurements; on a bad one, raises ValueError and changes nothing.
 
         Args:
-            success_rate: Raw success rate of the round's rollouts per task (NaN allowed where a
-                task had 0 rollouts). Must come with ``episodes``.
+            success_rate: Raw success rate per task (NaN where a task had 0 rollouts); with ``episodes``.
             episodes: Rollouts per task behind ``success_rate``.
-            gain: Per-task loss drop ``L_start - L_end`` of the round's training; negative values
-                are clipped to 0 (``max(0, .)``).
-            demos: Expert demos per task of the policy behind ``success_rate`` (required with it by a
-                method that reads ``DEMOS``; kept in the learning-curve history).
+            gain: Per-task loss drop ``L_start - L_end`` of the round's training, clipped to >= 0.
+            demos: Expert demos per task behind ``success_rate`` (required by methods that read ``DEMOS``).
             demos_so_far: Expert demos per task collected so far (the next allocation adds to them).
-
-        Raises:
-            ValueError: On a bad measurement; the scheduler is left unchanged.
         """
         if (success_rate is None) != (episodes is None):
             raise ValueError("success_rate and episodes go together: pass both or neither.")
@@ -991,11 +828,7 @@ class Scheduler:
         return np.asarray(self.config.metric(self.state), dtype=np.float64)
 
     def allocate(self, budget: int) -> Allocation:
-        """Allocates ``budget`` episodes and returns the full record.
-
-        Raises:
-            ValueError: If ``budget`` is not an integer >= n_min * num_tasks.
-        """
+        """Allocates ``budget`` episodes (an integer >= n_min * num_tasks) and returns the full record."""
         metric = self.metric()
         score, probability, counts = self.config.split(self.state, metric, budget)
         reads_demos = DEMOS in self.config.measurements
@@ -1051,11 +884,7 @@ class Scheduler:
         return state
 
     def load_state_dict(self, state: Mapping[str, Any]) -> None:
-        """Restores a state written by ``state_dict``.
-
-        Raises:
-            ValueError: If the state belongs to another method, task count or format version.
-        """
+        """Restores a ``state_dict`` (ValueError if of another method, task count or format version)."""
         if state.get("format_version") != STATE_FORMAT_VERSION:
             raise ValueError(
                 f"Scheduler state has format_version={state.get('format_version')!r}; this version "
@@ -1089,19 +918,7 @@ class Scheduler:
 
 
 def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int | None) -> Scheduler:
-    """Creates a scheduler by method name.
-
-    Args:
-        method: A registered method (``scheduling_methods()``: uniform, need, need_raw, gain, ...).
-        num_tasks: Number of tasks.
-        **hyperparameters: Any ``SchedulerConfig`` field (temperature, n_min, p0, P0, Q, R0).
-
-    Returns:
-        The scheduler.
-
-    Raises:
-        ValueError: On an unknown method, an unknown hyperparameter or a bad value.
-    """
+    """Creates a scheduler by method name and ``SchedulerConfig`` fields (ValueError on a bad one)."""
     config_class = scheduler_config_class(method)
     known = {f.name for f in dataclasses.fields(config_class)}
     unknown = sorted(set(hyperparameters) - known)
@@ -1111,19 +928,10 @@ def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int |
 
 
 def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
-    """Recomputes an allocation from its stored record alone, through the method's config class.
+    """Recomputes an ``Allocation.to_dict()`` record from its inputs alone, through the method's config.
 
-    The Kalman posterior is recomputed from the stored prior and measurements (when the record
-    carries measurements), so a tampered metric or Kalman state is detected too.
-
-    Args:
-        record: An ``Allocation.to_dict()`` record.
-
-    Returns:
-        The allocation recomputed from the record's inputs.
-
-    Raises:
-        ValueError: If the record is incomplete, of an unknown method or inconsistent with itself.
+    The Kalman posterior too, from the stored prior and measurements, so a tampered Kalman state is
+    detected. Raises a ValueError on an incomplete or inconsistent record or an unknown method.
     """
     stored = Allocation.from_dict(record)
     config = stored.config()
@@ -1159,15 +967,7 @@ def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
 
 
 def allocation_mismatches(record: Mapping[str, Any], rtol: float = 1e-9) -> list[str]:
-    """Lists the fields of a stored allocation record that its own inputs do not reproduce.
-
-    Args:
-        record: An ``Allocation.to_dict()`` record.
-        rtol: Relative tolerance for float fields.
-
-    Returns:
-        One message per mismatching field; empty when the record checks out.
-    """
+    """Messages on the fields of an ``Allocation.to_dict()`` record its inputs do not reproduce."""
     recomputed = recompute_allocation(record)
     problems = []
     for name in ("metric", "score", "probability"):

@@ -1,7 +1,7 @@
 """``lerobot-mtdagger compare``: every method over many seeds, as ordinary runs in a process pool.
 
 Every (method, seed) and every (bc, seed, budget) is one ``lerobot-mtdagger run`` with the same run
-options, in its own folder under the compare folder::
+options, in its own folder::
 
     <output_dir>/
         runs/need-seed0/          an ordinary experiment folder (verify, merge, report work on it)
@@ -9,23 +9,8 @@ options, in its own folder under the compare folder::
         compare.json              what was asked (methods, seeds, budgets, run options)
         results.csv, results.json one row per run x evaluated round (``results.py``)
 
-BC budgets are expert demos per task. The default is the cumulative demos per task of DAgger after
-each round (``initial_demos + k * budget_per_task``, k = 0..rounds), so BC has a point at every x
-where DAgger has one; BC at the budget of round k is ``run --mode=bc --dagger.rounds=k``, which also
-trains it by the same rule as DAgger's phase k (``RunConfig.phase_steps``).
-
-Runs are independent processes (``--jobs`` at once, default one per core); each gets
-``cores / jobs`` torch threads and env workers so the jobs do not oversubscribe the cores
-(``run_resources``: ``--cores``, ``taskset``, ``OMP_NUM_THREADS`` and an explicit ``--rollout.workers``
-are respected, so a study can share the machine with other work). A
-finished run is skipped, a cut-off run is resumed (``--resume=true``), so ``compare`` itself resumes.
-A run started by ``compare`` ends itself within a second of ``compare`` ending (``follow_parent``), so a
-``compare`` that is killed leaves no run writing on into its folder.
-Asked again with more ``--dagger.rounds``, it extends the finished DAgger runs by the new rounds and adds BC
-at the new budgets; the rounds already made are kept as they are.
-The DAgger methods of a seed make the same round 0 and phase 0 (the scheduler acts from round 1), so a
-run that starts after another of its seed has committed them copies them and begins at round 1
-(``analysis/round_zero.py``; ``--share_round0=false`` to make each its own).
+Finished runs are skipped and cut-off ones resumed; with more ``--dagger.rounds`` the DAgger runs
+are extended and BC added at the new budgets.
 """
 
 from __future__ import annotations
@@ -61,22 +46,14 @@ class CompareConfig:
         seeds: Seeds; every method runs every seed.
         bc_budgets: BC expert demos per task (empty: DAgger's cumulative demos after each round).
         jobs: Runs at once with ``launcher=local`` (None: one per core).
-        cores: Cores the local runs share (None: the cores this process may run on, so
-            ``taskset -c 1 lerobot-mtdagger compare ...`` keeps a study on core 1); each run gets
-            ``cores // jobs`` torch threads (``run_resources``).
+        cores: Cores the local runs share (None: those this process may run on, e.g. under ``taskset``).
         output_dir: The compare folder (on storage every Ray node sees, with ``launcher=ray``).
-        launcher: ``local`` (each run a process on this machine) or ``ray`` (each run a Ray task
-            on the cluster at ``ray_address``, ``analysis/launchers.py``).
-        ray_address: The Ray cluster of ``launcher=ray`` (``auto``: the one ``ray start`` left on
-            this machine; ``ray://host:10001``; None: start a local Ray).
-        ray_cpus_per_run: CPUs each run holds with ``launcher=ray`` (its torch threads, and from 2
-            its env workers).
-        ray_gpus_per_run: GPUs each run holds with ``launcher=ray`` (0: none; pass
-            ``--policy.device=cuda`` for the runs to use them).
-        share_round0: A DAgger run copies the round 0 and phase 0 that a run of its seed with the same
-            options but the scheduler committed before it started, and begins at round 1
-            (``analysis/round_zero.py``: the scheduler acts from round 1, so they are the same to the
-            bit); false: every run makes its own.
+        launcher: ``local`` (each run a process on this machine) or ``ray`` (each run a Ray task).
+        ray_address: The Ray cluster of ``launcher=ray`` (``auto``, ``ray://host:10001``; None: a local Ray).
+        ray_cpus_per_run: CPUs each run holds with ``launcher=ray`` (its threads and env workers).
+        ray_gpus_per_run: GPUs each run holds with ``launcher=ray`` (0: none; with ``--policy.device=cuda``).
+        share_round0: A DAgger run copies round 0 and phase 0 from a run of its seed that differs only in
+            the scheduler (they are the same to the bit); false: every run makes its own.
     """
 
     HELP_FOOTER: ClassVar[str] = (
@@ -125,11 +102,7 @@ def split_arguments(argv: Sequence[str]) -> tuple[list[str], list[str]]:
 
 
 def base_run_config(run_args: Sequence[str]) -> RunConfig:
-    """The run options every job shares, parsed once to check them and read the preset.
-
-    Raises:
-        ValueError: If the run options set what ``compare`` decides per job.
-    """
+    """The run options every job shares, parsed once (ValueError if they set what ``compare`` decides)."""
     for arg in run_args:
         if arg.split("=", 1)[0] in ("--seed", "--mode", "--scheduler.type", "--output_dir", "--resume"):
             raise UserError(f"{arg} is set per run by compare: use --methods/--seeds/--output_dir.")
@@ -137,11 +110,7 @@ def base_run_config(run_args: Sequence[str]) -> RunConfig:
 
 
 def bc_rounds_for(config: RunConfig, budgets: Sequence[int], num_tasks: int) -> dict[int, int]:
-    """BC budget (demos per task) -> the ``--dagger.rounds`` that gives it.
-
-    Raises:
-        ValueError: On a budget that no whole number of rounds gives.
-    """
+    """BC budget (demos per task) -> the ``--dagger.rounds`` that gives it (ValueError if none does)."""
     dagger = config.dagger
     per_round = dagger.budget_for(num_tasks) / num_tasks
     if not budgets:
@@ -178,13 +147,7 @@ def jobs_for(compare: CompareConfig, run_args: Sequence[str], num_tasks: int) ->
 
 
 def runs_not_started(compare_dir: Path) -> list[str]:
-    """The runs ``compare_dir/compare.json`` plans that have no folder under ``runs/`` yet, in its order.
-
-    Empty for a folder without ``compare.json``.
-
-    Raises:
-        UserError: If ``compare.json`` is not a compare plan.
-    """
+    """The runs ``compare.json`` plans without a folder under ``runs/`` (``UserError`` if not a plan)."""
     path = Path(compare_dir) / COMPARE_FILE
     if not path.is_file():
         return []
@@ -198,25 +161,12 @@ def runs_not_started(compare_dir: Path) -> list[str]:
 def run_resources(
     compare_config: CompareConfig, run_args: Sequence[str], environ: Mapping[str, str]
 ) -> tuple[int, int, int | None]:
-    """Runs at once, torch threads per run and env workers per run of a local ``compare``.
+    """Runs at once, torch threads and env workers per run of a local ``compare``.
 
-    The cores are ``--cores`` or those this process may run on (``taskset``). Each of the ``--jobs``
-    runs gets ``cores // jobs`` threads, fewer if ``OMP_NUM_THREADS`` is set for ``compare``: a run
-    given more threads than it has cores trains many times slower (a point-cloud training phase beside
-    one other job: 1.4 steps/s with 2 threads, 16.5 with 1; ``docs/benchmarks.md``). Env
-    workers match the threads (0, in-process, below 2) unless the run options set
-    ``--rollout.workers``, which then holds.
-
-    Args:
-        compare_config: ``compare``'s options.
-        run_args: The options passed to every run.
-        environ: ``compare``'s environment.
-
-    Returns:
-        ``(parallel, threads, workers)``; ``workers`` is None when the run options choose it.
-
-    Raises:
-        UserError: If ``OMP_NUM_THREADS`` is not a positive whole number.
+    The cores (``--cores``, else those ``taskset`` allows) are split among the ``--jobs``, fewer threads
+    if ``OMP_NUM_THREADS`` says so (a ``UserError`` if it is not a positive whole number): more threads
+    than cores train many times slower. Returns ``(parallel, threads, workers)``; workers match the
+    threads (0 below 2), None where the run options set ``--rollout.workers``.
     """
     cores = compare_config.cores or default_worker_count()
     parallel = compare_config.jobs or cores
@@ -243,8 +193,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
 
     Raises:
         ValueError: On a bad option (nothing is run).
-        UserError: If a run fails, once every other run has finished (rerun to resume); every failed
-            run and its log are named.
+        UserError: If a run fails, once every other run has finished, naming each and its log.
     """
     if compare_config.jobs is not None and compare_config.jobs < 1:
         raise UserError(f"--jobs must be >= 1, got {compare_config.jobs}.")

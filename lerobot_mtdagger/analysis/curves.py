@@ -1,10 +1,7 @@
 """Learning curves: evaluation success against expert demonstrations, method by method, from points.
 
-Works from the points of runs (``results.experiment_curve`` reads them from experiment folders) or
-from the rows of a saved results table, never from a folder. After phase k the policy was trained on
-rounds 0..k, which hold ``demos_per_task`` expert-labelled episodes per task. Runs of the same method
-with different seeds are grouped; a curve point is the mean and the sample standard deviation over
-seeds at the same round (the same number of demos for every seed of a method).
+Runs of one method with different seeds are grouped; a point is the mean and sample standard
+deviation over seeds at the same round (the same demos per task for every seed of a method).
 """
 
 from __future__ import annotations
@@ -48,11 +45,7 @@ def is_bc(row: Mapping[str, Any]) -> bool:
 
 
 def curves_from_rows(rows: Sequence[Mapping]) -> list[CurvePoint]:
-    """The learning curves of a saved results table (``results.read_results``), as from the folders.
-
-    Raises:
-        ValueError: As ``average_runs``.
-    """
+    """The learning curves of a saved results table's rows (ValueError as ``average_runs``)."""
     runs: dict[tuple[str, int], list[tuple[int, float, float]]] = defaultdict(list)
     for row in rows:
         name = curve_name(row["method"], is_bc(row), float(row["demos_per_task_mean"]))
@@ -62,11 +55,7 @@ def curves_from_rows(rows: Sequence[Mapping]) -> list[CurvePoint]:
 
 
 def average_runs(runs: Sequence[RunPoints]) -> list[CurvePoint]:
-    """Averages the runs of each method over seeds, round by round (mean and sample std).
-
-    Raises:
-        ValueError: If two runs of one method have the same seed, or no run has an evaluated point.
-    """
+    """Averages each method's runs over seeds, round by round (ValueError on a repeated seed or no point)."""
     grouped: dict[str, dict[int, list[tuple[int, float, float]]]] = defaultdict(dict)
     for method, seed, points in runs:
         if seed in grouped[method]:

@@ -1,16 +1,13 @@
 """The paper's figures, from a results table (``results.py``); ``summary.py`` writes them with ``report.md``.
 
-Every curve is the mean over seeds with a 95% t confidence band (``stats.mean_interval``); BC runs
-are points (one per data budget) with 95% error bars. Figures, each a PNG in the report folder:
+Curves are means over seeds with a 95% t band, BC runs points with 95% error bars. Each a PNG:
 
-1. ``success_vs_demos.png``: average evaluation success against expert demos per task;
-   ``success_vs_frames.png``: the same against expert-labelled frames per task (expert queries);
-2. ``demos_to_reach.png``: demos per task needed to reach each success level (interpolated per
-   seed; seeds that never reach a level are counted in the bar label, never dropped silently);
-3. ``metrics_vs_success.png``: the task-need estimate (1 - Kalman p) and the performance gain per
-   task after the last scheduled round, against the final evaluated success, with Pearson's r;
-4. ``hardest_tasks.png``: success curves on the two hardest tasks (lowest BC success at the largest
-   budget; lowest final success over all runs when there is no BC);
+1. ``success_vs_demos.png`` / ``success_vs_frames.png``: success against expert demos (or
+   expert-labelled frames) per task;
+2. ``demos_to_reach.png``: demos per task to reach each success level (seeds that never reach a
+   level are counted in the bar label);
+3. ``metrics_vs_success.png``: task need (1 - Kalman p) and gain per task against final success;
+4. ``hardest_tasks.png``: success on the two hardest tasks;
 5. ``kalman_ablation.png``: task need with (``need``) and without (``need_raw``) the Kalman filter;
 6. ``time_to_reach.png``: wall time (collection + training + evaluation) to reach each level.
 """
@@ -55,11 +52,7 @@ def baselines(rows: Sequence[Row]) -> list[str]:
 
 
 def runs_by_method(rows: Sequence[Row]) -> dict[str, dict[int, list[Row]]]:
-    """Method -> seed -> that seed's rows as one curve, ordered by demos.
-
-    A DAgger run is one curve (its rounds); BC runs of one seed at several budgets form one curve
-    (one point per budget).
-    """
+    """Method -> seed -> that seed's rows as one curve (a DAgger run's rounds, or BC's budgets), by demos."""
     grouped: dict[str, dict[int, list[Row]]] = defaultdict(lambda: defaultdict(list))
     for row in rows:
         grouped[row["method"]][row["seed"]].append(row)
@@ -70,12 +63,7 @@ def runs_by_method(rows: Sequence[Row]) -> dict[str, dict[int, list[Row]]]:
 
 
 def point_columns(seeds: dict[int, list[Row]]) -> list[list[Row]]:
-    """The seeds' rows grouped point by point: one column per (round, mean demos per task), in order.
-
-    Every seed of a finished method has the same points (``results.check_comparable``); a run still
-    being written, or BC run at fewer budgets for one seed, has fewer, and its columns hold fewer
-    seeds.
-    """
+    """The seeds' rows grouped by point (round, mean demos per task), in order."""
     columns: dict[tuple[int, float], list[Row]] = defaultdict(list)
     for curve in seeds.values():
         for row in curve:
@@ -93,11 +81,7 @@ def curve_points(seeds: dict[int, list[Row]], x_key: str, y_of=None) -> list[tup
 
 
 def seed_reach(curve: Sequence[Row], level: float, x_values) -> float | None:
-    """The demos, frames or seconds at which one seed's curve first reaches ``level``.
-
-    Interpolated along the curve when x increases along it; otherwise (the run times of BC runs at
-    several budgets) the smallest x among the points that reach the level.
-    """
+    """The demos, frames or seconds at which one seed's curve first reaches ``level`` (interpolated)."""
     xs = list(x_values(curve))
     success = [row["eval_success_mean"] for row in curve]
     if all(b > a for a, b in zip(xs, xs[1:], strict=False)):
@@ -153,11 +137,7 @@ def plot_success(
     y_key: str = "eval_success_mean",
     title: str | None = None,
 ) -> Path:
-    """Figure 1 (and 5 with ``methods``): success against demos or frames, one curve per method.
-
-    ``y_key="unseen_success_mean"`` draws the success on the unseen tasks instead (rows without it
-    are left out).
-    """
+    """Figure 1 (and 5 with ``methods``): ``y_key`` against demos or frames, one curve per method."""
     rows = [row for row in rows if row.get(y_key) is not None]
     plt = _pyplot()
     figure, axis = plt.subplots(figsize=(7, 4.5))
@@ -262,10 +242,7 @@ def plot_metrics(rows: Sequence[Row], path: Path) -> tuple[Path, dict[str, float
 
 
 def hardest_tasks(rows: Sequence[Row], count: int = 2) -> list[int]:
-    """Task indices with the lowest BC success at the largest budget (else lowest final success).
-
-    BC is the run labelled ``bc`` where there is one, else any BC variant.
-    """
+    """Task indices with the lowest BC success at the largest budget (without BC: final success)."""
     names = bc_methods(rows)
     bc = [row for row in rows if names and row["method"] == names[0]]
     if bc:

@@ -1,22 +1,12 @@
 """Headroom: how much any split of the same expert demonstrations could beat an even split.
 
-A scheduler can only gain what the task set leaves: given each task's learning curve (success
-against the expert demonstrations of that task), the best split of a total of ``N * b`` demos
-over ``N`` tasks is a small knapsack problem, solved exactly here by dynamic programming over
-integer demos. The headroom at ``b`` demos per task is that split's mean success minus the even
-split's; the demos per task the best split needs to match the even split's success say what a
-perfect scheduler could save.
-
-Curves are estimated from measured points (one per task, budget and seed): success rates at the
-same demos are pooled (weighted by their evaluation episodes), made non-decreasing by weighted
-isotonic regression, and interpolated linearly between measured budgets. No curve is extended past
-its measured range here (the replay bench, ``analysis/replay.py``, says how it extrapolates).
-
-With several seeds the in-sample headroom is optimistic (the best split also fits the curves'
-noise). The honest estimate chooses the split on the other seeds' curves and scores it, against
-the even split, on the held-out seed's own curve; its interval is a t interval over held-out seeds.
-
-Pure numpy; no torch, no environment.
+Given each task's learning curve, the best split of ``N * b`` demos over ``N`` tasks is a knapsack
+solved exactly by dynamic programming over integer demos; the headroom at ``b`` demos per task is its
+mean success minus the even split's. Curves pool the success rates at the same demos (weighted by
+episodes), are made non-decreasing by isotonic regression and interpolated linearly, never extended
+past the measured range. With several seeds the in-sample headroom is optimistic; the honest one
+chooses the split on the other seeds and scores it on the held-out seed (a t interval over seeds).
+Pure numpy.
 """
 
 from __future__ import annotations
@@ -39,8 +29,6 @@ class TaskPoint:
     """One measured point of one task's learning curve.
 
     Attributes:
-        task: Task index.
-        seed: Seed of the run that measured it.
         demos: Expert demonstrations of this task the policy was trained on.
         success: Evaluation success rate of the task, in [0, 1].
         episodes: Evaluation episodes behind ``success`` (its weight).
@@ -58,9 +46,7 @@ class LearningCurves:
     """Each task's success against its own expert demos, on a common grid of integer demos.
 
     Attributes:
-        task_names: One name per task.
-        low: Smallest demos per task every curve covers.
-        high: Largest demos per task every curve covers.
+        low: Smallest demos per task every curve covers; ``high``: the largest.
         success: Success of task i at ``low + j`` demos, shape (num_tasks, high - low + 1).
         measured: The measured demos of each task's curve (the knots of its interpolation).
         seeds: The seeds the curves pool.
@@ -85,18 +71,11 @@ class LearningCurves:
 
 
 def fit_curves(points: Sequence[TaskPoint], task_names: Sequence[str]) -> LearningCurves:
-    """Estimates every task's learning curve from measured points (pooled, isotonic, interpolated).
-
-    Args:
-        points: Measured points; every task needs at least two distinct budgets.
-        task_names: The task vocabulary (task index i is ``task_names[i]``).
-
-    Returns:
-        The curves on the integer demos that every task's measurements cover.
+    """Estimates every task's curve from measured points, on the integer demos every task covers.
 
     Raises:
-        UserError: If a task has fewer than two measured budgets, a task has no point, a point is
-            out of range, or the tasks' measured ranges do not overlap in two or more demos.
+        UserError: If a task lacks two measured budgets, a point is out of range, or the tasks'
+            measured ranges overlap in fewer than two demos.
     """
     by_task = _points_by_task(points, len(task_names), task_names)
     knots, fitted = [], []
@@ -167,7 +146,6 @@ class BestSplits:
     """The best split of every total budget the curves cover.
 
     Attributes:
-        curves: The curves the splits were chosen on.
         totals: Total demos, from ``num_tasks * low`` to ``num_tasks * high``.
         value: Mean success over tasks of the best split of each total, shape (len(totals),).
         choice: Demos of task i in the best split of each total, shape (num_tasks, len(totals)).
@@ -200,15 +178,8 @@ class BestSplits:
 def best_splits(curves: LearningCurves) -> BestSplits:
     """Solves the knapsack of every total at once: max mean success with each task in [low, high].
 
-    Dynamic programming over tasks: ``best_k(T) = max_n best_{k-1}(T - n) + f_k(n)``. Costs
-    O(num_tasks^2 * width^2) array operations' worth of work in ``num_tasks * width`` numpy calls
-    (width = high - low + 1), about 10 ms for 43 tasks over 25 budgets.
-
-    Args:
-        curves: The learning curves.
-
-    Returns:
-        The best split and its mean success for every total.
+    Dynamic programming over tasks, ``best_k(T) = max_n best_{k-1}(T - n) + f_k(n)``, in
+    ``num_tasks * width`` numpy calls (about 10 ms for 43 tasks over 25 budgets).
     """
     width = curves.high - curves.low + 1
     num_tasks = curves.num_tasks
@@ -251,12 +222,8 @@ class Headroom:
     """What the best split of ``demos_per_task * num_tasks`` demos gains over the even split.
 
     Attributes:
-        demos_per_task: The even split's demos per task.
-        even: Mean success of the even split.
-        best: Mean success of the best split of the same total.
-        gain: ``best - even``.
+        even: Mean success of the even split; ``best``: of the best split; ``gain``: ``best - even``.
         demos_to_match: Demos per task the best split needs to match ``even`` (None: not in range).
-        split: Demos per task of the best split.
     """
 
     demos_per_task: int
@@ -302,11 +269,8 @@ class HeldOutHeadroom:
     """The honest headroom at one budget: split chosen on the other seeds, scored on each held-out one.
 
     Attributes:
-        demos_per_task: The even split's demos per task.
         per_seed: ``(seed, best-split success - even success)`` on each held-out seed.
-        mean: Mean over held-out seeds.
-        low: Lower end of the 95% t interval (NaN with fewer than two seeds).
-        high: Upper end.
+        mean: Mean over held-out seeds; ``low``, ``high``: its 95% t interval (NaN with one seed).
     """
 
     demos_per_task: int
@@ -319,15 +283,7 @@ class HeldOutHeadroom:
 def held_out_headroom(
     points: Sequence[TaskPoint], task_names: Sequence[str], budgets: Sequence[int]
 ) -> list[HeldOutHeadroom]:
-    """Leave-one-seed-out headroom at each budget (needs two or more seeds).
-
-    Args:
-        points: Measured points of every seed.
-        task_names: The task vocabulary.
-        budgets: Even demos per task to score.
-
-    Returns:
-        One estimate per budget that every fold's curves cover.
+    """Leave-one-seed-out headroom at each of ``budgets`` (demos per task) that every fold covers.
 
     Raises:
         UserError: With fewer than two seeds, or as ``fit_curves`` for any fold.
@@ -369,15 +325,9 @@ ALL_CURVES = "all"
 
 
 def points_from_rows(rows: Sequence[dict], source: str = BC_CURVES) -> list[TaskPoint]:
-    """The per-task curve points of a results table's rows (``results.experiment_rows``).
+    """One curve point per task, evaluated row and seed of a results table's rows.
 
-    Args:
-        rows: Result rows with ``method``, ``seed``, ``round``, ``demos_per_task``, ``eval_success``
-            and ``eval_episodes_per_task``; rows without an evaluation are skipped.
-        source: ``"bc"`` (BC runs and DAgger round 0), ``"all"``, or one method's name.
-
-    Returns:
-        One point per task, evaluated row and seed.
+    ``source``: ``"bc"`` (BC runs and DAgger round 0), ``"all"``, or one method's name.
     """
     points = []
     for row in rows:

@@ -1,8 +1,7 @@
 """The headroom section of a report: what the best split of the same demos could gain, per budget.
 
-Built from a results table's rows (``analysis/headroom.py`` does the maths): the curves come from the
-BC runs and every DAgger run's round 0 when there are any BC runs, else from every evaluated phase.
-Writes ``headroom.json`` and ``headroom.png`` beside ``report.md`` and returns its markdown lines.
+The curves come from the BC runs and DAgger's round 0 when there are BC runs, else from every
+evaluated phase; writes ``headroom.json`` and ``headroom.png`` beside ``report.md``.
 """
 
 from __future__ import annotations
@@ -40,11 +39,7 @@ READ_ME = (
 
 
 def headroom_summary(rows: Sequence[Row], task_names: Sequence[str]) -> dict[str, Any]:
-    """The headroom at every measured even budget, in sample and held out (with two or more seeds).
-
-    Raises:
-        UserError: As ``headroom.fit_curves`` when the rows cannot give a curve for every task.
-    """
+    """The headroom at every measured even budget, in sample and held out (raising as ``fit_curves``)."""
     source = BC_CURVES if any(is_bc(row) for row in rows) else ALL_CURVES
     points = points_from_rows(list(rows), source)
     curves = fit_curves(points, task_names)
@@ -133,11 +128,7 @@ def plot_headroom(summary: dict[str, Any], path: Path) -> Path:
 def write_headroom(
     rows: Sequence[Row], task_names: Sequence[str], folder: Path
 ) -> tuple[list[str], Path | None]:
-    """Writes ``headroom.json`` and ``headroom.png``; returns the report lines and the figure.
-
-    Rows that cannot give every task a curve (for example one budget only) give one line saying why
-    instead of the section.
-    """
+    """Writes ``headroom.json`` and ``headroom.png``; returns the report lines (or one saying why not)."""
     try:
         summary = headroom_summary(rows, task_names)
     except UserError as error:

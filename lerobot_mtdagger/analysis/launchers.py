@@ -1,16 +1,8 @@
 """Launchers of a ``compare`` grid: each planned run as a process on this machine, or as a Ray task.
 
-``RunPool`` (``--launcher=local``, the default) runs ``--jobs`` runs at once, each a
-``lerobot-mtdagger run`` process; ``RayRunPool`` (``--launcher=ray``) runs each as a Ray task holding
-its share of a cluster's CPUs (and GPUs), the same command in the same folder. Both skip finished
-runs, resume cut-off ones, let one failed run stop none of the others, and on Ctrl-C start no
-further run and end the running ones (which the next ``compare`` resumes).
-
-Several ``compare`` processes may work on one folder with the same options (one per core, or per
-machine on a shared disk): each skips the runs another has finished and those another is writing
-(their writer lock, ``ExperimentDir.writer_lock``), so together they share the plan's runs. A
-``compare`` that skipped a run being written ends with an error naming it, having written no table:
-run it again once the other has ended to tabulate every run.
+Both skip finished runs, resume cut-off ones, let one failed run stop none of the others, and on
+Ctrl-C end the running ones. Several ``compare`` processes may share one folder: each skips the runs
+another has finished or is writing, and then ends with an error naming those, having written no table.
 """
 
 from __future__ import annotations
@@ -38,11 +30,7 @@ class RunHeldError(UserError):
 
 
 def check_not_held(folder: Path, name: str) -> None:
-    """Refuses to start a run another process is writing.
-
-    Raises:
-        RunHeldError: If another process holds the run folder's writer lock (naming its pid).
-    """
+    """Refuses to start a run another process is writing (``RunHeldError`` naming its pid)."""
     from lerobot_mtdagger.datasets.experiment_dir import writer_lock_holder
 
     holder = writer_lock_holder(folder)
@@ -52,11 +40,7 @@ def check_not_held(folder: Path, name: str) -> None:
 
 
 def raise_for_errors(errors: Sequence[UserError], total: int) -> None:
-    """The error a pool ends with: failed runs first, else the runs another process was writing.
-
-    Raises:
-        UserError: If any run failed or was held; each is named.
-    """
+    """Raises the ``UserError`` a pool ends with, naming each failed run first, else each held one."""
     held = [str(error) for error in errors if isinstance(error, RunHeldError)]
     failed = [str(error) for error in errors if not isinstance(error, RunHeldError)]
     skipped = f" Skipped, being written by another process: {', '.join(held)}." if held else ""
@@ -83,11 +67,7 @@ class Job:
 
 
 def is_finished(folder: Path, last_phase: int) -> bool:
-    """Whether the run in ``folder`` committed its training phases up to ``last_phase``.
-
-    A DAgger run finished at fewer rounds than asked is not: resuming it with more ``--dagger.rounds``
-    extends it (``ExperimentDir.check_resumable``).
-    """
+    """Whether the run in ``folder`` committed its phases up to ``last_phase`` (else a resume extends it)."""
     from lerobot_mtdagger.datasets.experiment_dir import (  # LeRobot: loaded only when needed
         CONFIG_FILE,
         ExperimentDir,
@@ -101,11 +81,7 @@ def is_finished(folder: Path, last_phase: int) -> bool:
 def job_command(
     job: Job, folder: Path, threads: int, workers: int | None
 ) -> tuple[list[str], dict[str, str]]:
-    """One job's ``lerobot-mtdagger run`` command (resumed if started) and its environment variables.
-
-    The variables are the thread counts; the pid the run must not outlive is the launcher's to add.
-    ``workers`` None leaves ``--rollout.workers`` to the job's own options.
-    """
+    """One job's ``run`` command (resumed if started) and thread variables (``workers`` None: the job's)."""
     from lerobot_mtdagger.datasets.experiment_dir import CONFIG_FILE
 
     resume = ["--resume=true"] if (folder / CONFIG_FILE).exists() else []
@@ -125,10 +101,7 @@ def run_arguments(job: Job, folder: Path, workers: int | None) -> list[str]:
 
 
 def start_from_shared_round_zero(job: Job, folder: Path, workers: int | None) -> None:
-    """Copies into a job not started yet the round 0 and phase 0 of a run beside it that made the same.
-
-    ``analysis/round_zero.py``: DAgger runs of one seed whose options differ only in the scheduler. The
-    job then starts as a resume, at round 1.
+    """Copies into a job not started yet a shared round 0 and phase 0 (``analysis/round_zero.py``).
 
     Raises:
         UserError: On bad run options, or if another process started writing ``folder`` meanwhile.
@@ -139,25 +112,19 @@ def start_from_shared_round_zero(job: Job, folder: Path, workers: int | None) ->
 
 
 class RunPool:
-    """The runs of one ``compare``, ``parallel`` at once, each in its own process.
+    """The runs of one ``compare``, ``parallel`` at once, each in its own process (``--launcher=local``).
 
-    One failed run stops none of the others. An interrupt (Ctrl-C, or any exception in the waiting
-    thread) starts no further run and ends the running ones, which the next ``compare`` resumes.
+    Args:
+        runs_dir: The compare folder's ``runs/``.
+        parallel: Runs at once.
+        threads: Torch threads per run.
+        workers: Env worker processes per run (None: the run options choose).
+        share_round0: Start a DAgger run from a shared round 0 (``start_from_shared_round_zero``).
     """
 
     def __init__(
         self, runs_dir: Path, parallel: int, threads: int, workers: int | None, share_round0: bool = True
     ) -> None:
-        """Prepares the pool; nothing runs before ``run_all``.
-
-        Args:
-            runs_dir: The compare folder's ``runs/``.
-            parallel: Runs at once.
-            threads: Torch threads per run.
-            workers: Env worker processes per run (None: the run options choose).
-            share_round0: Start a DAgger run from the round 0 of a run beside it that made the same
-                one, where there is one when it starts (``start_from_shared_round_zero``).
-        """
         self.runs_dir = runs_dir
         self.parallel = parallel
         self.threads = threads
@@ -171,7 +138,7 @@ class RunPool:
         """Runs (or resumes, or skips) every job; returns the run folders in the order of ``jobs``.
 
         Raises:
-            UserError: Once every job has ended, if any run failed; each failed run and its log are named.
+            UserError: Once every job has ended, if any run failed, naming each and its log.
         """
         executor = ThreadPoolExecutor(max_workers=self.parallel)
         futures = [executor.submit(self.run_one, job) for job in jobs]
@@ -194,7 +161,7 @@ class RunPool:
         """Runs (or resumes, or skips) one job in its own process; returns its folder.
 
         Raises:
-            UserError: If the run fails, or the pool was interrupted before it started (its log is named).
+            UserError: If the run fails, or the pool was interrupted before it started.
             RunHeldError: If another process is writing the run.
         """
         folder = self.runs_dir / job.name
@@ -232,12 +199,7 @@ class RunPool:
 
 
 def run_job_process(command: list[str], variables: dict[str, str], log_path: str) -> int:
-    """Runs one job's command to its end, its output appended to ``log_path``; returns its exit code.
-
-    The body of a ``RayRunPool`` task, on whichever node holds it: the run inherits that node's
-    environment plus ``variables``, and ends with this process (``follow_parent``), so a cancelled
-    or lost task leaves no run behind.
-    """
+    """Runs one job's command, output appended to ``log_path``, ending with it; returns its exit code."""
     env = {**os.environ, **variables, PARENT_PID_ENV: str(os.getpid())}
     with open(log_path, "a") as log:
         process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env)
@@ -250,31 +212,21 @@ def run_job_process(command: list[str], variables: dict[str, str], log_path: str
 
 
 class RayRunPool:
-    """The runs of one ``compare`` as Ray tasks, each holding ``cpus`` CPUs and ``gpus`` GPUs.
+    """The runs of one ``compare`` as Ray tasks (``--launcher=ray``), as many at once as the cluster allows.
 
-    Ray runs as many at once as the cluster's resources allow. Every node must see the compare
-    folder at the same path (shared storage) and have this package installed at the same
-    interpreter path. One failed run stops none of the others; an interrupt cancels every task (the
-    running runs end and are resumed by the next ``compare``).
+    Every node must see the compare folder and this package's interpreter at the same paths.
+
+    Args:
+        runs_dir: The compare folder's ``runs/``.
+        cpus: CPUs per run (its torch threads and, from 2, its env workers).
+        gpus: GPUs per run (0: none; a fraction shares one).
+        address: The Ray cluster (None: a local Ray; ``UserError`` if there is none).
+        share_round0: Start a DAgger run from a shared round 0 committed before this ``compare``.
     """
 
     def __init__(
         self, runs_dir: Path, cpus: int, gpus: float, address: str | None, share_round0: bool = True
     ) -> None:
-        """Joins (or starts) the Ray cluster; nothing runs before ``run_all``.
-
-        Args:
-            runs_dir: The compare folder's ``runs/``.
-            cpus: CPUs per run (its torch threads and, from 2, its env workers).
-            gpus: GPUs per run (0: none; a fraction shares one).
-            address: The Ray cluster (None: a local Ray on this machine).
-            share_round0: Start a DAgger run from the round 0 of a run beside it that made the same
-                one (``start_from_shared_round_zero``): with every task submitted at once, only a run
-                that had committed its phase 0 before this ``compare`` can be that run.
-
-        Raises:
-            UserError: If Ray is missing or there is no cluster at ``address``.
-        """
         self.runs_dir = runs_dir
         self.share_round0 = share_round0
         self.cpus = cpus
@@ -285,7 +237,7 @@ class RayRunPool:
         """Runs (or resumes, or skips) every job; returns the run folders in the order of ``jobs``.
 
         Raises:
-            UserError: Once every job has ended, if any run failed; each failed run and its log are named.
+            UserError: Once every job has ended, if any run failed, naming each and its log.
         """
         ray = self.ray
         task = ray.remote(num_cpus=self.cpus, num_gpus=self.gpus, max_retries=0)(run_job_process)

@@ -1,15 +1,8 @@
 """Saving runs' records for a study: copied out of ``outputs/`` and compacted into byte-stable archives.
 
-A run's records are its small JSON files (``config.json``, each round's ``meta/mtdagger.json``, or
-``meta/info.json`` for a round written before that file, each phase's ``training.json``): its numbers
-without frames or weights. ``lerobot-mtdagger records`` writes them; ``saved_records`` (beside this
-module) reads them back for ``report --records``.
-
-- ``save_runs(runs, dest)``: every run under ``runs`` into ``dest/<run>/``, each replaced whole.
-- ``compact(root)``: each folder of saved runs into one ``runs-records.tar.gz``, the same bytes for the
-  same files; the folders are removed only once the archive lists every file they held.
-- ``save_compares(outputs, dest)``: a study's compare folders, each into ``dest/<folder>/`` as an archive
-  beside its ``results.csv``, runs archived earlier and no longer in ``outputs/`` kept.
+A run's records are its small JSON files (``SavedRunRecords``): its numbers without frames or
+weights. ``save_runs`` copies them, ``compact`` packs saved runs into one ``runs-records.tar.gz``
+(the same bytes for the same files), ``save_compares`` saves a study's compare folders.
 """
 
 from __future__ import annotations
@@ -39,11 +32,7 @@ RESULTS_TABLE = "results.csv"
 
 
 def run_record_files(run: Path) -> dict[str, Path]:
-    """A run's record files, by their path in the saved copy (``rounds/<round>/mtdagger.json``, ...).
-
-    A round's record is its ``meta/mtdagger.json``; a round written before that file keeps it only in
-    ``meta/info.json``, which is saved instead.
-    """
+    """A run's record files, by their path in the saved copy."""
     files = {CONFIG_FILE: run / CONFIG_FILE}
     for round_dir in sorted(run.glob("rounds/round-*")):
         record, info = round_dir / RECORD_FILE, round_dir / INFO_FILE
@@ -59,13 +48,7 @@ def run_record_files(run: Path) -> dict[str, Path]:
 
 
 def save_runs(runs: Path, dest: Path) -> list[str]:
-    """Copies the records of every run under ``runs`` into ``dest/<run>/``.
-
-    A run's saved folder is replaced whole (a run restarted from nothing leaves none of its earlier
-    records); runs not under ``runs`` keep theirs. An unfinished run gives what it has.
-
-    Returns:
-        The names of the runs saved.
+    """Copies the records of every run under ``runs`` into ``dest/<run>/`` (each replaced whole); their names.
 
     Raises:
         UserError: If ``runs`` is not a folder of runs.
@@ -85,10 +68,7 @@ def save_runs(runs: Path, dest: Path) -> list[str]:
 
 
 def stable_archive(folder: Path, members: list[str]) -> bytes:
-    """A gzipped tar of ``members`` (paths under ``folder``): sorted, no times, owners or names.
-
-    The same files give the same bytes on every machine and day.
-    """
+    """A gzipped tar of ``members`` under ``folder``, the same bytes on every machine and day."""
     paths = sorted({m for member in members for m in _with_contents(folder, member)})
     buffer = io.BytesIO()
     with tarfile.open(fileobj=buffer, mode="w", format=tarfile.GNU_FORMAT) as tar:
@@ -119,8 +99,7 @@ def compact_folder(folder: Path) -> Path:
     """Packs every subfolder of ``folder`` into ``folder/runs-records.tar.gz`` and removes them.
 
     Raises:
-        UserError: If the archive exists already (nothing is overwritten), or if it does not list every
-            file of the subfolders (nothing is removed).
+        UserError: If the archive exists, or lacks a file of the subfolders (nothing is removed).
     """
     archive = folder / ARCHIVE_NAME
     if archive.exists():
@@ -148,11 +127,7 @@ def _holds_runs(folder: Path) -> bool:
 
 
 def compact(root: Path) -> list[Path]:
-    """Compacts a study's records: ``root`` itself if it holds runs, else each subfolder that does.
-
-    Returns:
-        The archives written (none when nothing holds runs' records).
-    """
+    """Archives a study's records: ``root`` if it holds runs, else each subfolder that does (the archives)."""
     if not root.is_dir():
         raise UserError(f"records: {root} is not a folder: give a study's records folder.")
     if _holds_runs(root):
@@ -161,15 +136,10 @@ def compact(root: Path) -> list[Path]:
 
 
 def save_compares(outputs: Path, dest: Path) -> list[str]:
-    """Saves each compare folder under ``outputs`` into ``dest/<folder>/``: its archive and table.
+    """Saves each compare folder under ``outputs`` into ``dest/<folder>/``; one line each on what was kept.
 
-    Runs an earlier save archived that ``outputs`` no longer holds stay in the archive; a run
-    ``outputs`` holds replaces its archived records whole. When the archive then holds runs the
-    compare folder did not run, its ``results.csv`` would not show them: it is not saved (an earlier
-    one is removed), and ``report --records=<dest/folder>`` makes the table of every archived run.
-
-    Returns:
-        One line per compare folder saved, saying what was kept.
+    Archived runs ``outputs`` no longer holds stay; where the archive then holds runs the folder did not
+    run, its ``results.csv`` is not saved (``report --records`` tabulates every archived run).
     """
     if not outputs.is_dir():
         raise UserError(f"records: {outputs} is not a folder: give a study's outputs folder (outputs/STUDY).")

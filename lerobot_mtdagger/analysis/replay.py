@@ -1,27 +1,13 @@
 """A replay bench: measured learning curves as the environment of a scheduler.
 
-Each replicate runs the scheduling loop of a DAgger study without training anything: every task
-starts at ``initial_demos``; each round the scheduler is fed each task's success drawn binomially
-(``eval_episodes`` episodes) from the task's curve at the demos of the policy it measures, and its
-allocation adds to each task's demos. The runner's timing is kept (``lag=1``): round 1 has no
-measurement, round k sees the rollouts of round k-1, run by the policy trained before them. The
-outcome of a replicate is the curves' expected mean success after each phase, averaged over the
-phases after round 0 (the budgets a study's primary reads).
-
-Beside the registered schedulers it runs two oracles that know every curve: the online oracle
-allocates round by round by the true gain per demo (``learning_curve.greedy_split``), the static
-oracle takes, at each budget, the best split of all demos so far (``analysis.headroom.best_splits``: not
-reachable round by round, the ceiling of any split). A scheduler's share of the headroom is
-``(scheduler - uniform) / (online oracle - uniform)``.
-
-What a replay leaves out: DAgger's on-policy states, the coupling of tasks through one network
-and the spread between training seeds (so its intervals are narrower than a study's). Beyond the
-largest measured demos a curve is held flat (``extrapolation="flat"``) or continued along its last
-measured slope (``"slope"``, capped at 1): the flat choice can only understate what giving a task
-more demos is worth, the slope choice can only overstate it. Performance gain cannot be replayed:
-it needs per-task loss curves, which a success curve does not give.
-
-Pure numpy; the schedulers are the toolkit's own (``scheduler.make_scheduler``).
+Each replicate runs a DAgger study's scheduling loop without training: each round the scheduler is
+fed each task's success drawn binomially from its curve at the demos of the policy measured (the
+runner's one-round lag), and its allocation adds demos. A replicate's outcome is the curves'
+expected mean success after each phase, averaged over the phases after round 0. Two oracles know
+every curve: the online one allocates round by round by true gain per demo, the static one takes the
+best split of all demos at each budget (the ceiling). A scheduler's share of the headroom is
+``(scheduler - uniform) / (online oracle - uniform)``. ``docs/scheduler.md`` says what a replay
+leaves out and how curves are extended past the measured demos (``flat`` or ``slope``).
 """
 
 from __future__ import annotations
@@ -58,7 +44,7 @@ class ReplaySetting:
         eval_episodes: Episodes behind each measured success rate.
         n_min: Minimum episodes per task per round (schedulers and the online oracle).
         lag: Rounds between a policy and the allocation its success informs (1: the runner's timing).
-        extrapolation: Beyond the measured demos: ``flat`` or ``slope``.
+        extrapolation: Beyond the measured demos: ``flat`` or ``slope`` (capped at 1).
         replicates: Replicate runs per scheduler.
         seed: Seed of the replicates (replicate r of every scheduler draws from the same stream).
     """
@@ -93,12 +79,9 @@ class ReplaySetting:
 
 @dataclass(frozen=True)
 class ReplayCurves:
-    """Curves on every integer demos from ``initial_demos`` to the most a task can reach.
+    """Curves on every integer demos from ``low`` (column 0) to the most a task can reach.
 
-    Attributes:
-        low: Demos of column 0.
-        success: Success of task i at ``low + j`` demos, shape (num_tasks, width).
-        measured_high: The largest demos every curve was measured at (beyond: extrapolated).
+    ``success`` has shape (num_tasks, width); beyond ``measured_high`` demos it is extrapolated.
     """
 
     low: int
@@ -118,11 +101,7 @@ class ReplayCurves:
 
 
 def extend_curves(curves: LearningCurves, setting: ReplaySetting) -> ReplayCurves:
-    """The measured curves extended to every demos a replay can reach.
-
-    Raises:
-        UserError: If the study starts below the measured range.
-    """
+    """The measured curves extended to every demos a replay can reach (``UserError`` if it starts below)."""
     if setting.initial_demos < curves.low:
         raise UserError(
             f"--initial_demos={setting.initial_demos} is below the smallest demos every task was measured at "
@@ -180,11 +159,7 @@ class ArmSpec:
 
     @classmethod
     def parse(cls, text: str) -> ArmSpec:
-        """Reads ``method`` or ``method:key=value,key=value``.
-
-        Raises:
-            UserError: On an unknown method, a method that cannot be replayed, or a bad option.
-        """
+        """Reads ``method`` or ``method:key=value,key=value`` (``UserError`` on a bad method or option)."""
         method, _, rest = text.partition(":")
         try:
             config_class = scheduler_config_class(method)
@@ -221,10 +196,8 @@ class ArmOutcome:
     """What one arm did over the replicates.
 
     Attributes:
-        label: The arm.
         success: Expected mean success after each phase, shape (replicates, rounds + 1).
         demos: Demos per task after each phase, shape (replicates, rounds + 1, num_tasks).
-        seconds: Wall time of the arm.
     """
 
     label: str
@@ -304,8 +277,7 @@ def replay_uniform(curves: ReplayCurves, setting: ReplaySetting) -> ArmOutcome:
 def replay_static_oracle(curves: ReplayCurves, setting: ReplaySetting) -> ArmOutcome:
     """At each phase, the best split of all demos so far (the ceiling; not reachable round by round).
 
-    A task gets at most ``STATIC_ORACLE_SHARE`` times the even split's demos at the last phase (and,
-    with flat extrapolation, nothing past its measured demos, where more are worth nothing).
+    A task gets at most ``STATIC_ORACLE_SHARE`` times the last phase's even demos.
     """
     start = time.perf_counter()
     even_last = setting.initial_demos + setting.rounds * setting.budget_per_round / curves.num_tasks
@@ -345,15 +317,11 @@ class ArmSummary:
     """One arm against uniform and the online oracle.
 
     Attributes:
-        label: The arm.
         mean_success: Mean success over the budgets, mean over replicates.
         vs_uniform: ``(mean, low, high)`` of the arm - uniform (95% t interval over replicates).
         share: ``(mean, low, high)`` share of the online oracle's headroom (bootstrap 95%).
-        replicate_sd: Standard deviation over replicates of arm - uniform, evaluation noise included
-            (a study's seeds add training noise on top).
-        demos_to_reach: Demos per task at which the mean success first reaches each level
-            (interpolated on the mean path; None: not reached).
-        seconds: Wall time of the arm.
+        replicate_sd: SD over replicates of arm - uniform, evaluation noise included (no training noise).
+        demos_to_reach: Demos per task at which the mean success first reaches each level (None: never).
     """
 
     label: str
@@ -418,11 +386,7 @@ def _share_of_headroom(
 
 
 def _evaluation_noise_sd(outcome: ArmOutcome, uniform: ArmOutcome, curves, setting: ReplaySetting) -> float:
-    """SD of the difference of two arms' measured (not expected) mean success over the budgets.
-
-    Each phase's evaluation is a mean of binomial rates over tasks, independent across phases and
-    arms; the arm's mean demos at each phase stand for its replicates. 0 for the static oracle.
-    """
+    """SD of the difference of two arms' measured (binomial) mean success over the budgets."""
     variance = 0.0
     for arm in (outcome, uniform):
         if np.isnan(arm.demos).any():

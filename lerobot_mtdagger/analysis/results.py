@@ -1,14 +1,8 @@
 """The results table of a set of experiments: one row per experiment and committed training phase.
 
-A row describes the policy trained on rounds 0..k of one run: its method and seed, the expert data
-behind it (demos and expert-labelled frames per task, cumulative), its evaluation success, the
-scheduler's signals at that point and the wall time of the round. ``write_results`` stores the rows
-as CSV (list columns as JSON) and JSON next to the runs, with the task names, the config each
-method's runs share and, for a study in progress, its unfinished runs in ``results_meta.json``.
-``read_results`` reads them back and ``merge_tables`` joins tables made apart (other seeds, other
-machines), so a report can be drawn from saved tables alone, when the run folders are gone. This is
-the one module that reads experiment folders for studies (also ``learning_curves``,
-``check_comparable`` and ``run_progress``); ``curves``, ``figures`` and ``summary`` work from its rows::
+A row describes the policy trained on rounds 0..k of one run: method and seed, the cumulative expert
+demos and labelled frames per task, its evaluation success, the scheduler's signals and the round's
+wall time. Saved tables read back (``read_results``, ``merge_tables``) when the runs are gone::
 
     <folder>/
         results.csv         one row per run x evaluated phase, list columns as JSON
@@ -72,14 +66,9 @@ def round_frames_per_task(root: Path, num_tasks: int) -> list[int]:
 
 
 def experiment_rows(root: Path, label: str | None = None) -> list[dict[str, Any]]:
-    """The rows of one experiment, one per committed training phase with an evaluation.
+    """One row per evaluated phase of the experiment at ``root`` (ValueError if it has no round).
 
-    Args:
-        root: The experiment folder.
-        label: Method name of its rows (default: the run's method); ``bc`` says whether it is BC.
-
-    Raises:
-        ValueError: If ``root`` is not an experiment with committed rounds.
+    ``label`` is the rows' method name (default: the run's method, ``bc`` for BC).
     """
     experiment = open_run(root)
     rounds = experiment.committed_rounds()
@@ -153,12 +142,7 @@ def _progress_and_unseen(phase: Any) -> dict[str, Any]:
 
 
 def results_rows(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> list[dict[str, Any]]:
-    """The rows of every experiment, sorted by (method, seed, demos, round).
-
-    Args:
-        roots: Experiment folders.
-        labels: Method name per folder where it is not the run's own (``report --variants``).
-    """
+    """The rows of every experiment, sorted; ``labels`` names a folder's method where not its own."""
     labels = labels or {}
     rows = [row for root in roots for row in experiment_rows(Path(root), labels.get(Path(root)))]
     return sorted(rows, key=_row_order)
@@ -177,22 +161,15 @@ def write_results(
     unfinished: Sequence[str] = (),
     verification: Sequence[str] = (),
 ) -> tuple[Path, Path]:
-    """Writes ``results.csv``, ``results.json`` and ``results_meta.json`` into ``folder``.
+    """Writes ``results.csv``, ``results.json``, ``results_meta.json`` into ``folder``; returns the first two.
 
     Args:
-        rows: The rows (``results_rows``).
+        rows: The rows (``results_rows``); a ``UserError`` without one.
         folder: Where they go (made if missing).
         task_names: The suite's task names in task-index order (the per-task columns' order).
         configs: The config each method's runs share (``check_comparable``).
         unfinished: One line per unfinished run of a study in progress (``RunProgress.describe``).
-        verification: One line per run left out for failing verification, or read from unverified
-            records (``report --unverified=true``); saved only when there is one.
-
-    Returns:
-        The paths of ``results.csv`` and ``results.json``.
-
-    Raises:
-        UserError: If there is no row.
+        verification: One line per run left out for failing verification, or read unverified.
     """
     if not rows:
         raise UserError("No evaluated training phase in these experiments: nothing to tabulate.")
@@ -217,10 +194,9 @@ class SavedTable:
     """A results table read back from disk (``read_results``) or joined from several (``merge_tables``).
 
     Attributes:
-        rows: One row per run and evaluated phase.
         task_names: The task of each per-task column, in task-index order.
         unfinished: One line per run that was unfinished when the table was written.
-        configs: The config each method's runs share; None for a table written before they were saved.
+        configs: The config each method's runs share (None: not saved with the table).
         source: Where it was read from (for messages).
         verification: One line per run left out for failing verification or read unverified.
     """
@@ -234,16 +210,7 @@ class SavedTable:
 
 
 def read_results(path: Path) -> SavedTable:
-    """Reads a saved results table.
-
-    Args:
-        path: A ``results.json`` written by ``write_results`` (``report`` or ``compare``), or the folder
-            that holds it with its ``results_meta.json``.
-
-    Raises:
-        UserError: If a file is missing or is not what ``write_results`` writes, naming the file and
-            the fix.
-    """
+    """Reads a saved ``results.json`` or its folder (``UserError`` naming a missing or foreign file)."""
     path = Path(path)
     json_path = path / RESULTS_FILE if path.is_dir() else path
     meta_path = json_path.parent / META_FILE
@@ -281,12 +248,10 @@ def read_results(path: Path) -> SavedTable:
 
 
 def merge_tables(tables: Sequence[SavedTable]) -> SavedTable:
-    """Joins tables made apart (other seeds, other machines) into one, refusing what would mislead.
+    """Joins tables made apart (other seeds, other machines), refusing what would mislead (``UserError``).
 
-    Raises:
-        UserError: If the tables name different tasks, one was written without the methods' configs,
-            a method's runs were made with different configs, or two tables hold the same point
-            (method, seed, demos per task, round), which the mean would count twice.
+    Refused: different tasks, a method's config lacking or differing, and a point (method, seed, demos
+    per task, round) in two tables, which the mean would count twice.
     """
     if len(tables) == 1:
         return tables[0]
@@ -325,11 +290,7 @@ def merge_tables(tables: Sequence[SavedTable]) -> SavedTable:
 
 
 def _join_rows(tables: Sequence[SavedTable]) -> list[dict[str, Any]]:
-    """The rows of every table, sorted as ``results_rows`` sorts them.
-
-    Raises:
-        UserError: If two tables hold the same (method, seed, demos per task, round).
-    """
+    """The rows of every table, sorted (``UserError`` if two tables hold the same point)."""
     seen: dict[tuple, str] = {}
     for table in tables:
         for row in table.rows:
@@ -344,11 +305,7 @@ def _join_rows(tables: Sequence[SavedTable]) -> list[dict[str, Any]]:
 
 
 def _read_json(path: Path) -> Any:
-    """The JSON in ``path``.
-
-    Raises:
-        UserError: If it is not JSON, naming the file.
-    """
+    """The JSON in ``path`` (``UserError`` naming the file if it is not JSON)."""
     try:
         return json.loads(path.read_text())
     except json.JSONDecodeError as error:
@@ -370,23 +327,17 @@ PER_RUN_FIELDS = (
     "rollout.worker_backend",
     "rollout.ray_address",
 )
-"""Options (dotted paths) that may differ between the runs of one method (they never change a
-result, or are what the runs are repeated over)."""
+"""Options that may differ between the runs of one method (result-neutral, or what runs repeat over)."""
 
 BC_BUDGET_FIELDS = ("dagger.rounds", "scheduler")
-"""Options that may also differ between BC runs: the budget (``dagger.rounds``) and the unused
-scheduler (every ``scheduler.*`` option)."""
+"""Options that may also differ between BC runs: the budget and the unused ``scheduler.*``."""
 
 
 @dataclass(frozen=True)
 class RunProgress:
-    """How far one run has got: its committed rounds and training phases against its last phase.
+    """How far one run in ``root`` has got: its committed ``rounds`` and ``phases`` against ``last_phase``.
 
-    Attributes:
-        root: The experiment folder.
-        rounds: Committed rounds (0 for a run that has just started).
-        phases: Indices of the committed training phases.
-        last_phase: The phase the run ends with: 0 for BC, ``rounds`` for DAgger (its config).
+    ``last_phase`` is 0 for BC, ``rounds`` for DAgger (from its config).
     """
 
     root: Path
@@ -406,11 +357,7 @@ class RunProgress:
 
 
 def run_progress(root: Path) -> RunProgress:
-    """How far the run in ``root`` has got (a run still being written is read as it stands).
-
-    Raises:
-        UserError: If ``root`` has no ``config.json`` or holds a corrupt round.
-    """
+    """How far the run in ``root`` has got (``UserError`` without a config or on a corrupt round)."""
     path = Path(root) / CONFIG_FILE
     if not path.is_file():
         raise UserError(f"{root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}).")
@@ -426,12 +373,7 @@ def run_progress(root: Path) -> RunProgress:
 
 
 def experiment_curve(root: Path, label: str | None = None) -> RunPoints:
-    """The evaluated points of one experiment folder.
-
-    Args:
-        root: The experiment folder.
-        label: The method name to report it under (default: its method, ``bc`` for BC).
-    """
+    """The evaluated points of one experiment folder, under ``label`` (default: its method)."""
     experiment = open_run(root)
     record = experiment.read_round_record(0)
     points = []
@@ -444,16 +386,10 @@ def experiment_curve(root: Path, label: str | None = None) -> RunPoints:
 
 
 def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> list[CurvePoint]:
-    """Groups experiments by method and averages their curves over seeds, round by round.
-
-    Args:
-        roots: Experiment folders.
-        labels: Method name per folder where it is not the run's own (a variant of a method, e.g.
-            BC with balanced sampling reported as ``bc-balanced`` beside ``bc``).
+    """Groups experiments by method (or ``labels``) and averages their curves over seeds, round by round.
 
     Raises:
-        ValueError: If two runs of one method used the same seed (a duplicate would bias the mean),
-            their configs differ in more than the seed (``check_comparable``), or no run has an
+        ValueError: On a repeated seed of one method, configs that differ beyond the seed, or no
             evaluated phase.
     """
     labels = labels or {}
@@ -462,16 +398,10 @@ def learning_curves(roots: Sequence[Path], labels: Mapping[Path, str] | None = N
 
 
 def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = None) -> dict[str, dict]:
-    """Refuses to group runs of one method whose configs differ in more than ``PER_RUN_FIELDS``.
+    """The options each method's runs share, refusing runs that differ beyond ``PER_RUN_FIELDS``.
 
-    BC runs may also differ in ``BC_BUDGET_FIELDS`` (one BC run per budget). A run given a label in
-    ``labels`` is grouped under that label, not under its method.
-
-    Returns:
-        The options each method's runs share (by dotted path, without those fields), by method name.
-
-    Raises:
-        ValueError: Naming the method, the differing fields with their values and two such runs.
+    BC runs may also differ in ``BC_BUDGET_FIELDS``; a ``labels`` entry groups a run under its label.
+    The ValueError names the method, the differing fields with their values and two such runs.
     """
     first_of_method: dict[str, tuple[Path, dict]] = {}
     for root in roots:
@@ -505,9 +435,8 @@ def check_comparable(roots: Sequence[Path], labels: Mapping[Path, str] | None = 
 def config_differences(first: Mapping, second: Mapping) -> str:
     """``"option: a vs b, ..."`` for every option whose value differs (empty when none does).
 
-    Either config may be nested, flat by dotted path or stored before the options were grouped. An
-    option one config lacks (stored before the option existed) counts as what it was then
-    (``RunConfig.option_defaults``: ``training.lr_schedule`` was ``constant``).
+    Either config may be nested, flat or in an older layout; an option one lacks counts as its former
+    value (``RunConfig.option_defaults``).
     """
     defaults = RunConfig.option_defaults()
     first, second = (flatten(migrate_run_config(config)) for config in (first, second))

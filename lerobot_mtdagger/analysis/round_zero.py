@@ -1,21 +1,11 @@
 """Round 0 shared between the DAgger methods of one seed: ``compare`` copies it instead of redoing it.
 
-In a DAgger run (``runner/dagger.py``), round 0 (``initial_demos`` expert demonstrations per task) and
-phase 0 (the first policy, trained on them and evaluated) come before the scheduler acts: it first
-allocates round 1. Every random draw derives from the seed and the round, so two DAgger runs whose
-options differ only in the scheduler (``--scheduler.type`` and its hyperparameters), in
-``--dagger.rounds`` (no round depends on how many follow it) or in options that never change a result
-make the same round 0 and phase 0, to the bit. ``compare`` runs the first method of a seed in full;
-before it starts another method of that seed, it copies the committed round 0 and phase 0 of a run that
-has them into the new run's folder, and the new run resumes at round 1 (on MT10 pixels, phase 0 was
-7-30% of a run's time: ``docs/benchmarks.md``).
-
-The copy is a run of its own, as if it had made its round 0 itself: its ``config.json`` and its round-0
-record (method, config, scheduler hyperparameters) are its own, the record's notes name the run it was
-copied from, and its ledger lists its own records. The round's data, the policy and the phase's
-training record (losses, evaluation and timings: the seconds the source spent making them) are the
-source's files, hard-linked where the file system allows (committed files are never changed), else
-copied. ``--share_round0=false`` makes every run make its own.
+Round 0 and phase 0 come before the scheduler acts, and every random draw derives from the seed and
+the round; so DAgger runs differing only in the scheduler, ``--dagger.rounds`` or result-neutral
+options make them the same, to the bit. A run started beside one that has committed them copies
+them and resumes at round 1 (``--share_round0=false``: each makes its own). The copy's config,
+round-0 record (naming its source) and ledger are its own; the data, policy and training record are
+the source's files, hard-linked where possible.
 """
 
 from __future__ import annotations
@@ -53,9 +43,8 @@ SCHEDULER_PREFIX = "scheduler."
 def round_zero_differences(source: Mapping[str, Any], target: Mapping[str, Any]) -> list[str]:
     """The options by which two run configs (``RunConfig.to_dict``) would make different round-0s.
 
-    Empty when both are DAgger runs whose options differ only in the scheduler, ``dagger.rounds`` and
-    options that never change a result (an option one config predates counts as its default).
-    ``["mode"]`` when either is a BC run: BC's round 0 holds the whole budget.
+    Empty for DAgger runs differing only in the scheduler, ``dagger.rounds`` and result-neutral options;
+    ``["mode"]`` when either is a BC run (BC's round 0 holds the whole budget).
     """
     if source.get("mode") != "dagger" or target.get("mode") != "dagger":
         return ["mode"]
@@ -72,11 +61,7 @@ def round_zero_differences(source: Mapping[str, Any], target: Mapping[str, Any])
 
 
 def round_zero_source(runs_dir: Path, config: RunConfig, exclude: Path) -> Path | None:
-    """A run under ``runs_dir`` (not ``exclude``) whose committed round 0 and phase 0 ``config`` would make.
-
-    The first such folder by name; None if there is none. Folders that are not experiments are passed
-    over, as are runs that have not committed phase 0 yet.
-    """
+    """The first run under ``runs_dir`` but ``exclude`` that committed ``config``'s round 0 and phase 0."""
     target = config.to_dict()
     for folder in sorted(path for path in Path(runs_dir).iterdir() if path.is_dir() and path != exclude):
         experiment = ExperimentDir(folder)
@@ -102,8 +87,7 @@ def link_or_copy(source: str, destination: str) -> None:
 def copy_round_zero(source: Path, target: Path, config: RunConfig) -> None:
     """Makes ``target`` a new experiment of ``config`` holding ``source``'s round 0 and phase 0.
 
-    Each is staged and committed by an atomic rename, as a run commits them: a copy cut off half-way
-    leaves a run that resumes by making what is missing itself.
+    Each is committed as a run commits it (a copy cut off half-way leaves a run that resumes).
 
     Raises:
         UserError: If ``target`` exists and is not empty, or another process is writing it.
@@ -144,13 +128,8 @@ def own_round_zero_record(origin: ExperimentDir, config: RunConfig, source_name:
 def share_round_zero(folder: Path, run_args: Sequence[str]) -> Path | None:
     """Gives a run not started yet the round 0 and phase 0 of a run beside it that made the same ones.
 
-    Args:
-        folder: The run's folder (its siblings are the other runs of the compare).
-        run_args: The run's ``lerobot-mtdagger run`` options, ``--output_dir`` included.
-
-    Returns:
-        The run it was copied from, or None (a run already started, a BC run, or no such run yet:
-        it makes its own).
+    ``folder`` is the run's folder, ``run_args`` its ``run`` options (``--output_dir`` included).
+    Returns the source run, or None (already started, a BC run, or no source yet).
 
     Raises:
         UserError: On bad run options, or if another process started writing ``folder`` meanwhile.

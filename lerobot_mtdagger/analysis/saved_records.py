@@ -1,11 +1,8 @@
 """Runs' saved records (config, round and phase records; no frames or weights), as folders or archives.
 
-``scripts/save_run_records.sh`` saves a run's records as a folder; a study keeps many runs' records
-compacted into one byte-stable archive, ``runs-records.tar.gz``, holding one folder per run
-(``scripts/save_compare_records.sh``, ``scripts/compact_records.sh``). ``report --records`` reads both:
-an archive is unpacked once per process into a temporary folder (removed at exit), and each of its
-runs is named as if it were unpacked beside the archive, so a table drawn from an archive names the
-same runs as one drawn from the folders it was made from.
+``report --records`` reads a run's folder of records, a folder of them, or their byte-stable archive
+``runs-records.tar.gz``, which is unpacked once per process into a temporary folder; its runs are named
+as if unpacked beside the archive, so a table names the same runs either way.
 """
 
 from __future__ import annotations
@@ -26,15 +23,11 @@ ARCHIVE_NAME = "runs-records.tar.gz"
 """The archive of a folder of runs' records."""
 
 _UNPACKED: dict[Path, tuple[Path, Path]] = {}
-"""Each archive read (resolved path) -> (the folder it was unpacked into, the folder its runs are named
-in: the archive's own folder)."""
+"""Each archive read -> (the folder it was unpacked into, the folder its runs are named in)."""
 
 
 def saved_records_runs(path: Path) -> list[Path]:
-    """The runs' records at ``path``: a run's folder, a folder of them, or archives of them.
-
-    A folder may hold runs' folders, a ``runs-records.tar.gz``, and subfolders each holding one
-    (a study's compare folders); an archive may be given itself.
+    """The runs' records at ``path``: a run's folder, a folder of them (or of compare folders), or archives.
 
     Raises:
         UserError: If ``path`` holds no run's records, naming the commands that save them.
@@ -65,11 +58,7 @@ def _runs_in(folder: Path) -> list[Path]:
 
 
 def unpack(archive: Path) -> Path:
-    """The folder ``archive`` is unpacked into (once per process; removed at exit).
-
-    Raises:
-        UserError: If it is not a readable tar archive.
-    """
+    """The folder ``archive`` is unpacked into, once per process (``UserError`` if not a tar archive)."""
     key = archive.resolve()
     if key not in _UNPACKED:
         folder = Path(tempfile.mkdtemp(prefix="mtdagger-records-"))

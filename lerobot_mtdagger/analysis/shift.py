@@ -1,22 +1,10 @@
 """Covariate shift of a policy: its action error on the states it reaches against on the expert's states.
 
-DAgger's premise is that a policy trained on expert states errs more on the states its own actions
-lead to than on expert states, and that labelling those states fixes it. ``measure_shift`` measures
-that gap for a trained policy, per task, on the evaluation reset seeds (which no training episode
-uses), without training anything:
-
-- the policy's own rollouts (it acts throughout, as in evaluation), with the expert labelling every
-  state: the squared action error ``|pi(s) - pi*(s)|^2`` on the policy's own states, split into its
-  successful and its failed episodes, and its success (equal to ``evaluate``'s on the same episodes);
-- the expert's rollouts from the same reset seeds: the policy's error on the expert's states.
-
-The policy's action is clipped to the env's action space before it is compared, as the env clips what
-it executes: a policy fed a state far outside its training data (a MuJoCo instability resets the
-simulation mid-episode) may output actions of any size, and an unclipped error would then measure
-only that. Errors are averaged over a task's frames. The ratio own / expert per task is the covariate shift
-factor: near 1, the policy meets no state it has not learnt to act in, and relabelled rollouts have
-little to add over more demonstrations; well above 1, its own states are where it goes wrong. Like
-evaluation, episodes end at the first success.
+``measure_shift`` runs, on the evaluation reset seeds, the policy with the expert labelling every
+state, and the expert from the same seeds; the mean squared action error ``|clip(pi(s)) - pi*(s)|^2``
+per frame gives, per task, the shift factor own / expert. Near 1 relabelled rollouts add little over
+more demonstrations; well above 1 the policy's own states are where it goes wrong. Actions are
+clipped as the env clips them; episodes end at the first success, as in evaluation.
 """
 
 from __future__ import annotations
@@ -37,19 +25,14 @@ from lerobot_mtdagger.utils.seeds import EVAL_STREAM
 
 @dataclass
 class ShiftResult:
-    """Per-task action errors of a policy on its own states and on the expert's.
+    """Per-task action errors of a policy on its own states and on the expert's (mean squared, per frame).
 
     Attributes:
-        task_names: The suite's tasks.
         success: The policy's success rate per task on the measured episodes.
-        own_error: Mean squared action error per frame on the policy's own states.
-        own_error_succeeded: The same on its successful episodes only (None: none succeeded).
+        own_error_succeeded: ``own_error`` on its successful episodes only (None: none succeeded).
         own_error_failed: The same on its failed episodes only (None: none failed).
-        expert_error: Mean squared action error per frame on the expert's states.
         own_error_by_dimension: ``own_error`` per action dimension (it sums to ``own_error``).
-        expert_error_by_dimension: ``expert_error`` per action dimension.
         episodes: Episodes per task, of the policy and of the expert each.
-        seed: Seed of the evaluation episodes.
     """
 
     task_names: list[str]
@@ -112,14 +95,8 @@ def measure_shift(workers: EnvWorkers, policy: PolicyFn, episodes_per_task: int,
     Args:
         workers: The env workers (their suite gives the tasks and the experts).
         policy: The policy (``PolicyRunner`` or any callable of observations and task names).
-        episodes_per_task: Episodes per task, run once by the policy and once by the expert.
+        episodes_per_task: Episodes per task (> 0), run once by the policy and once by the expert.
         seed: Seed of the evaluation episodes (``evaluate``'s episodes for the same seed).
-
-    Returns:
-        The per-task success and errors.
-
-    Raises:
-        ValueError: If ``episodes_per_task`` is not positive.
     """
     if episodes_per_task <= 0:
         raise ValueError(f"episodes_per_task must be > 0, got {episodes_per_task}.")
@@ -149,11 +126,7 @@ def measure_shift(workers: EnvWorkers, policy: PolicyFn, episodes_per_task: int,
 
 
 def action_bounds(suite: TaskSuite) -> tuple[np.ndarray, np.ndarray]:
-    """The (low, high) of the suite's action space, read from the env of its first task.
-
-    Raises:
-        ValueError: If that env's action space is not a box.
-    """
+    """The (low, high) of the suite's action space, from its first task's env (ValueError if not a box)."""
     env = suite.make_env(suite.task_names[0])
     try:
         space = env.action_space
@@ -186,10 +159,7 @@ def _episode_errors(
     task_names: list[str],
     bounds: tuple[np.ndarray, np.ndarray],
 ) -> list[np.ndarray]:
-    """``(clip(pi(s)) - label)^2`` per frame and action dimension, (frames, dims), of each recorded episode.
-
-    The policy is queried once per episode, on all of its frames; its actions are clipped to ``bounds``.
-    """
+    """``(clip(pi(s)) - label)^2`` per frame and dimension of each episode (one policy call per episode)."""
     errors = []
     for episode in episodes:
         frames = episode.frames
@@ -203,11 +173,7 @@ def _episode_errors(
 def _task_mean(
     errors: Sequence[np.ndarray], episodes: Sequence[Episode], task: int, success: bool | None = None
 ) -> np.ndarray | None:
-    """Mean error per frame and dimension over a task's episodes (those with ``success`` if given).
-
-    Returns:
-        The mean per action dimension, or None without an episode.
-    """
+    """Mean error per dimension over a task's episodes (with ``success`` if given; None without one)."""
     chosen = [
         error
         for error, episode in zip(errors, episodes, strict=True)

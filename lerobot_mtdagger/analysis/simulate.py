@@ -1,9 +1,8 @@
 """Synthetic multitask learning curves for exercising schedulers without simulators.
 
-Each synthetic task has a hidden difficulty ``d``: after ``n`` expert episodes the policy's true
-success probability is ``1 - exp(-n / d)``. A round rolls the policy out ``n_i`` times per task
-(binomial success) and reports a loss drop that shrinks as the task saturates. This is a toy for
-demos and scheduler tests, not a model of any benchmark.
+A task of hidden difficulty ``d`` succeeds with probability ``1 - exp(-n / d)`` after ``n`` expert
+episodes; a round rolls out binomially and reports a loss drop that shrinks as the task saturates.
+A toy for demos and scheduler tests, not a model of any benchmark.
 """
 
 from __future__ import annotations
@@ -21,12 +20,7 @@ logger = logging.getLogger(__name__)
 
 @dataclass
 class SyntheticTasks:
-    """Hidden learning curves of a set of synthetic tasks.
-
-    Attributes:
-        difficulty: Episodes needed per e-fold of failure probability, one per task (> 0).
-        demos: Expert episodes collected so far per task.
-    """
+    """Hidden learning curves: ``difficulty`` per task (> 0) and the ``demos`` collected so far."""
 
     difficulty: np.ndarray
     demos: np.ndarray
@@ -78,21 +72,10 @@ class SimulatedRound:
 def simulate(
     scheduler: Scheduler, tasks: SyntheticTasks, rounds: int, budget: int, initial_demos: int, seed: int
 ) -> list[SimulatedRound]:
-    """Runs the scheduling loop of Algorithm 1 on synthetic tasks.
+    """Runs the scheduling loop of Algorithm 1 on synthetic tasks; returns one record per round after 0.
 
-    Round 0 gives every task ``initial_demos``; each later round feeds the scheduler the previous
-    round's measured success and this round's loss drop, then allocates ``budget`` episodes.
-
-    Args:
-        scheduler: The scheduler under test (its task count must match ``tasks``).
-        tasks: The synthetic tasks (mutated: demos accumulate).
-        rounds: DAgger rounds after round 0.
-        budget: Episodes per round.
-        initial_demos: Round-0 episodes per task.
-        seed: Seed of the rollout noise.
-
-    Returns:
-        One record per round after round 0.
+    Round 0 gives every task ``initial_demos``; each later round feeds the scheduler the previous round's
+    measured success and this round's loss drop, then allocates ``budget`` episodes (``tasks`` mutated).
     """
     rng = np.random.default_rng(seed)
     num_tasks = tasks.difficulty.size

@@ -1,8 +1,6 @@
 """Statistics over seeds: t confidence intervals, paired differences, demos needed to reach a level.
 
-Every function takes one value per seed. Intervals are Student-t intervals over seeds (the seeds are
-the independent replicates; evaluation episodes within a seed are not). With one seed the mean is
-reported and the interval is undefined (NaN), never invented.
+Seeds are the independent replicates (not evaluation episodes); with one seed the interval is NaN.
 """
 
 from __future__ import annotations
@@ -19,14 +17,7 @@ CONFIDENCE = 0.95
 
 @dataclass(frozen=True)
 class Interval:
-    """A mean over seeds with its confidence interval.
-
-    Attributes:
-        mean: Mean over the seeds.
-        low: Lower end of the interval (NaN with fewer than two seeds).
-        high: Upper end (NaN with fewer than two seeds).
-        n: Number of seeds.
-    """
+    """A mean over ``n`` seeds with its confidence interval ``[low, high]`` (NaN below two seeds)."""
 
     mean: float
     low: float
@@ -52,11 +43,7 @@ def format_difference(interval: Interval) -> str:
 
 
 def mean_interval(values: Sequence[float], confidence: float = CONFIDENCE) -> Interval:
-    """Mean of ``values`` with a Student-t interval (``mean +- t * s / sqrt(n)``).
-
-    Raises:
-        ValueError: On an empty sequence, a NaN value or a confidence outside (0, 1).
-    """
+    """Mean of ``values`` with a Student-t interval (ValueError: empty, a NaN, confidence outside (0, 1))."""
     array = np.asarray(values, dtype=np.float64)
     if array.size == 0:
         raise ValueError("No values: a mean over seeds needs at least one seed.")
@@ -75,27 +62,14 @@ def mean_interval(values: Sequence[float], confidence: float = CONFIDENCE) -> In
 def paired_difference(
     first: Sequence[float], second: Sequence[float], confidence: float = CONFIDENCE
 ) -> Interval:
-    """Mean of ``first[i] - second[i]`` over paired seeds, with its t interval.
-
-    Raises:
-        ValueError: If the sequences differ in length.
-    """
+    """Mean of ``first[i] - second[i]`` over paired seeds with its t interval (ValueError: lengths differ)."""
     if len(first) != len(second):
         raise ValueError(f"Paired values need one pair per seed, got {len(first)} and {len(second)}.")
     return mean_interval(np.asarray(first, float) - np.asarray(second, float), confidence)
 
 
 def demos_to_reach(demos: Sequence[float], success: Sequence[float], level: float) -> float | None:
-    """Expert demos needed to first reach ``level``, linearly interpolated along one seed's curve.
-
-    Args:
-        demos: Demos per task at each point, increasing.
-        success: Success at each point.
-        level: The success level.
-
-    Returns:
-        The interpolated demos at the first crossing; ``demos[0]`` if the first point already
-        reaches it; None if the curve never reaches it.
+    """Expert demos at which one seed's curve first reaches ``level``, linearly interpolated (None: never).
 
     Raises:
         ValueError: On sequences of different lengths or demos that do not increase.

@@ -1,9 +1,7 @@
 """The markdown summary of a comparison (``report.md``), from a results table (``results.py``).
 
-Paired differences, demo ratios, reach, hardest-task gaps, unseen tasks, stability and cost: each a
-list of lines built from the rows.
-
-``write_report`` writes the figures (``figures.py``) and this summary into a report folder.
+Paired differences, demo ratios, reach, hardest-task gaps, unseen tasks, stability and cost, each a
+list of lines built from the rows; ``write_report`` writes them with the figures (``figures.py``).
 """
 
 from __future__ import annotations
@@ -86,9 +84,8 @@ def demos_ratio(
 def comparison_pairs(rows: Sequence[Row]) -> list[tuple[str, str]]:
     """The (method, baseline) pairs of the summary.
 
-    Every method against every baseline (Uniform DAgger and each BC variant), Uniform DAgger against
-    each BC variant, each labelled BC variant against ``bc``, and task need with the Kalman filter
-    against task need without it.
+    Every method against every baseline (Uniform DAgger and each BC variant), each labelled BC variant
+    against ``bc``, and task need with the Kalman filter against task need without it.
     """
     bases = baselines(rows)
     bc_names = bc_methods(rows)
@@ -216,9 +213,8 @@ def cost_lines(rows: Sequence[Row]) -> list[str]:
 def unseen_lines(rows: Sequence[Row]) -> list[str]:
     """Markdown: the paper's in-domain / unseen table, per method at each point (none without unseen tasks).
 
-    In-domain: the training tasks; unseen: the suite's held-out tasks (the drawers a policy has no
-    task index for), evaluated after every phase and never given to the scheduler. Progress is the
-    0-3 score (touch the handle, pull, open). Mean over seeds with a 95% t interval.
+    Unseen: the suite's held-out tasks (never given to the scheduler); progress is the 0-3 score (touch
+    the handle, pull, open). Mean over seeds with a 95% t interval.
     """
     if not any(row.get("unseen_success_mean") is not None for row in rows):
         return []
@@ -316,17 +312,12 @@ def write_report(
     """Writes every figure and ``report.md`` into ``folder``; returns the markdown path.
 
     Args:
-        rows: The results rows (``results.results_rows``).
+        rows: The results rows (``results.results_rows``); a ValueError without one.
         task_names: The suite's task names, in task-index order.
         folder: Where the figures and ``report.md`` go.
         levels: Success levels of the reach tables and figures.
-        unfinished: One line per unfinished run (``RunProgress.describe``); the report then says it
-            is interim and lists them.
-        verification: One line per run left out for failing verification or read from unverified
-            records; the report lists them.
-
-    Raises:
-        ValueError: If there is no row.
+        unfinished: One line per unfinished run; the report then says it is interim and lists them.
+        verification: One line per run left out for failing verification or read unverified.
     """
     if not rows:
         raise UserError("No evaluated round in these experiments: nothing to report.")

@@ -1,12 +1,9 @@
 """Loading policy folders safely: a checkpoint never names Python code to import.
 
-LeRobot's processor loader (``DataProcessorPipeline.from_pretrained``) builds every step of
-``policy_preprocessor.json`` / ``policy_postprocessor.json`` either from LeRobot's step registry
-(``"registry_name"``) or by importing and calling any ``"class"`` the file names: a folder with
-``{"class": "os.system", ...}`` runs a shell command when it is loaded. ``check_policy_folder``
-refuses such a folder before LeRobot reads it, unless the user says the checkpoint is trusted: every
-step must name a registered processor step and nothing else. The weights are safetensors and the
-policy config resolves its ``type`` through LeRobot's config registry, so neither can run code.
+LeRobot's processor loader builds each step of ``policy_preprocessor.json`` and
+``policy_postprocessor.json`` from its registry or by importing any ``"class"`` the file names
+(``{"class": "os.system", ...}`` runs a command on load). Unless the checkpoint is trusted, every
+step must name a registered processor step.
 """
 
 from __future__ import annotations
@@ -38,11 +35,7 @@ class UntrustedCheckpointError(UserError):
 
 
 def check_processor_config(path: Path) -> None:
-    """Refuses a processor config whose steps are not all LeRobot registry names.
-
-    Raises:
-        UntrustedCheckpointError: Naming the file, the step and what it asks for.
-    """
+    """Refuses a processor config whose steps are not all LeRobot registry names, naming file and step."""
     try:
         config = json.loads(Path(path).read_text())
     except json.JSONDecodeError as error:
@@ -70,11 +63,7 @@ def check_processor_config(path: Path) -> None:
 
 
 def check_policy_folder(folder: Path) -> None:
-    """Checks the processor configs of a local policy folder (those it has).
-
-    Raises:
-        UntrustedCheckpointError: If a processor config names code to import.
-    """
+    """Checks the processor configs a local policy folder has (``UntrustedCheckpointError``)."""
     for name in PROCESSOR_FILES:
         path = Path(folder) / name
         if path.is_file():
@@ -82,11 +71,7 @@ def check_policy_folder(folder: Path) -> None:
 
 
 def check_hub_policy(repo_id: str) -> None:
-    """Downloads (into the Hub cache LeRobot reads from) and checks a Hub policy's processor configs.
-
-    Raises:
-        UntrustedCheckpointError: If a processor config names code to import.
-    """
+    """Downloads (into LeRobot's Hub cache) and checks a Hub policy's processor configs."""
     from huggingface_hub import hf_hub_download
 
     for name in PROCESSOR_FILES:
@@ -99,11 +84,7 @@ def is_hub_id(path: str) -> bool:
 
 
 def check_policy_path(path: str | Path) -> None:
-    """Refuses a policy path that is neither a loadable local policy folder nor a Hub id.
-
-    Raises:
-        UserError: Naming the path (or the file in it) at fault and what to pass instead.
-    """
+    """Refuses a path that is neither a loadable policy folder nor a Hub id (``UserError`` naming the fix)."""
     folder = Path(path)
     if folder.exists():
         check_local_policy(folder)
@@ -115,14 +96,7 @@ def check_policy_path(path: str | Path) -> None:
 
 
 def check_local_policy(folder: Path) -> None:
-    """Checks that a local folder is a complete policy of a student's type with readable safetensors files.
-
-    The types are ``student_types.student_policy_types()``: the built-in students' and those registered.
-
-    Raises:
-        UserError: If it is a file, a dataset, an experiment, another policy type, or a file of it is
-            missing or unreadable, naming it.
-    """
+    """Checks that a folder is a complete policy of a student's type, its files readable (``UserError``)."""
     if not folder.is_dir():
         raise UserError(f"{folder} is a file: --policy_path takes a policy folder or a Hub id owner/name.")
     if (folder / "policies").is_dir():
@@ -173,19 +147,14 @@ def load_policy(
 ) -> tuple[Any, Any, Any]:
     """Loads a policy folder or Hub id (a student's type) with its saved processors, after the checks above.
 
-    Args:
-        path: A local policy folder or a Hub repo id.
-        device: Torch device.
-        trust_checkpoint: Let the processor configs name Python classes to import (LeRobot's
-            loader imports and calls them); otherwise every step must be a LeRobot registry name.
+    ``trust_checkpoint`` lets the processor configs name Python classes to import.
 
     Returns:
         The policy (in eval mode, on ``device``), its pre-processor and its post-processor.
 
     Raises:
         UntrustedCheckpointError: If a processor config names code and the checkpoint is not trusted.
-        UserError: If the path is not a complete ``mtdagger`` policy folder or a reachable Hub
-            policy, naming the path or file and the fix.
+        UserError: If the path is not a complete policy folder or a reachable Hub policy.
     """
     check_policy_path(path)
     if Path(path).exists():

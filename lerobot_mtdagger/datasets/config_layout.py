@@ -1,12 +1,7 @@
 """The layout of a stored run config: its options by dotted path.
 
-``lerobot-mtdagger run`` groups its options (``RunConfig``): ``suite`` (the suite and its
-observations, shared with ``eval``, ``shift`` and the LeRobot env plugin), ``dagger`` (rounds, demo
-budgets, beta), ``rollout`` (episode cuts, evaluation episodes, env workers), ``training``
-(steps, sampling, held-out split), ``policy`` and ``scheduler``. A config stored by an earlier
-version is first read through ``migrations.migrate_run_config`` (``migrations.stored_option`` reads one
-option of a stored config in either layout), so every reader (resume, results, the Hub card) sees one
-layout; this module knows only today's.
+A config stored by an earlier version is first read through ``migrations.migrate_run_config``, so
+every reader sees today's layout, the only one this module knows.
 """
 
 from __future__ import annotations
@@ -42,8 +37,5 @@ RESULT_NEUTRAL_OPTIONS: tuple[str, ...] = (
 
 
 def result_options(config: Mapping[str, Any], ignore: Sequence[str]) -> dict[str, Any]:
-    """A run config's leaves by dotted path, without the options in ``ignore`` (compared on resume).
-
-    ``config`` is in today's layout (a stored one through ``migrations.migrate_run_config`` first).
-    """
+    """A run config's leaves by dotted path (today's layout), without the options in ``ignore``."""
     return {key: value for key, value in flatten(config).items() if key not in ignore}

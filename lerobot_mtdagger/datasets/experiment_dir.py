@@ -8,24 +8,18 @@ Layout of an experiment directory::
         rounds/
             round-000/               LeRobotDataset v3.0 of round 0 (expert demonstrations)
                 meta/mtdagger.json   the round's record (allocation, Kalman state, ...): the truth
-                meta/info.json       ... "mtdagger": a mirror of it on LeRobot 0.4 only (0.6 warns)
+                meta/info.json       ... "mtdagger": a mirror of it on LeRobot 0.4 only
             round-001/               LeRobotDataset of round 1 (DAgger rollouts, expert labels)
             .staging/round-002/      a round being written: never read, deleted on resume
         policies/
             round-000/               policy trained on rounds 0..0 (LeRobot pretrained model +
                                      processors) and training.json (per-task losses, gain, eval)
             .staging/round-001/      a training phase being written
-            .progress/round-001.pt   its progress, saved every few minutes: kept on resume, which
-                                     goes on from it (runner.training.phase_progress); deleted at commit
+            .progress/round-001.pt   its progress, saved every few minutes; a resume goes on from it
 
-A round or training phase is committed by an atomic rename of its finished staging folder; anything
-cut off half-way stays in ``.staging`` and is discarded, so a committed round is immutable and
-complete. Every round dataset carries the experiment's full task vocabulary in the same order
-(``meta.save_episode_tasks(task_names)`` right after creation), so task_index i is the same task in
-every round and in merged datasets.
-
-A round is written in one go by :meth:`ExperimentDir.write_round` with the fast writer of
-``lerobot_mtdagger.datasets.round_writer``.
+A round or phase is committed by an atomic rename of its finished staging folder, so a committed
+round is immutable and complete. Every round holds the experiment's full task vocabulary in the same
+order, so task_index i is the same task in every round and in merged datasets.
 """
 
 from __future__ import annotations
@@ -81,8 +75,7 @@ EXPERT_CHECK_FILE = "expert_check.json"
 
 STATS_FILE = "meta/stats.json"
 INFO_FILE = "meta/info.json"
-"""LeRobot's dataset info; its ``mtdagger`` key mirrors the round's record (rounds written before the
-record had a file of its own hold it only there)."""
+"""LeRobot's dataset info; its ``mtdagger`` key mirrors the round's record (or holds the only copy)."""
 
 RECORD_FILE = "meta/mtdagger.json"
 """The round's record, in a file LeRobot never rewrites: readers and ``verify`` take it as the truth."""
@@ -99,14 +92,12 @@ DATASET_FPS = 80
 
 VIDEO_BACKEND = "pyav"
 """The decoder named when a round is created: rounds hold no video, and naming one keeps LeRobot >= 0.5
-from probing torchcodec, which logs a multi-line warning per dataset where FFmpeg's libraries are absent."""
+from probing torchcodec (a warning per dataset where FFmpeg's libraries are absent).
+"""
 
 
 def writer_lock_holder(root: Path) -> str | None:
-    """Who holds ``root``'s writer lock (``ExperimentDir.writer_lock``): its pid, or None if nobody does.
-
-    Probes the lock with a shared, non-blocking ``flock`` released at once, without creating anything.
-    """
+    """Who holds ``root``'s writer lock: its pid, or None (probed without creating anything)."""
     path = root / LOCK_FILE
     if not path.is_file():
         return None
@@ -136,9 +127,8 @@ def write_json_atomic(path: Path, payload: Any) -> None:
 def write_record_files(root: Path, record: dict[str, Any]) -> None:
     """Writes a dataset's record (``meta/mtdagger.json``) and, on LeRobot 0.4, its ``meta/info.json`` mirror.
 
-    LeRobot 0.6 warns of any key of ``info.json`` it does not know on every load, so there the mirror is
-    left out (and one copied from an older round removed). Each file is written anew
-    (``write_json_atomic``), so a hard link to the former file is left intact.
+    Each file is written anew (a hard link to the former one is left intact); LeRobot 0.6, which warns
+    of unknown ``info.json`` keys, gets no mirror.
     """
     info_path = root / INFO_FILE
     info = json.loads(info_path.read_text())
@@ -151,11 +141,7 @@ def write_record_files(root: Path, record: dict[str, Any]) -> None:
 
 
 def read_committed_json(path: Path, fix: str) -> Any:
-    """Reads a JSON file of a committed round or phase.
-
-    Raises:
-        CorruptExperimentError: Naming the file, what is wrong and ``fix``.
-    """
+    """Reads a JSON file of a committed round or phase (``CorruptExperimentError`` naming it and ``fix``)."""
     try:
         return json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as error:
@@ -163,9 +149,9 @@ def read_committed_json(path: Path, fix: str) -> Any:
 
 
 def fill_added_options(stored: dict[str, Any], given: Mapping[str, Any], added: Mapping[str, Any]) -> None:
-    """Gives ``stored`` each option of ``added`` it lacks where ``given`` holds that default.
+    """Gives ``stored`` each option of ``added`` it lacks where ``given`` holds that option's former value.
 
-    ``added`` maps an option's dotted path to what it was before it existed.
+    ``added`` maps an option's dotted path to its value before the option existed.
     """
     for key, default in added.items():
         if key in given and key not in stored and given[key] == default:
@@ -196,21 +182,13 @@ def _only(frame: Mapping[str, Any], features: Mapping[str, Any]) -> dict[str, An
 
 
 def round_record_from_info(path: Path, info_path: Path) -> RoundRecord:
-    """The round record mirrored under ``mtdagger`` in a round's LeRobot ``info.json`` at ``info_path``.
-
-    Raises:
-        CorruptExperimentError: If the file is unreadable or holds no committed record.
-    """
+    """The round record mirrored under ``mtdagger`` in ``info_path`` (``CorruptExperimentError`` if none)."""
     info = read_committed_json(info_path, "restore it, or move the round out of the experiment directory")
     return round_record_from(info.get(RECORD_KEY) if isinstance(info, dict) else None, path, info_path)
 
 
 def round_record_from(record: Any, path: Path, info_path: Path) -> RoundRecord:
-    """The committed round record ``record`` read from ``info_path`` (for the round at ``path``).
-
-    Raises:
-        CorruptExperimentError: If it is not a record of this format, or not committed.
-    """
+    """The committed round record ``record`` from ``info_path`` (``CorruptExperimentError`` if not one)."""
     if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
         raise CorruptExperimentError(
             f"{path} is not a lerobot-mtdagger round (no '{RECORD_KEY}' record of format "
@@ -224,11 +202,7 @@ def round_record_from(record: Any, path: Path, info_path: Path) -> RoundRecord:
 
 
 def committed_into_ledger(path: Path) -> bool:
-    """Whether a record file says it was committed into the experiment's ledger (unreadable: False).
-
-    ``path`` is a round's ``meta/mtdagger.json`` (or ``meta/info.json``, whose ``mtdagger`` key holds the
-    record in older rounds) or a phase's ``training.json``.
-    """
+    """Whether a record file says it was committed into the experiment's ledger (unreadable: False)."""
     try:
         values = json.loads(Path(path).read_text())
     except (OSError, json.JSONDecodeError):
@@ -239,10 +213,9 @@ def committed_into_ledger(path: Path) -> bool:
 
 
 class ExperimentDir:
-    """The on-disk state of one experiment (see the module docstring for the layout)."""
+    """The on-disk state of one experiment at ``root`` (see the module docstring for the layout)."""
 
     def __init__(self, root: Path) -> None:
-        """Points at ``root`` (nothing is created)."""
         self.root = Path(root)
         self.rounds = self.root / ROUNDS_DIR
         self.policies = self.root / POLICIES_DIR
@@ -256,11 +229,7 @@ class ExperimentDir:
         return self.root.exists() and any(self.root.iterdir())
 
     def initialise(self, config: dict[str, Any], extra: Mapping[str, Any] | None = None) -> None:
-        """Creates the experiment atomically: built beside ``root``, then renamed onto it.
-
-        A start that fails before the rename leaves nothing at ``root``; after it, ``root`` holds
-        the config, the ``extra`` JSON files (file name -> content; e.g. ``expert_check.json``) and
-        empty ``rounds/`` and ``policies/``, a folder ``--resume=true`` continues.
+        """Creates the experiment (``extra``: JSON files by name) beside ``root``, then renames it there.
 
         Raises:
             UserError: If the directory exists and is not empty.
@@ -287,12 +256,7 @@ class ExperimentDir:
 
     @contextlib.contextmanager
     def writer_lock(self, record_pid: bool = True) -> Iterator[None]:
-        """Holds the folder's writer lock: one run writes into an experiment at a time.
-
-        The lock is an OS lock (``flock``) on ``<root>/.lock``, released when the process exits,
-        however it exits (a run killed with SIGKILL leaves no stale lock). The file holds the pid
-        of the writer, for the message a second writer gets; a resume of a finished run, which
-        writes nothing, leaves it as it is (``record_pid=False``).
+        """Holds the writer lock (``flock`` on ``<root>/.lock``, holding the pid): one writer at a time.
 
         Raises:
             ExperimentLockedError: At once, if another process holds the lock, naming it.
@@ -321,15 +285,10 @@ class ExperimentDir:
         ignore: Sequence[str] = RESULT_NEUTRAL_OPTIONS,
         added_defaults: Mapping[str, Any] | None = None,
     ) -> None:
-        """Checks that ``root`` holds an experiment started with the same config.
+        """Checks that ``root`` holds an experiment started with the same config, option by option.
 
-        Both configs are compared option by option (dotted paths, the stored one migrated to today's
-        layout). Options in ``ignore`` never change a result, so they may differ from the stored
-        config. So may a larger ``dagger.rounds`` of a DAgger run: no round depends on how many
-        follow it, so the run is extended (``extend_rounds``) and its rounds so far are those of a
-        run started with the larger number. An option the stored config lacks (added to the toolkit
-        after the run started) matches when ``config`` gives it its default in ``added_defaults``
-        (by dotted path): a new option's default keeps the behaviour the run was made with.
+        May differ: options in ``ignore``; a larger ``dagger.rounds`` of a DAgger run (``extend_rounds``);
+        an option the stored config lacks, given its default in ``added_defaults`` (by dotted path).
 
         Raises:
             NotAnExperimentError: If there is no experiment to resume.
@@ -358,11 +317,7 @@ class ExperimentDir:
             )
 
     def extend_rounds(self, rounds: int) -> None:
-        """Raises the stored ``dagger.rounds`` of a DAgger run to ``rounds`` (nothing if not larger).
-
-        Call it after ``check_resumable`` accepted the config, with the writer lock held. The config
-        is written back in today's layout.
-        """
+        """Raises the stored ``dagger.rounds`` to ``rounds`` (after ``check_resumable``, lock held)."""
         config = self.read_config()
         stored = config["dagger"]["rounds"]
         if rounds > stored:
@@ -371,11 +326,7 @@ class ExperimentDir:
             write_json_atomic(self.root / CONFIG_FILE, config)
 
     def read_config(self) -> dict[str, Any]:
-        """The run config stored in the experiment, in today's layout (``migrate_run_config``).
-
-        Raises:
-            NotAnExperimentError: If ``root`` holds no readable ``config.json``.
-        """
+        """The stored run config in today's layout (``NotAnExperimentError`` if there is no readable one)."""
         config_path = self.root / CONFIG_FILE
         if not self.root.is_dir():
             raise NotAnExperimentError(
@@ -393,11 +344,7 @@ class ExperimentDir:
             raise CorruptExperimentError(f"{config_path} is unreadable ({error}).") from None
 
     def check_committed_files(self) -> None:
-        """Refuses to go on from an experiment whose committed files changed after commit.
-
-        Raises:
-            CorruptExperimentError: Naming every changed, missing or added file and the fix.
-        """
+        """Refuses an experiment whose committed files changed (``CorruptExperimentError`` naming each)."""
         problems = []
         for round_index in self.committed_rounds():
             problems += self.round_file_problems(self.read_round_record(round_index))
@@ -431,10 +378,7 @@ class ExperimentDir:
         return digest_mismatches(self.policy_root(record.round), record.files, exclude=(TRAINING_FILE,))
 
     def clear_staging(self) -> None:
-        """Deletes everything that was being written when a run was cut off.
-
-        A phase's saved progress is kept (the phase goes on from it), but for phases committed since.
-        """
+        """Deletes what was being written when a run was cut off (a phase's saved progress is kept)."""
         for parent in (self.rounds, self.policies):
             staging = parent / STAGING_DIR
             if staging.exists():
@@ -452,12 +396,7 @@ class ExperimentDir:
         return self.rounds / round_name(round_index)
 
     def committed_rounds(self) -> list[int]:
-        """Indices of the committed rounds, ascending.
-
-        Raises:
-            UserError: If a round folder is not a committed round of this format (a foreign or
-                corrupt dataset in the output directory).
-        """
+        """Indices of the committed rounds, ascending (``UserError`` on a folder that is not one)."""
         indices = []
         if not self.rounds.exists():
             return indices
@@ -473,14 +412,7 @@ class ExperimentDir:
 
     @staticmethod
     def read_round_record_at(path: Path) -> RoundRecord:
-        """The ``mtdagger`` record of the round dataset at ``path``.
-
-        Read from ``meta/mtdagger.json``, or, for a round written before that file existed, from
-        ``meta/info.json``.
-
-        Raises:
-            CorruptExperimentError: If ``path`` holds no readable round record.
-        """
+        """The record of the round at ``path`` (``CorruptExperimentError`` if it holds no readable one)."""
         if (path / RECORD_FILE).is_file():
             fix = "restore it, or move the round out of the experiment directory"
             return round_record_from(read_committed_json(path / RECORD_FILE, fix), path, path / RECORD_FILE)
@@ -521,20 +453,14 @@ class ExperimentDir:
     ) -> LeRobotDataset:
         """Creates a round dataset in staging and writes all its episodes in one go.
 
-        Equivalent to :meth:`create_round` followed by ``add_frame`` for every frame and
-        ``save_episode`` after every episode, but much cheaper (see :func:`write_round_episodes`).
-        Commit the returned dataset with :meth:`commit_round`; add nothing more to it.
+        As :meth:`create_round` and ``add_frame``/``save_episode`` per frame and episode would, but much
+        cheaper. Commit the returned (not finalised) dataset with :meth:`commit_round`.
 
         Args:
             round_index: Index of the round.
             features: The round's LeRobot features (``records.round_features``).
             task_names: The experiment's task vocabulary, in task-index order.
-            episodes: ``(task, frames)`` per episode, in the order they are stored; each frame maps
-                every non-default feature to its value (as for ``LeRobotDataset.add_frame``, without
-                ``task``).
-
-        Returns:
-            The staged dataset, all episodes written (not finalised).
+            episodes: ``(task, frames)`` per episode; a frame maps each non-default feature to its value.
 
         Raises:
             ValueError: If a frame does not match the features or an episode has no frame.
@@ -547,21 +473,13 @@ class ExperimentDir:
         return dataset
 
     def round_features(self, suite_features: dict[str, Any]) -> dict[str, Any]:
-        """The features of this experiment's next round (``records.round_features``).
-
-        With the provenance columns, unless round 0 was written without them: an experiment started
-        before they existed keeps one schema.
-        """
+        """The features of the next round: with provenance columns unless round 0 has none (one schema)."""
         first = self.round_root(0) / INFO_FILE
         provenance = not first.is_file() or has_provenance(json.loads(first.read_text())["features"])
         return round_features(suite_features, provenance=provenance)
 
     def commit_round(self, round_index: int, dataset: LeRobotDataset, record: RoundRecord) -> Path:
-        """Finalises a staged round, writes its record (its file and info.json's mirror), commits it.
-
-        Raises:
-            FileExistsError: If the round is already committed (a committed round is immutable).
-        """
+        """Finalises a staged round, writes its record files and commits it (``FileExistsError`` if done)."""
         final = self.round_root(round_index)
         if final.exists():
             raise FileExistsError(f"Round {round_index} is already committed at {final}; it is immutable.")
@@ -632,11 +550,7 @@ class ExperimentDir:
     # ---------------------------------------------------------------------------------------------
 
     def committed_record_files(self) -> list[Path]:
-        """Every committed record file, in commit order (round k's record, then phase k's).
-
-        Found by folder name alone (``round-XXX`` with a record file), without reading any record:
-        the other checks of a round's record are ``committed_rounds``' and ``verify``'s.
-        """
+        """Every committed record file, in commit order (round k's, then phase k's), found by folder name."""
         rounds = {int(p.name.split("-")[1]) for p in self.rounds.glob("round-*") if p.is_dir()}
         rounds = {k for k in rounds if any((self.round_root(k) / f).is_file() for f in RECORD_FILES)}
         phases = set(self.committed_phases())
@@ -654,12 +568,7 @@ class ExperimentDir:
         Ledger(self.root).append(self.committed_record_files(), write_json_atomic)
 
     def ledger_problems(self, resuming: bool = False) -> list[str]:
-        """Records that differ from the ledger.
-
-        Args:
-            resuming: Accept what a resume mends: the last records deleted to be redone, and records
-                committed by a run cut off before it reached the ledger.
-        """
+        """Records that differ from the ledger, less what a resume mends when ``resuming``."""
         records = self.committed_record_files()
         ledger = Ledger(self.root)
         if not ledger.exists():
@@ -668,11 +577,7 @@ class ExperimentDir:
         return [p for p in problems if "is committed but not in" not in p] if resuming else problems
 
     def _missing_ledger_problems(self, records: Sequence[Path], resuming: bool) -> list[str]:
-        """A missing ledger, named when a record says it was committed into one (else none).
-
-        A resume accepts the one case a cut-off leaves: the experiment's first record, committed just
-        before the ledger was started (the resume starts it).
-        """
+        """A missing ledger, named when a record says it was committed into one."""
         ledgered = [path for path in records if committed_into_ledger(path)]
         if not ledgered or (resuming and ledgered == list(records[-1:]) and len(records) == 1):
             return []
@@ -683,21 +588,14 @@ class ExperimentDir:
         ]
 
     def ledger_note(self) -> str | None:
-        """One line for an experiment made before ledgers (no ledger, no record written into one), else None.
-
-        Its records are checked against their files only; its first resume starts its ledger.
-        """
+        """A note for an experiment with no ledger and no record committed into one, else None."""
         records = self.committed_record_files()
         if not records or Ledger(self.root).exists() or any(committed_into_ledger(p) for p in records):
             return None
         return pre_ledger_note(self.root, LEDGER_FILE)
 
     def read_phase_record(self, round_index: int) -> PhaseRecord:
-        """The training record of a committed phase.
-
-        Raises:
-            CorruptExperimentError: If the record is unreadable.
-        """
+        """The training record of a committed phase (``CorruptExperimentError`` if unreadable)."""
         path = self.policy_root(round_index) / TRAINING_FILE
         fix = f"delete policies/{round_name(round_index)} and every later phase, and resume to retrain them"
         values = read_committed_json(path, fix)
@@ -708,32 +606,23 @@ SAVED_RECORD_FILE = "mtdagger.json"
 """A round's ``meta/mtdagger.json`` where the saved records keep it (``rounds/<round>/``)."""
 
 SAVED_INFO_FILE = "info.json"
-"""A round's ``meta/info.json`` where the saved records of a round without ``mtdagger.json`` keep it."""
+"""A round's ``meta/info.json`` where the saved records keep it (rounds without ``mtdagger.json``)."""
 
 
 class SavedRunRecords(ExperimentDir):
     """A run's small JSON records, saved apart from its datasets and weights, read as a run is read.
 
-    The layout ``lerobot-mtdagger records --action=save`` writes, so that a study's numbers outlive
-    their run folders::
+    The layout ``lerobot-mtdagger records --action=save`` writes; enough to report the run, not to
+    verify, resume, merge or push it::
 
         <run>/config.json                       the run's options
-        <run>/rounds/round-000/mtdagger.json    the round's record (meta/mtdagger.json), or, for a
-                                                round written before that file, info.json (its "mtdagger")
+        <run>/rounds/round-000/mtdagger.json    the round's record (or info.json with it)
         <run>/policies/round-000/training.json  the phase's training record, evaluation included
-
-    Enough to tabulate and report the run (``analysis.results``), not to verify, resume, merge or push
-    it: there are no frames and no weights. A round's frames are known only in total (the record's
-    ``frames``), not per task.
     """
 
     @staticmethod
     def read_round_record_at(path: Path) -> RoundRecord:
-        """The record of the saved round at ``path`` (its ``mtdagger.json``, else its ``info.json``).
-
-        Raises:
-            CorruptExperimentError: If ``path`` holds no readable committed record.
-        """
+        """The record of the saved round at ``path`` (``CorruptExperimentError`` if none is readable)."""
         if (path / SAVED_RECORD_FILE).is_file():
             fix = "save the run's records again"
             record = read_committed_json(path / SAVED_RECORD_FILE, fix)
@@ -754,13 +643,7 @@ def open_run(root: Path) -> ExperimentDir:
 
 
 def sort_stats_file(root: Path) -> None:
-    """Rewrites a dataset's ``meta/stats.json`` with sorted keys: a round's bytes are reproducible.
-
-    LeRobot aggregates statistics over a set of feature names, so the file's key order follows
-    Python's per-process string hashing: two identical rounds would differ byte for byte, and the
-    sha256 of a round (and a kill-and-resume run against an uninterrupted one) could not be compared.
-    The content is unchanged; readers look keys up by name.
-    """
+    """Rewrites ``meta/stats.json`` with sorted keys, so a round's bytes are reproducible."""
     path = root / STATS_FILE
     if path.is_file():
         stats = json.loads(path.read_text())
@@ -773,17 +656,7 @@ RENUMBERED_COLUMNS = ("episode_index", "index", "task_index")
 
 @contextlib.contextmanager
 def _data_files_merged_in_arrow(features: Mapping[str, Mapping[str, Any]]) -> Iterator[None]:
-    """Lets LeRobot 0.4's ``aggregate_datasets`` merge data files with multi-dimensional features.
-
-    Without images, ``aggregate_data`` reads each data file into pandas and writes it back with
-    ``DataFrame.to_parquet``, which fails on a 2-D feature such as an (N, 3) point cloud ("Conversion
-    failed for column observation.pointcloud"). While this context is open, the data files of such a
-    dataset are merged in Arrow instead (``_append_data_file``): the source file's own table, with
-    the index columns LeRobot renumbered taken from its DataFrame. Metadata files are unchanged.
-
-    Args:
-        features: The datasets' LeRobot features (every round has the same).
-    """
+    """Lets LeRobot 0.4's ``aggregate_datasets`` merge data files with 2-D features, in Arrow."""
     from lerobot.datasets import aggregate
     from lerobot.datasets.utils import DEFAULT_DATA_PATH
 
@@ -812,16 +685,8 @@ def _append_data_file(
 ) -> tuple[dict[str, int], tuple[int, int]]:
     """``append_or_create_parquet_file`` for data files, in Arrow (same file rotation rule).
 
-    Args:
-        df: The source file's frames as LeRobot renumbered them (``RENUMBERED_COLUMNS`` are taken).
-        src_path: The source data file.
-        idx: The destination's current ``chunk`` and ``file`` (updated on rotation).
-        max_mb: Size at which a destination file is closed.
-        chunk_size: Files per chunk.
-        path_format: Destination path with ``{chunk_index}`` and ``{file_index}``.
-
     Returns:
-        ``idx`` and the (chunk, file) the frames were written to.
+        ``idx`` (the destination's ``chunk`` and ``file``, updated) and the (chunk, file) written to.
     """
     table = pq.read_table(src_path)
     for name in RENUMBERED_COLUMNS:
@@ -848,16 +713,10 @@ def merge_rounds(
     repo_id: str = "local/merged",
     unverified: Sequence[str] = (),
 ) -> Path:
-    """Merges round datasets into ONE LeRobotDataset with LeRobot's own aggregation.
+    """Merges round datasets into one LeRobotDataset with LeRobot's own aggregation, task indices kept.
 
-    Task indices are preserved: every round holds the full vocabulary in the same order. The merged
-    dataset gets a ``mtdagger`` record listing the merged rounds' records (``meta/mtdagger.json``,
-    mirrored in meta/info.json). ``unverified``: the verification problems the caller chose to read past
-    (``merge --unverified=true``), listed in that record under ``unverified``; without them a round whose
-    files changed after commit is refused.
-
-    The merge is written beside ``output`` and renamed onto it when complete, so a merge that stops
-    half-way leaves no ``output`` (and a re-run starts clean).
+    Its ``mtdagger`` record lists the rounds' records and ``unverified`` (problems the caller read
+    past). It is written beside ``output`` and renamed onto it when complete.
 
     Raises:
         UserError: If ``output`` exists.

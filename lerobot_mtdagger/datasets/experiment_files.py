@@ -1,9 +1,4 @@
-"""Names of an experiment folder's files and folders (the layout ``datasets.experiment_dir`` makes).
-
-In a module that imports nothing, so that readers of saved records (``analysis.saved_records`` and the
-studies' table scripts) need not import LeRobot and torch, as ``experiment_dir`` does, to know a file's
-name.
-"""
+"""Names of an experiment folder's files and folders, in a module that imports nothing (no LeRobot)."""
 
 from __future__ import annotations
 

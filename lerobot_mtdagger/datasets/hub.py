@@ -1,23 +1,10 @@
 """Pushing a Multitask DAgger experiment to the Hugging Face Hub, one git revision per round.
 
-Every committed round ``DIR/rounds/round-XXX`` is a standalone LeRobotDataset. Round k is uploaded to the
-dataset repo as one commit that holds exactly round k's dataset files plus a dataset card (``README.md``)
-covering rounds 0..k, and that commit is tagged ``round-{k:03d}``: ``LeRobotDataset(repo_id,
-revision="round-002")`` loads round 2, and ``main`` ends at the last pushed round. Every committed training
-phase ``DIR/policies/round-XXX`` (a LeRobot pretrained model) is pushed to an optional model repo and tagged
-the same way, so ``revision="round-002"`` there is the policy trained on rounds 0..2.
-
-Uploads use ``HfApi.upload_folder`` with ``delete_patterns`` scoped to the dataset (``data/``, ``meta/``,
-``videos/``) or to the model files (``*.json``, ``*.safetensors``), so files of an earlier round that the
-next round does not have vanish from the next commit; other files a user added to the repo (and the Hub's
-``.gitattributes``, which ``delete_patterns`` never removes) are kept. The round folders themselves are never
-written to: committed rounds are immutable, and the card is added through a temporary folder of symlinks.
-
-Re-pushing an experiment (for example after resuming it with more rounds) is allowed: every round is uploaded
-again in order and new rounds get their tags. ``create_tag(..., exist_ok=True)`` leaves an existing tag where
-it is (the Hub does not move it), so the tag of an already pushed round keeps pointing at its first commit,
-which holds the same files since committed rounds are immutable and the card of round k only depends on
-rounds 0..k. The Hub skips an upload that changes nothing and returns the current head instead.
+Round k is one commit of the dataset repo holding exactly round k's files and a card (``README.md``)
+of rounds 0..k, tagged ``round-{k:03d}``: ``LeRobotDataset(repo_id, revision="round-002")`` loads
+round 2. Training phase k goes to an optional model repo, tagged the same way. Other files in the
+repos are kept. Re-pushing is allowed: an existing tag stays on its first commit, which holds the
+same files, since committed rounds never change.
 """
 
 from __future__ import annotations
@@ -102,13 +89,7 @@ def allocation_table(task_names: Sequence[str], records: Sequence[RoundRecord]) 
 
 
 def eval_table(task_names: Sequence[str], evals: dict[int, dict[str, Any] | None]) -> str:
-    """Success per task (rows) of the policy trained on rounds 0..k (columns), with a mean row.
-
-    Args:
-        task_names: The task vocabulary.
-        evals: Round index -> the ``eval`` entry of that training phase's record (None where the phase is
-            missing or was not evaluated).
-    """
+    """Success per task (rows) of the policy of rounds 0..k (columns, from ``evals``), with a mean row."""
     if not any(evals.values()):
         return "No evaluation was recorded for these rounds."
     rounds = sorted(evals)
@@ -138,20 +119,7 @@ def _phase_eval(experiment: ExperimentDir, round_index: int) -> dict[str, Any] |
 
 
 def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: int | None = None) -> str:
-    """Fills the dataset-card template for the experiment's rounds 0..``up_to_round``.
-
-    Args:
-        experiment: The experiment directory.
-        repo_id: The Hub dataset repo the card is for.
-        up_to_round: Last round the card describes, i.e. the round held by the revision the card is
-            pushed with (None: the last committed round).
-
-    Returns:
-        The card's markdown, with YAML front matter.
-
-    Raises:
-        ValueError: If the experiment has no committed round or ``up_to_round`` is not committed.
-    """
+    """The dataset card of ``repo_id`` for rounds 0..``up_to_round`` (None: all; ValueError if absent)."""
     committed = experiment.committed_rounds()
     if not committed:
         raise UserError(f"{experiment.root} has no committed round to describe.")
@@ -191,15 +159,7 @@ def render_dataset_card(experiment: ExperimentDir, repo_id: str, up_to_round: in
 
 @contextlib.contextmanager
 def folder_with_card(folder: Path, card: str) -> Iterator[Path]:
-    """A temporary folder mirroring ``folder`` through file symlinks, plus ``README.md`` holding ``card``.
-
-    ``folder`` is never written to. Files are symlinked one by one (``upload_folder`` lists files with
-    ``Path.glob("**/*")``, which does not descend into symlinked directories) and copied where symlinks are
-    not available. A ``README.md`` of ``folder`` itself is replaced by ``card``.
-
-    Yields:
-        The temporary folder, deleted on exit.
-    """
+    """A temporary folder of file symlinks (or copies) mirroring ``folder``, plus ``card`` as README.md."""
     with tempfile.TemporaryDirectory(prefix="mtdagger-push-") as tmp:
         staged = Path(tmp) / folder.name
         staged.mkdir()
@@ -226,11 +186,7 @@ def upload_and_tag(
     commit_message: str,
     delete_patterns: Sequence[str],
 ) -> str:
-    """Uploads ``folder`` as one commit (deleting remote files matching ``delete_patterns``) and tags it.
-
-    Returns:
-        The commit id that ``tag`` names (or would name, if the tag already existed: it is left as it is).
-    """
+    """Uploads ``folder`` as one commit (deleting remote ``delete_patterns``); returns the tag's commit."""
     info = api.upload_folder(
         repo_id=repo_id,
         repo_type=repo_type,
@@ -288,12 +244,7 @@ def push_phases(api: HfApi, experiment: ExperimentDir, repo_id: str, phases: Seq
 
 
 def _pushable(experiment: ExperimentDir, with_policies: bool) -> tuple[list[int], list[int]]:
-    """The committed rounds (and phases, if wanted) to push, checked before anything is sent.
-
-    Raises:
-        UserError: If the directory is not an experiment, has no committed round, or no committed
-            phase while policies are wanted.
-    """
+    """The committed rounds (and phases, if wanted) to push, checked before anything is sent."""
     if not (experiment.root / CONFIG_FILE).exists():
         raise UserError(
             f"{experiment.root} is not a lerobot-mtdagger experiment (no {CONFIG_FILE}): pass the "
@@ -311,14 +262,7 @@ def _pushable(experiment: ExperimentDir, with_policies: bool) -> tuple[list[int]
 
 
 def check_hub_access(api: HfApi) -> str:
-    """Checks that the Hub answers and accepts the token, before anything is uploaded.
-
-    Returns:
-        The user name the token belongs to.
-
-    Raises:
-        UserError: With no token, a rejected token, or no connection, saying how to fix it.
-    """
+    """The token's user name, once the Hub answers and accepts it (else a ``UserError`` saying the fix)."""
     from huggingface_hub.errors import HfHubHTTPError, LocalTokenNotFoundError
 
     try:
@@ -351,27 +295,20 @@ def push_experiment(
 ) -> dict[str, dict[str, str]]:
     """Pushes every committed round (and optionally every training phase) to the Hub, one tag per round.
 
-    Creates the dataset repo (and the model repo) if needed, then uploads round k, in increasing k, as one
-    commit holding exactly round k's dataset files and the card of rounds 0..k, tagged ``round-{k:03d}``.
-    Training phase k goes to ``policy_repo_id`` tagged ``round-{k:03d}`` likewise. Re-pushing is allowed;
-    see the module docstring for what happens to existing tags.
-
     Args:
         experiment_dir: Output directory of a ``lerobot-mtdagger run``.
-        dataset_repo_id: Hub dataset repo, ``owner/name``.
+        dataset_repo_id: Hub dataset repo, ``owner/name`` (created if needed).
         policy_repo_id: Hub model repo for the trained policies (None: policies are not pushed).
-        private: Whether repos created by this call are private (an existing repo's visibility is
-            left as it is).
+        private: Whether repos created by this call are private.
         api: The Hub client (default: a new ``HfApi()``, authenticated as usual, e.g. by ``HF_TOKEN``).
-        added_defaults: ``RunConfig.option_defaults``, for the verification (as ``verify`` passes it).
+        added_defaults: ``RunConfig.option_defaults``, for the verification.
 
     Returns:
-        ``{"dataset": {tag: commit_id}, "policy": {tag: commit_id}}`` (``policy`` empty when not pushed).
+        ``{"dataset": {tag: commit_id}, "policy": {tag: commit_id}}``.
 
     Raises:
-        UserError: If ``experiment_dir`` is not an experiment, there is nothing to push, it fails
-            verification (``check_before_reading``: a changed file or record, a missing ledger), or the
-            Hub cannot be reached with the token; nothing is sent then.
+        UserError: If there is nothing to push, the experiment fails verification, or the Hub cannot be
+            reached with the token; nothing is sent then.
     """
     from lerobot_mtdagger.datasets.verify import check_before_reading
 

@@ -1,9 +1,7 @@
 """Checksums of committed files: a committed round or policy is immutable, and this proves it.
 
-At commit, every file of a round dataset (except ``meta/info.json``, which holds the record itself)
-and of a policy folder (except ``training.json``, which holds the phase record) is hashed with
-sha256 into the record. ``verify`` and every resume compare the files on disk against them, so a
-truncated, garbled, deleted or added file is named before anything reads it.
+At commit every file of a round dataset or policy folder, but the file holding the record, is
+hashed into the record; ``verify`` and every resume name a truncated, garbled, deleted or added one.
 """
 
 from __future__ import annotations
@@ -25,12 +23,7 @@ def file_sha256(path: Path) -> str:
 
 
 def folder_digests(folder: Path, exclude: Collection[str] = ()) -> dict[str, str]:
-    """sha256 of every file under ``folder`` by its relative POSIX path, sorted.
-
-    Args:
-        folder: The folder to hash.
-        exclude: Relative paths to leave out (the file holding the record).
-    """
+    """sha256 of every file under ``folder`` but ``exclude``, by its relative POSIX path, sorted."""
     folder = Path(folder)
     files = sorted(p for p in folder.rglob("*") if p.is_file())
     relative = [(p.relative_to(folder).as_posix(), p) for p in files]
@@ -40,17 +33,9 @@ def folder_digests(folder: Path, exclude: Collection[str] = ()) -> dict[str, str
 def digest_mismatches(
     folder: Path, recorded: Mapping[str, str], exclude: Collection[str] = (), added_ok: bool = False
 ) -> list[str]:
-    """Files of ``folder`` that differ from the digests recorded at commit.
+    """One message per file of ``folder`` missing, changed or not in ``recorded`` (path -> sha256).
 
-    Args:
-        folder: The committed folder.
-        recorded: Relative path -> sha256, as recorded at commit.
-        exclude: Relative paths that were not hashed.
-        added_ok: Leave files not recorded unnamed (a policy folder outside its experiment, where a Hub
-            download adds ``.gitattributes`` and ``.cache/``).
-
-    Returns:
-        One message per missing, changed or unexpected file, naming its path.
+    ``exclude``: paths not hashed; ``added_ok``: files not recorded are fine (a Hub download adds some).
     """
     folder = Path(folder)
     present = folder_digests(folder, exclude)

@@ -1,24 +1,14 @@
 """The experiment's ledger: a hash chain over every committed record, so an edited number is named.
 
-A round's files and a policy's files are hashed into their records at commit
-(``datasets/integrity.py``), but the records themselves (``rounds/<round>/meta/mtdagger.json``,
-mirrored in ``meta/info.json``, and ``policies/<round>/training.json``) hold the numbers ``report``,
-``compare`` and a resume read: success, allocations, losses. ``ledger.json`` at the experiment's root
-lists every record in commit order with its sha256 and the sha256 of the entry before it, like git's
-commits::
+``ledger.json`` lists every round and phase record in commit order with its sha256 and the hash of
+the entry before it::
 
     {"entries": [
       {"record": "rounds/round-000/meta/mtdagger.json", "sha256": "...", "previous": null},
       {"record": "policies/round-000/training.json", "sha256": "...", "previous": "<entry 0's hash>"},
       ...]}
 
-An edited record no longer matches its entry; an edited entry breaks the chain after it; a ledger
-none of whose entries matches is another's (replaced). ``verify``, every resume and every reader
-(``datasets/verify.py``'s ``check_before_reading``) check it. Every record committed with a ledger says
-so (``ledger: true``), so a deleted ledger is named. An experiment made before the ledger existed has
-none and no record saying so (its records are checked against their files only); the first commit of a
-resumed one starts it with the records it holds then, as they are. A record committed by a run cut off
-before it reached the ledger is added by the next resume.
+``docs/reliability.md`` describes what is checked and when.
 """
 
 from __future__ import annotations
@@ -43,23 +33,18 @@ def entry_hash(entry: dict[str, Any]) -> str:
 
 
 class Ledger:
-    """The hash chain of an experiment folder's committed records."""
+    """The hash chain of the committed records of the experiment at ``root`` (it may not exist yet)."""
 
     def __init__(self, root: Path) -> None:
-        """The ledger of the experiment at ``root`` (it may not exist yet)."""
         self.root = Path(root)
         self.path = self.root / LEDGER_FILE
 
     def exists(self) -> bool:
-        """Whether the experiment has a ledger (one made before the ledger existed has none)."""
+        """Whether the experiment has a ledger."""
         return self.path.is_file()
 
     def entries(self) -> list[dict[str, Any]]:
-        """The entries, in commit order ([] without a ledger).
-
-        Raises:
-            ValueError: If the file is not a ledger.
-        """
+        """The entries, in commit order ([] without a ledger; ValueError if the file is not a ledger)."""
         if not self.exists():
             return []
         try:
@@ -79,12 +64,7 @@ class Ledger:
         return count
 
     def append(self, records: Sequence[Path], write: Any) -> None:
-        """Adds the records (files under ``root``) that the ledger does not list yet, in order.
-
-        Args:
-            records: Record files, in commit order; those already listed are skipped.
-            write: ``write(path, payload)``, an atomic JSON writer.
-        """
+        """Adds the record files (in commit order) not listed yet, written with ``write(path, payload)``."""
         entries = self.entries()
         tail = self.missing_tail(entries)
         if tail:  # the last rounds were deleted to be redone: their entries go, and they are written anew
@@ -105,10 +85,7 @@ class Ledger:
     def problems(self, records: Sequence[Path], deleted_tail_ok: bool = False) -> list[str]:
         """What differs between the committed records and the ledger (nothing without a ledger).
 
-        Args:
-            records: Every committed record file, in commit order.
-            deleted_tail_ok: Accept entries at the end whose records were deleted (the last rounds,
-                deleted so that a resume redoes them; the resume then drops those entries).
+        ``deleted_tail_ok`` accepts entries at the end whose records were deleted for a resume to redo.
         """
         if not self.exists():
             return []

@@ -1,17 +1,7 @@
 """The rules about runs stored by earlier versions of the toolkit: one ordered list of migrations.
 
-Every change that alters what a stored run config holds or means is one ``Migration`` in
-``MIGRATIONS``, oldest first (``docs/changes.md`` describes each). A migration may
-
-- rewrite a stored config into the newer layout (``rewrite``; ``migrate_run_config`` applies every
-  rewrite in order, so every reader sees today's layout),
-- name what an option it added was before it existed (``former_values``: a run stored without the
-  option resumes when it is given that value; ``former_option_values`` gathers them),
-- explain why a resume is refused (``resume_hint``; ``resume_hint`` asks the newest migration first,
-  since the latest change that accounts for the difference is the one to name).
-
-A new change to what runs store appends one migration here; no other module keeps rules about
-older runs.
+Every change to what a stored run config holds or means is one ``Migration`` in ``MIGRATIONS``,
+oldest first (``docs/changes.md`` describes each); no other module keeps rules about older runs.
 """
 
 from __future__ import annotations
@@ -34,14 +24,10 @@ class Migration:
         name: A short identifier.
         since: The date of the change (``docs/changes.md`` has the entry).
         summary: What changed, in one sentence.
-        rewrite: Turns a config stored before the change into the newer layout; it returns a config
-            already in that layout as a copy. None when the layout did not change.
+        rewrite: Turns a config stored before the change into the newer layout (a copy), or None.
         former_values: Options the change added, by dotted path, and the value runs made before had.
-        resume_hint: ``hint(stored_config, differing, stored_options)``: a parenthesised sentence
-            that tells the user how to resume a run made before the change, or ``""`` when the
-            change does not account for the differing options. ``stored_config`` is the stored
-            config in today's layout, ``differing`` the dotted paths that differ, ``stored_options``
-            the stored config's options by dotted path. None when nothing needs saying.
+        resume_hint: ``hint(stored_config, differing, stored_options)`` as for ``resume_hint``: how to
+            resume a run made before the change, or ``""`` when the change does not explain ``differing``.
     """
 
     name: str
@@ -85,23 +71,19 @@ FLAT_OPTION_PATHS: dict[str, str] = {
     "gain_split": "training.gain_split",
     "heldout_fraction": "training.heldout_fraction",
 }
-"""Each option of the flat run config (before the groups) and its path today: the command line names
-the new spelling of an old one from it, and the README's changelog lists it."""
+"""Each option of the flat run config (before the groups) -> its path today."""
 
 RESCALED_PRESETS: dict[str, str] = {
     "metaworld-pixels": "metaworld-pixels-paper",
     "drawers-pointcloud": "drawers-pointcloud-paper",
 }
-"""Presets whose values were scaled to a 2-core CPU -> the preset that keeps the former values. A
-stored config holds the values themselves, so only resuming is affected."""
+"""Presets whose values were scaled to a 2-core CPU -> the preset that keeps the former values."""
 
 PIXELS_FORMER_VALUES: tuple[tuple[str, dict[str, Any]], ...] = (
     ("2026-11-27", {"training.sampling": "uniform"}),
     ("2026-11-29", {"training.steps_rule": "fixed", "training.epochs": 100.0}),
 )
-"""``metaworld-pixels``' later values, by the date they changed -> what runs made before had: the
-preset samples ``balanced`` since 2026-11-27 (DAgger runs since 2026-11-26), and its DAgger phases
-make 10 passes (``epochs``) since 2026-11-29."""
+"""``metaworld-pixels``' changed values, by the date they changed -> what runs made before had."""
 
 
 def is_flat(config: Mapping[str, Any]) -> bool:
@@ -110,10 +92,7 @@ def is_flat(config: Mapping[str, Any]) -> bool:
 
 
 def group_flat_options(config: Mapping[str, Any]) -> dict[str, Any]:
-    """A flat stored config's options moved into their groups (a grouped config: a copy).
-
-    An option the flat config lacks (it was added later) stays absent, as it was absent before.
-    """
+    """A flat stored config's options moved into their groups (a grouped config: a copy)."""
     if not is_flat(config):
         return copy.deepcopy(dict(config))
     grouped: dict[str, Any] = {}
@@ -152,11 +131,7 @@ def rescaled_preset_hint(
 def pixels_preset_hint(
     stored_config: Mapping[str, Any], differing: Sequence[str], stored: Mapping[str, Any]
 ) -> str:
-    """Names the options that keep a ``metaworld-pixels`` run made before the preset changed them.
-
-    The date named is that of the earliest change among the differing options (a run that sampled
-    uniform was made before 2026-11-27, and so before 2026-11-29 too).
-    """
+    """Names the options (and the earliest date) that keep a ``metaworld-pixels`` run made before a change."""
     if stored_config.get("preset") != "metaworld-pixels" or not differing:
         return ""
     former = {key: value for _, values in PIXELS_FORMER_VALUES for key, value in values.items()}
@@ -227,11 +202,7 @@ MIGRATIONS: tuple[Migration, ...] = (
 
 
 def pre_ledger_note(root: Path, ledger_file: str) -> str:
-    """What ``verify`` and every reader say of an experiment made before ledgers.
-
-    Such an experiment has no ledger and no record committed into one: it is read, its records checked
-    against their files only, and a resume starts its ledger.
-    """
+    """What ``verify`` and every reader say of an experiment made before ledgers (its resume starts one)."""
     return (
         f"{root} was made before experiments had a ledger ({ledger_file}; or before "
         f"{LEDGER_RECORDS_SINCE}, when records began to say they were committed into one): its records are "

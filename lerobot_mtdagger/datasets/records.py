@@ -1,11 +1,9 @@
 """What an experiment writes about itself: DAgger frame columns, round records and phase records.
 
-Every committed round dataset carries a ``RoundRecord`` in ``meta/mtdagger.json``, mirrored under the
-key ``"mtdagger"`` of its ``meta/info.json`` for readers of the dataset info (rounds written before the
-file existed hold it only there; LeRobot may rewrite info.json without it, the file stays the truth);
-every committed training phase carries a ``PhaseRecord`` in ``policies/round-XXX/training.json``. Both
-are written and read only through these classes (``to_dict`` / ``from_dict``), so the field list below
-is the on-disk format::
+A committed round carries a ``RoundRecord`` in ``meta/mtdagger.json`` (the truth; mirrored under
+``"mtdagger"`` in ``meta/info.json``), a committed training phase a ``PhaseRecord`` in
+``policies/round-XXX/training.json``. Both are written and read only through these classes, so their
+fields are the on-disk format::
 
     rounds/round-002/meta/mtdagger.json
         {"round": 2, "method": "need", "episodes_per_task": [...], "allocation": {...},
@@ -47,8 +45,7 @@ DAGGER_ROUND = "dagger_round"
 """Per frame: the DAgger round the frame was collected in (int64, shape (1,))."""
 
 INTERVENTION = "intervention"
-"""Per frame, in LeRobot's name (its DAgger rollouts mark expert frames so): the EXPERT's action was
-executed (bool, shape (1,); ``not learner_acted``)."""
+"""Per frame, in LeRobot's name for it: the expert's action was executed (bool, ``not learner_acted``)."""
 
 NEXT_REWARD = "next.reward"
 """Per frame, as ``lerobot-eval`` records it: the env's reward for this frame's executed action."""
@@ -57,7 +54,7 @@ NEXT_SUCCESS = "next.success"
 """Per frame, as ``lerobot-eval`` records it: the env reported success after this frame's action."""
 
 NEXT_DONE = "next.done"
-"""Per frame, as ``lerobot-eval`` records it: the episode ended after this frame's action (its last frame)."""
+"""Per frame, as ``lerobot-eval`` records it: the episode ended after this frame's action."""
 
 EPISODE_SUCCESS = "success"
 """Per episode, in ``meta/episodes``: whether the env reported success at any step of the episode."""
@@ -82,9 +79,8 @@ def round_features(
 ) -> dict[str, dict[str, Any]]:
     """The features of a round dataset: the suite's, ``executed_action``, the DAgger flags, provenance.
 
-    The provenance columns (``provenance``) are LeRobot's ``intervention`` and ``next.*``. Rounds of
-    an experiment started before they existed are written without them (``provenance=False``), so
-    all its rounds share one schema.
+    The provenance columns are LeRobot's ``intervention`` and ``next.*``; ``provenance=False`` leaves
+    them out, so that every round of an experiment whose round 0 lacks them shares one schema.
     """
     action = suite_features["action"]
     executed = {"dtype": action["dtype"], "shape": tuple(action["shape"]), "names": action["names"]}
@@ -94,13 +90,7 @@ def round_features(
 
 @dataclass(frozen=True)
 class StepOutcome:
-    """What the env returned for a frame's executed action.
-
-    Attributes:
-        reward: The env's reward.
-        success: Whether the env reported success.
-        done: Whether the episode ended with this step.
-    """
+    """What the env returned for a frame's executed action: ``reward``, ``success``, ``done``."""
 
     reward: float
     success: bool
@@ -123,7 +113,7 @@ def dagger_columns(
 
 
 def has_provenance(features: Mapping[str, Any]) -> bool:
-    """Whether a round's features hold the provenance columns (rounds written before them do not)."""
+    """Whether a round's features hold the provenance columns."""
     return INTERVENTION in features
 
 
@@ -169,48 +159,37 @@ def allocation_view(allocation: dict[str, Any] | None) -> dict[str, Any]:
 
 @dataclass
 class RoundRecord:
-    """The record of one committed round (``meta/info.json["mtdagger"]``).
+    """The record of one committed round (``meta/mtdagger.json``).
+
+    An optional field is None (``ledger`` False) where the record does not hold it.
 
     Attributes:
         task_names: The experiment's task vocabulary (task index i is ``task_names[i]``).
         round: Round index k (0: expert demonstrations).
-        method: ``bc`` or the scheduling method (``uniform``, ``need``, ``need_raw``, ``gain``, ...).
+        method: ``bc`` or the scheduling method.
         beta: Probability of executing the expert's action at a step (1 in round 0).
-        seed: Experiment seed.
         budget: Episodes collected in the round.
-        temperature: The scheduler's softmax temperature.
-        n_min: The scheduler's minimum episodes per task.
         episodes_per_task: Episodes collected per task.
         demos_so_far: Expert-labelled episodes per task in rounds 0..k.
         rollout_success: Success rate per task of this round's rollouts, whoever acted (None in
-            round 0 and where a task had no episode).
-        rollout_episodes: Episodes behind ``rollout_success``.
+            round 0 and where a task had no episode); ``rollout_episodes``: the episodes behind it.
         expert_success: Round 0 only: the experts' success rate per task.
         learner_steps: Steps where the learner's action was executed.
-        frames: Frames stored.
         config: The run config (``RunConfig.to_dict``).
-        success_rate: Scheduler input: the measured success rate it was fed (the previous round's).
-        episodes: Scheduler input: the rollouts behind ``success_rate``.
-        gain: Scheduler input: the previous training phase's performance gain.
-        kalman_prior: Kalman state before this round's update (``{"p": None, "P": None}`` in round 0).
-        kalman_posterior: Kalman state after it.
-        metric: The method's metric per task (None in round 0).
-        score: Rank-normalised metric.
-        probability: Softmax probabilities.
+        success_rate: Scheduler input: the measured success rate (the previous round's); ``episodes``:
+            the rollouts behind it; ``gain``: the previous training phase's performance gain.
+        kalman_prior: Kalman state before this round's update (``{"p": None, "P": None}`` in round 0);
+            ``kalman_posterior``: after it.
+        metric: The method's metric per task (None in round 0); ``score``: as softmax scores;
+            ``probability``: the softmax.
         eval_success: Evaluation success per task of the policy that collected this round.
         allocation: The full ``Allocation.to_dict()`` (None in round 0); ``verify`` recomputes it.
         scheduler_state: ``Scheduler.state_dict()`` after this round's allocation (resume restores it).
-        notes: Human-readable remarks.
-        format_version: ``FORMAT_VERSION``.
         committed: True once the round is committed (a record without it is never read).
-        learner_success: Success rate per task of this round's episodes where only the learner
-            acted (None in round 0 and where a task had none): the next round's task need
-            measurement.
-        learner_episodes: Episodes behind ``learner_success``.
-        files: sha256 of every file of the round dataset but ``meta/info.json``, by relative path,
-            written at commit (None in rounds committed before checksums were recorded).
-        ledger: True once committed into the experiment's ``ledger.json`` (``datasets/ledger.py``); False
-            in rounds committed before the ledger existed, so a missing ledger is told from one never made.
+        learner_success: Success rate per task of this round's episodes where only the learner acted
+            (the next round's task need measurement); ``learner_episodes``: the episodes behind it.
+        files: sha256 of every file of the round dataset but ``meta/info.json``, by relative path.
+        ledger: True once committed into the experiment's ``ledger.json`` (``datasets/ledger.py``).
     """
 
     task_names: list[str]
@@ -254,11 +233,7 @@ class RoundRecord:
 
     @classmethod
     def from_dict(cls, values: Mapping[str, Any], where: str = "round record") -> RoundRecord:
-        """Reads a stored record (its run config in today's layout: ``migrate_run_config``).
-
-        Raises:
-            ValueError: If a field is missing, naming it and ``where``.
-        """
+        """Reads a stored record, its config migrated (ValueError naming a missing field and ``where``)."""
         if isinstance(values.get("config"), Mapping):
             values = {**values, "config": migrate_run_config(values["config"])}
         return _from_mapping(cls, values, where)
@@ -268,43 +243,34 @@ class RoundRecord:
 class PhaseRecord:
     """The record of one committed training phase (``policies/round-XXX/training.json``).
 
+    An optional field is None (``ledger`` False) where the record does not hold it.
+
     Attributes:
-        round: k: the policy was trained on rounds 0..k.
-        trained_on_rounds: ``[0, ..., k]``.
+        round: k: the policy was trained on rounds 0..k (``trained_on_rounds``).
         frames: Frames of D(k) (held-out episodes included).
         steps: Optimiser steps taken (with ``steps_rule=plateau``, up to where the phase stopped).
         gain_split: Where the per-task loss was measured (``train`` or ``heldout``).
         loss_start: Per-task loss of the initial weights (None where a task had no sample).
         loss_end: Per-task loss after training.
-        gain: ``max(0, loss_previous - loss_end)`` per task, the next round's performance gain
-            (None in phase 0: there is no previous policy, and a loss drop from random weights
-            measures the scale of each task's actions, not learning).
+        gain: ``max(0, loss_previous - loss_end)`` per task, the next round's performance gain (None in
+            phase 0: a loss drop from random weights measures the scale of the actions, not learning).
         loss_samples: Frames per task behind the losses.
         final_train_loss: The last training losses.
         eval: ``EvalResult.to_dict()`` of the trained policy (None when not evaluated).
         demos_per_task: Expert-labelled episodes per task in D(k).
         timings: Seconds per part of the round (collect_s, write_s, load_s, train_s, eval_s).
-        loss_previous: Per-task loss of the previous phase's policy (the one that collected round
-            k) on the same frames, in this phase's normalisation (None in phase 0).
-        files: sha256 of every file of the policy folder but ``training.json``, by relative path,
-            written at commit (None in phases committed before checksums were recorded).
-        best_step: With ``steps_rule=plateau``, the step whose weights were kept (the lowest held-out
-            loss; 0: the phase's initial weights); None otherwise.
-        heldout_loss: With ``steps_rule=plateau``, ``[step, mean held-out loss]`` at every
-            measurement; None otherwise.
-        heldout_eval: ``EvalResult.to_dict()`` on the suite's unseen tasks (the held-out drawers),
-            recorded beside ``eval`` and never given to the scheduler; None where not evaluated.
-        environment: Where the phase trained (``training_environment``: package versions, the CPU
-            and its kernel level, torch threads, device); None in phases written before it was
-            recorded. The same data and seeds give the same weights bit for bit only in the same
-            environment: elsewhere the arithmetic differs in the last bits and grows over the steps.
-        passes_per_task: Per task, the frames the phase's steps drew over its training frames (how
-            many passes over each task's data it made); None in phases written before it was recorded.
+        loss_previous: Per-task loss of the policy that collected round k on the same frames, in this
+            phase's normalisation (None in phase 0).
+        files: sha256 of every file of the policy folder but ``training.json``, by relative path.
+        best_step: With ``steps_rule=plateau``, the step whose weights were kept (0: the initial ones).
+        heldout_loss: With ``steps_rule=plateau``, ``[step, mean held-out loss]`` at every measurement.
+        heldout_eval: ``EvalResult.to_dict()`` on the suite's unseen tasks; never given to the scheduler.
+        environment: Where the phase trained (package versions, CPU, torch threads, device): the same
+            data and seeds give the same weights bit for bit only in the same environment.
+        passes_per_task: Per task, the passes the phase's steps made over its training frames.
         resumed_after_steps: The steps after which a cut phase was resumed from its saved progress
-            (``runner.training.phase_progress``), in order; empty: trained in one go; None in phases written
-            before progress was saved. Its ``steps_s`` and ``train_s`` count every process's steps.
-        ledger: True once committed into the experiment's ``ledger.json``; False in phases committed
-            before the ledger existed.
+            (empty: trained in one go); its ``steps_s`` and ``train_s`` count every process's steps.
+        ledger: True once committed into the experiment's ``ledger.json``.
     """
 
     round: int
@@ -341,9 +307,5 @@ class PhaseRecord:
 
     @classmethod
     def from_dict(cls, values: Mapping[str, Any], where: str = "training record") -> PhaseRecord:
-        """Reads a stored record.
-
-        Raises:
-            ValueError: If a field is missing, naming it and ``where``.
-        """
+        """Reads a stored record (ValueError naming a missing field and ``where``)."""
         return _from_mapping(cls, values, where)

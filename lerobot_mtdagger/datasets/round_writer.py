@@ -1,11 +1,4 @@
-"""The fast round writer: a whole round of episodes into a staged LeRobotDataset at once.
-
-``write_round_episodes`` writes the same files, values, statistics and metadata as LeRobot's
-``add_frame`` / ``save_episode`` loop, but with one Arrow conversion for the whole round instead of a
-``datasets`` conversion and a per-row ``map`` per episode, and cheaper statistics (6-10 times faster
-for vector features, checked against LeRobot's on every episode). Rounds with image or video features
-take LeRobot's own per-frame path.
-"""
+"""The fast round writer: a whole round of episodes into a staged LeRobotDataset at once."""
 
 from __future__ import annotations
 
@@ -42,30 +35,17 @@ EpisodeFrames = tuple[str, Sequence[Mapping[str, Any]]]
 def write_round_episodes(dataset: LeRobotDataset, episodes: Sequence[EpisodeFrames]) -> None:
     """Writes episodes into a new, empty LeRobotDataset as LeRobot's own recording loop would.
 
-    The result is what ``add_frame`` per frame and ``save_episode`` per episode write: the same data
-    parquet file (one row group per episode, same schema and values), the same per-episode statistics,
-    the same ``meta/episodes`` rows, ``tasks.parquet``, ``info.json`` and ``stats.json`` (written by
-    LeRobot's own ``meta.save_episode``). The only difference is the random ``datasets`` cache
-    fingerprint LeRobot leaves in the data file's schema metadata, which differs between any two
-    writes and is never read. What is saved: one column-wise Arrow conversion and one parquet writer
-    for the whole round instead of a ``datasets`` conversion plus a per-row ``map`` per episode
-    (LeRobot's ``embed_images``, a no-op without images, ~1 ms per frame), and LeRobot's statistics
-    computed with fewer passes (:class:`_FastQuantileStats`, checked bit for bit against LeRobot's
-    ``compute_episode_stats`` on each round's first episode, which is used instead if they differ).
-    A new data file is started where the next episode would take the current one past
-    ``data_files_size_in_mb``, measured on the uncompressed Arrow size (a conservative estimate of
-    the parquet size LeRobot measures). Datasets with image or video features are written through
-    ``add_frame`` / ``save_episode``.
-
-    Runs inside :func:`~lerobot_mtdagger.utils.quiet.quiet_third_party`.
+    The same files as ``add_frame``/``save_episode`` (but for a random ``datasets`` fingerprint), from
+    one Arrow conversion per round and fewer statistics passes, checked against LeRobot's on the first
+    episode; 6-10 times faster for vector features. Image and video rounds take LeRobot's own path.
 
     Args:
         dataset: A dataset just created (``LeRobotDataset.create``), without episodes.
         episodes: ``(task, frames)`` per episode (see :meth:`ExperimentDir.write_round`).
 
     Raises:
-        ValueError: If the dataset already holds episodes, a frame does not match the features, or an
-            episode has no frame.
+        ValueError: If the dataset holds episodes, a frame does not match the features, or an episode
+            has no frame.
     """
     if dataset.meta.total_episodes != 0 or unsaved_frames(dataset) > 0:
         raise ValueError(
@@ -90,10 +70,7 @@ def episode_success_metadata(columns: Mapping[str, Any]) -> dict[str, bool]:
 
 
 def save_episode_with_success(dataset: LeRobotDataset, frames: Sequence[Mapping[str, Any]]) -> None:
-    """``dataset.save_episode()`` with the episode's success added to its ``meta/episodes`` row.
-
-    LeRobot's ``save_episode`` builds the row itself; its metadata call is wrapped for this one episode.
-    """
+    """``dataset.save_episode()`` with the episode's success added to its ``meta/episodes`` row."""
     if not frames or NEXT_SUCCESS not in frames[0]:
         dataset.save_episode()
         return
@@ -113,14 +90,8 @@ def save_episode_with_success(dataset: LeRobotDataset, frames: Sequence[Mapping[
 def save_episode_with_scalar_columns(dataset: LeRobotDataset, frames: Sequence[Mapping[str, Any]]) -> None:
     """``save_episode_with_success`` with each one-value feature's column handed on as scalars.
 
-    LeRobot stores a feature of shape ``(1,)`` as a scalar ``datasets.Value`` column, but its
-    ``save_episode`` stacks the frames' ``(1,)`` arrays into an ``(N, 1)`` column, and ``datasets``
-    then converts each ``(1,)`` row with ``int()`` / ``float()`` / ``bool()``: deprecated since numpy
-    1.25 and an error (``only 0-dimensional arrays can be converted to Python scalars``) from numpy
-    2.5 (LeRobot issue #3343). The column is flattened to ``(N,)`` just for that conversion: the same
-    values and schema, and the statistics, computed before it, still see ``(N, 1)``. LeRobot's newer
-    dataset writer flattens these columns itself before its statistics; nothing is left to flatten
-    then.
+    ``datasets`` would convert LeRobot's ``(N, 1)`` column row by row with ``int()``/``float()`` (an
+    error from numpy 2.5); it is flattened to ``(N,)`` just for that (the statistics see ``(N, 1)``).
     """
     owner = episode_data_writer(dataset)
     save_data = owner._save_episode_data
@@ -172,10 +143,7 @@ def _episode_buffer(
 
 
 def _arrow_table(columns: Mapping[str, np.ndarray], hf_features: datasets.Features) -> pa.Table:
-    """The Arrow table ``datasets.Dataset.from_dict(columns, features=hf_features)`` holds.
-
-    Same schema (with its ``huggingface`` metadata) and values, built column-wise instead of row by row.
-    """
+    """The Arrow table ``datasets.Dataset.from_dict(columns, features=hf_features)`` holds, built faster."""
     arrays = []
     for key, feature in hf_features.items():
         column = np.asarray(columns[key])
@@ -187,16 +155,7 @@ def _arrow_table(columns: Mapping[str, np.ndarray], hf_features: datasets.Featur
 
 
 class _FastQuantileStats(RunningQuantileStats):
-    """LeRobot's ``RunningQuantileStats`` with cheaper histogram and quantile loops, same results.
-
-    The results are the same bit for bit (``_write_vector_episodes`` checks that on every round's
-    first episode and falls back to LeRobot's own statistics if they ever differ).
-
-    ``_update_histograms`` runs ``np.histogram``'s own algorithm for explicit bin edges (sorted data,
-    inclusive search of the edges) without its per-call checks, converting a bool column to uint8 as
-    ``np.histogram`` does, minus its RuntimeWarning. ``_compute_quantiles`` computes each histogram's
-    cumulative sum once instead of once per quantile.
-    """
+    """LeRobot's ``RunningQuantileStats`` with cheaper histogram and quantile loops, same results."""
 
     def _update_histograms(self, batch: np.ndarray) -> None:
         if batch.dtype == np.bool_:
@@ -271,11 +230,7 @@ def _same_stats(ours: Mapping[str, Any], theirs: Mapping[str, Any]) -> bool:
 def _checked_fast_stats(
     buffer: Mapping[str, np.ndarray], dataset: LeRobotDataset
 ) -> tuple[dict[str, Any], Callable[..., dict[str, Any]]]:
-    """The first episode's statistics and the statistics function for the round's other episodes.
-
-    The fast function if it gives exactly what LeRobot's ``compute_episode_stats`` gives on this
-    episode, else LeRobot's (with a warning).
-    """
+    """The first episode's statistics and the fast statistics function if it matched, else LeRobot's."""
     reference = compute_episode_stats(buffer, dataset.features)
     try:
         fast = _vector_episode_stats(buffer, dataset.features)

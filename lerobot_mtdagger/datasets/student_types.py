@@ -1,8 +1,6 @@
 """The policy types a run's student may save (names only: reading it imports nothing heavy).
 
-The built-in students (``--policy.type``) are named here once: ``runner/student.py`` registers one
-student per name, and ``checkpoints`` accepts a policy folder of any of these types. A student
-registered from outside the package adds its policy type with ``add_student_policy_type``.
+A student registered from outside the package adds its type with ``add_student_policy_type``.
 """
 
 from __future__ import annotations

@@ -1,13 +1,8 @@
 """Audits an experiment folder: every committed round and policy against its files and its record.
 
-``verify_experiment`` first refuses a folder that is not an experiment. For each committed round
-``verify_round`` checks that every file matches the sha256 recorded at commit, counts the episodes
-per task and the frames in the data files themselves against the record, checks the task vocabulary
-and its order, the cumulative demonstration counts, and for DAgger rounds that the allocation
-recomputes from the record alone (``scheduler.allocation_mismatches``, through the method's
-registered config class) and chains with the previous round: its measured success, the previous
-phase's gain, the Kalman prior = the previous round's posterior. For each committed policy
-``verify_policy`` checks its files' sha256 and that it loads.
+A round's files against their sha256, its episodes, frames and tasks against its record, and a
+DAgger round's allocation recomputed and chained with the previous round and phase; a policy's
+files, and that it loads. ``check_before_reading`` is what every reader runs first.
 """
 
 from __future__ import annotations
@@ -39,14 +34,7 @@ logger = logging.getLogger(__name__)
 
 
 def stored_tasks(root: Path, num_tasks: int) -> tuple[list[str], list[int], int]:
-    """What a round dataset's files hold: task vocabulary, episodes per task index, frames.
-
-    The vocabulary is read from ``meta/tasks.parquet`` (in task_index order); the episodes and frames
-    are counted in the data files themselves, not in the metadata.
-
-    Raises:
-        CorruptExperimentError: Naming the file that cannot be read.
-    """
+    """A round's task vocabulary, episodes per task and frames, counted in its files."""
     tasks_table = read_parquet(root / "meta" / "tasks.parquet").to_pandas()
     order = [str(task) for task in tasks_table.sort_values("task_index").index]
     paths = sorted((root / "data").glob("*/*.parquet"))
@@ -61,11 +49,7 @@ def stored_tasks(root: Path, num_tasks: int) -> tuple[list[str], list[int], int]
 
 
 def read_parquet(path: Path, columns: list[str] | None = None) -> pa.Table:
-    """Reads a parquet file of a round.
-
-    Raises:
-        CorruptExperimentError: Naming the file.
-    """
+    """Reads a parquet file of a round (``CorruptExperimentError`` naming it)."""
     try:
         return pq.read_table(path, columns=columns)
     except (OSError, pa.ArrowException) as error:
@@ -75,12 +59,7 @@ def read_parquet(path: Path, columns: list[str] | None = None) -> pa.Table:
 def expert_mismatches(
     run_config: dict, record: RoundRecord, added_defaults: Mapping[str, Any] | None = None
 ) -> list[str]:
-    """Whether a round was collected with the run's experts (``--expert.*``, the same in every round).
-
-    An option that one side does not store (the run began before it existed) is taken at its default
-    from ``added_defaults`` (``RunConfig.option_defaults``, by dotted path); without a default for it,
-    it is not compared.
-    """
+    """How a round's experts differ from the run's ``--expert.*`` (missing options: ``added_defaults``)."""
     stored, recorded = run_config.get("expert") or {}, record.config.get("expert") or {}
     defaults = {
         path.split(".", 1)[1]: v for path, v in (added_defaults or {}).items() if path.startswith("expert.")
@@ -104,17 +83,10 @@ def verify_round(
     committed_phases: set[int],
     added_defaults: Mapping[str, Any] | None = None,
 ) -> list[str]:
-    """Checks one committed round against its data and its own record.
+    """Checks one committed round against its data and record; one message per problem.
 
-    Args:
-        experiment: The experiment folder.
-        record: The round's record.
-        previous: The previous round's record (None for round 0).
-        committed_phases: Indices of the committed training phases.
-        added_defaults: Options' defaults by dotted path, for options the run's config predates.
-
-    Returns:
-        One message per problem, prefixed by the round's name; empty when the round checks out.
+    ``previous`` is the previous round's record (None for round 0); ``added_defaults`` the defaults by
+    dotted path of options the run's config lacks.
     """
     name = round_name(record.round)
     problems = experiment.round_file_problems(record)
@@ -170,18 +142,7 @@ def _chain_mismatches(
 
 
 def verify_policy(experiment: ExperimentDir, round_index: int, load: bool = True) -> list[str]:
-    """Checks one committed policy folder: its files against its record's checksums, and that it loads.
-
-    Loading never runs code named by the checkpoint (``trust_checkpoint`` stays false).
-
-    Args:
-        experiment: The experiment folder.
-        round_index: The phase's round.
-        load: Also load the policy (``verify``); a reader that loads it itself skips this.
-
-    Returns:
-        One message per problem, prefixed by the policy's folder.
-    """
+    """Checks a committed policy folder's files and, with ``load``, that it loads (running no named code)."""
     prefix = f"policies/{round_name(round_index)}"
     try:
         record = experiment.read_phase_record(round_index)
@@ -207,16 +168,10 @@ def _load_problems(folder: Path) -> list[str]:
 def verify_experiment(
     experiment: ExperimentDir, added_defaults: Mapping[str, Any] | None = None, reading: bool = False
 ) -> tuple[int, int, list[str]]:
-    """Verifies every committed round and policy of an experiment.
+    """Verifies every committed round and policy; returns the rounds and policies verified and the problems.
 
-    ``added_defaults`` (``RunConfig.option_defaults``) gives options the run's config predates their
-    default, so that its rounds' records are compared with it as a resume compares a config. Readers
-    (``check_before_reading``) pass ``reading=True``: every check but loading each policy, and the ledger
-    as a resume takes it (the last rounds deleted to be redone, a record committed by a run cut off, or
-    still running, just before it reached the ledger).
-
-    Returns:
-        The numbers of rounds and of policies verified, and every problem found.
+    ``added_defaults`` (``RunConfig.option_defaults``) fills options the run's config lacks.
+    ``reading=True`` skips loading the policies and takes the ledger as a resume does.
 
     Raises:
         NotAnExperimentError: If the folder is missing or holds no experiment.
@@ -275,18 +230,8 @@ def check_before_reading(
 ) -> list[str]:
     """What every reader (``merge``, ``report``, ``push``, ``eval``, ``shift``, ``plan``) checks first.
 
-    The experiment is verified as ``verify`` does (``verify_experiment``, without loading its policies):
-    every committed round's and policy's files against their checksums, the data files' episodes and
-    frames, the records' chain, and the ledger (edited, missing or replaced). An experiment made before
-    ledgers is read, with an info line saying so.
-
-    Args:
-        experiment: The experiment to read.
-        unverified: Read it even if it fails (``--unverified=true``), with a logged warning.
-        added_defaults: ``RunConfig.option_defaults``, as ``verify`` passes it.
-
-    Returns:
-        The problems read past (empty unless ``unverified``), for the reader's output to name.
+    The experiment is verified as ``verify`` does, without loading its policies; with ``unverified``
+    (``--unverified=true``) a failure is logged and its problems returned for the output to name.
 
     Raises:
         NotAnExperimentError: If the folder holds no experiment.
@@ -304,14 +249,7 @@ def check_before_reading(
 
 
 def _refused_or_read(what: str, problems: list[str], fix: str, unverified: bool) -> list[str]:
-    """Refuses ``problems`` in one line (``what (problems): fix, or --unverified=true``) or warns of them.
-
-    Returns:
-        ``problems`` (read past with ``unverified``).
-
-    Raises:
-        CorruptExperimentError: If there is a problem and ``unverified`` is false.
-    """
+    """Refuses ``problems`` in one line, or with ``unverified`` logs a warning and returns them."""
     if not problems:
         return []
     shown = "; ".join(problems[:SHOWN_PROBLEMS])
@@ -326,10 +264,7 @@ def _refused_or_read(what: str, problems: list[str], fix: str, unverified: bool)
 
 
 def experiment_of(folder: Path) -> ExperimentDir | None:
-    """The experiment a round dataset or policy folder (``<experiment>/rounds|policies/round-XXX``) is of.
-
-    None for a folder anywhere else (copied out, downloaded, a LeRobot dataset or policy).
-    """
+    """The experiment of a ``<experiment>/rounds|policies/round-XXX`` folder, else None."""
     folder = Path(folder)
     inside = folder.parent.name in (ROUNDS_DIR, POLICIES_DIR) and folder.name.startswith("round-")
     root = folder.parent.parent
@@ -341,16 +276,9 @@ def check_policy_folder(
 ) -> list[str]:
     """What ``eval``, ``shift`` and ``plan`` check of a policy folder before loading it, wherever it lives.
 
-    A folder of an experiment: the experiment, as ``check_before_reading``. Any other folder (copied out,
-    pushed and downloaded again): its files against the checksums its ``training.json`` carries (files
-    added beside them, such as a Hub download's ``.gitattributes``, are not its own and are left out). A
-    folder without checksums (a LeRobot policy, a Hub id) is read, with an info line saying so.
-
-    Returns:
-        The problems read past (empty unless ``unverified``).
-
-    Raises:
-        CorruptExperimentError: In one line naming the changed files and the fix.
+    A folder of an experiment: the experiment. Another: its files against its ``training.json``'s
+    checksums (files a Hub download adds are left out), or an info line without them. With
+    ``unverified`` the problems are returned, else raised (``CorruptExperimentError``).
     """
     folder = Path(folder)
     experiment = experiment_of(folder)
@@ -368,11 +296,7 @@ def check_policy_folder(
 
 
 def carried_checksums(folder: Path) -> dict[str, str] | None:
-    """The file checksums a policy folder's ``training.json`` carries (None: no file, or none recorded).
-
-    Raises:
-        CorruptExperimentError: If ``training.json`` is there but unreadable.
-    """
+    """The checksums a policy folder's ``training.json`` carries (None: none; raises if it is unreadable)."""
     path = Path(folder) / TRAINING_FILE
     if not path.is_file():
         return None

@@ -1,18 +1,14 @@
 """Errors caused by what the user gave (an option, a path, a file), as opposed to bugs of ours.
 
 The command line prints a :class:`UserError` as one line, ``error: <what> <how to fix>``, and exits
-with status 2; any other exception is a bug and keeps its traceback (``--debug`` shows the traceback
-of a user error too). Every message names the option, path or file at fault and the fix.
+with status 2; any other exception is a bug and keeps its traceback (``--debug`` shows it for both).
 """
 
 from __future__ import annotations
 
 
 class UserError(ValueError):
-    """A problem with the user's input, whose message names the input and the fix.
-
-    A ``ValueError`` so that code catching bad values keeps working.
-    """
+    """A problem with the user's input, whose message names the input and the fix (a ``ValueError``)."""
 
 
 class NotAnExperimentError(UserError):

@@ -1,10 +1,8 @@
 """``--help`` for every command: its own options, one line each, from the configs' docstrings.
 
-draccus prints each config class's whole docstring as a block and its options without help; this
-prints one line per option instead: ``--group.name=TYPE``, the first sentence of the option's entry
-in its class's ``Attributes:`` (or ``Args:``) section, and its default. A choice group
-(``--scheduler.type``, ``--policy.type``) lists its choices and then the options of the chosen one
-(the one ``--<group>.type=`` names on the command line, else the default).
+Each option shows as ``--group.name=TYPE``, the first sentence of its entry in its class's
+``Attributes:`` (or ``Args:``) section, and its default. A choice group (``--scheduler.type``,
+``--policy.type``) lists its choices, then the options of the chosen one (or the default).
 """
 
 from __future__ import annotations
@@ -81,8 +79,8 @@ def option_lines(
         cls: The config dataclass.
         options: The command line (which choice of a group to describe).
         prefix: The group's dotted path.
-        choices: ``group class -> {choice name: class or None}`` for a choice group whose choices are
-            costly to import (None: not described, or not that group); default ``get_known_choices``.
+        choices: ``group class -> {choice name: class or None}`` for choices costly to import (None:
+            not described); default ``get_known_choices``.
     """
     docs = attribute_docs(cls)
     for field in dataclasses.fields(cls):
@@ -124,10 +122,7 @@ def _group_lines(
 
 
 def _declared_class(owner: type, field: dataclasses.Field, default: Any) -> type:
-    """The group's declared class, else its default's class.
-
-    The declared class (a choice registry) is looked up in the module that defines ``owner``.
-    """
+    """The group's declared class (looked up in ``owner``'s module), else its default's class."""
     name = field.type if isinstance(field.type, str) else getattr(field.type, "__name__", "")
     declared = getattr(sys.modules.get(owner.__module__), str(name).strip(), None)
     return declared if isinstance(declared, type) else type(default)

@@ -1,25 +1,11 @@
 """Every LeRobot name that moved between 0.4.4 and 0.6.1, and every private attribute we read: one place.
 
-The package runs on LeRobot 0.4.x (Python < 3.12) and 0.6.x (Python >= 3.12); the test suite runs on
-both (``.ci/run``), and ``scripts/check_lerobot_names.py`` checks the names against a LeRobot source tree.
-Moved in 0.5/0.6:
-
-- ``dataset_to_policy_features``: ``lerobot.datasets.utils`` -> ``lerobot.utils.feature_utils``;
-- ``validate_frame``: ``lerobot.datasets.utils`` -> ``lerobot.datasets.feature_utils``;
-- ``DEFAULT_FEATURES``: ``lerobot.datasets.utils`` -> ``lerobot.utils.constants``;
-- ``get_hf_features_from_features``: ``lerobot.datasets.utils`` -> ``lerobot.datasets.feature_utils``,
-  and a dataset no longer keeps ``hf_features`` (``dataset_hf_features`` builds them from its features);
-- a dataset's unsaved frames: ``dataset.episode_buffer`` -> ``dataset.writer.episode_buffer`` (0.5.1);
-- the step of ``save_episode`` that turns an episode's columns into a ``datasets.Dataset``:
-  ``dataset._save_episode_data`` -> ``dataset.writer._save_episode_data`` (0.5.1; the dataset's
-  method of that name only forwards there, and the writer's ``save_episode`` calls its own).
-
-Everything else the package imports from LeRobot has one spelling in both lines (the script checks
-that too). Behaviour that differs without a name moving is handled where it is used: LeRobot 0.6 logs
-through named loggers (``utils/quiet.py``), reads ``meta/info.json`` into a typed ``DatasetInfo`` that
-warns of and drops unknown keys on every load (so the round record lives in ``meta/mtdagger.json``, and
-its mirror in ``info.json`` is written on 0.4 only: ``INFO_KEEPS_OTHER_KEYS``), and probes torchcodec
-unless a dataset is created with a ``video_backend`` (``datasets/experiment_dir.py``).
+The package runs on LeRobot 0.4.x (Python < 3.12) and 0.6.x (Python >= 3.12);
+``scripts/check_lerobot_names.py`` checks the names below against a LeRobot source tree. Behaviour
+that differs without a name moving is handled where it is used: LeRobot 0.6 logs through named
+loggers (``utils/quiet.py``), drops unknown keys of ``meta/info.json`` (so the round record lives in
+``meta/mtdagger.json``; ``INFO_KEEPS_OTHER_KEYS``), and probes torchcodec unless a dataset is created
+with a ``video_backend`` (``datasets/experiment_dir.py``).
 """
 
 from __future__ import annotations
@@ -79,12 +65,7 @@ def unsaved_frames(dataset: Any) -> int:
 
 
 def episode_data_writer(dataset: Any) -> Any:
-    """The object whose ``_save_episode_data`` LeRobot's ``save_episode`` calls for ``dataset``.
-
-    LeRobot 0.4 writes an episode's columns in the dataset's own method (its ``writer`` attribute is
-    then a ``pyarrow`` ``ParquetWriter`` or ``None``); from 0.5.1 the dataset holds an episode writer
-    (``writer``, kept as ``_writer``) whose ``save_episode`` calls the writer's method of that name.
-    """
+    """The object whose ``_save_episode_data`` LeRobot's ``save_episode`` calls (0.4: the dataset itself)."""
     for name in ("writer", "_writer"):
         writer = getattr(dataset, name, None)
         if writer is not None and hasattr(writer, "_save_episode_data"):

@@ -7,12 +7,9 @@ from typing import Any
 
 
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[Any]], align: str | None = None) -> str:
-    """A GitHub-flavoured markdown table.
+    """A GitHub-flavoured markdown table (cells written with ``str``, a ``|`` escaped).
 
-    Args:
-        header: Column titles.
-        rows: Cells, one sequence per row (written with ``str``; a ``|`` inside a cell is escaped).
-        align: One letter per column, ``l`` (``---``) or ``r`` (``---:``); None: every column ``l``.
+    ``align`` has one letter per column, ``l`` or ``r`` (None: every column ``l``).
 
     Raises:
         ValueError: If ``align`` or a row does not have one entry per column.

@@ -1,8 +1,4 @@
-"""A run that ends with the ``compare`` that started it (``follow_parent``).
-
-``compare`` sets ``PARENT_PID_ENV`` in each run's environment (``analysis.launchers``); ``run`` calls
-``follow_parent`` at start, so a ``compare`` that is killed leaves no run writing on into its folder.
-"""
+"""A run that ends with the ``compare`` that started it, so a killed ``compare`` leaves no run writing on."""
 
 from __future__ import annotations
 
@@ -22,19 +18,10 @@ PARENT_POLL_S = 0.5
 
 
 def follow_parent(poll_s: float = PARENT_POLL_S) -> threading.Thread | None:
-    """Ends this process (SIGTERM) once the ``compare`` that started it has ended.
+    """Ends this process (SIGTERM) once the ``compare`` that started it has ended, as a killed run ends.
 
-    Called by ``lerobot-mtdagger run`` at start. Without it, a ``compare`` killed by ``kill`` or
-    ``kill -9`` leaves its runs going on in the background, writing into run folders that a new
-    ``compare`` then resumes at the same time. The run ends as a killed run does: committed rounds and
-    phases stay, the next ``compare`` resumes it. Does nothing when ``PARENT_PID_ENV`` is not set
-    (a run started by hand).
-
-    Args:
-        poll_s: Seconds between two checks of the parent process.
-
-    Returns:
-        The daemon thread that watches the parent, or None when there is no parent to follow.
+    Without it, a killed ``compare``'s runs would write on into folders a new ``compare`` resumes.
+    Returns the watching daemon thread, or None without ``PARENT_PID_ENV`` (a run started by hand).
     """
     expected = os.environ.get(PARENT_PID_ENV)
     if not expected:

@@ -1,13 +1,9 @@
 """Command-line options into configs, with one clear message per mistake.
 
-draccus reads every value as YAML and parses with argparse; a bad value surfaces as a YAML traceback
-that does not name the option, an unknown option as argparse's usage block and a ``SystemExit``, and
-a config's own check as a ``ParsingError`` hiding it. ``parse_options`` turns each into a
-``UserError`` naming the option and the fix.
-
-draccus also reads each field's help text from its class's source, and ``inspect.getsource`` of a
-class parses its whole module on Python 3.11, once per FIELD: 2-3 s for every parse of ``RunConfig``.
-``cache_dataclass_sources`` makes draccus read each class's source once per process.
+draccus surfaces a bad value as a YAML traceback, an unknown option as argparse's usage block and a
+config's own check as a ``ParsingError``; ``parse_options`` turns each into a ``UserError`` naming
+the option and the fix. ``cache_dataclass_sources`` makes draccus read each class's source once per
+process instead of once per field (2-3 s for every parse of ``RunConfig`` on Python 3.11).
 """
 
 from __future__ import annotations
@@ -30,17 +26,14 @@ from lerobot_mtdagger.utils.errors import UserError
 T = TypeVar("T")
 
 PARSING = threading.RLock()
-"""One parse at a time in a process: a parse swaps ``sys.stderr`` (and a config may narrow its parser),
-which two threads parsing at once (``compare``'s pool) would leave swapped. Reentrant: a parse within a
-parse, in the same thread, restores in order."""
+"""One parse at a time per process (a parse swaps ``sys.stderr``); reentrant within a thread."""
 
 
 @functools.cache
 def _class_source(cls: type) -> str | OSError | TypeError:
     """The source of ``cls``, or the error ``inspect.getsource`` raised for it, found once.
 
-    A class made by ``dataclasses.make_dataclass`` (the LeRobot students' options) has no source:
-    finding that out parses a whole module too, so the failure is kept as well.
+    A class made by ``dataclasses.make_dataclass`` has no source; finding that out parses a module too.
     """
     try:
         return inspect.getsource(cls)
@@ -52,12 +45,7 @@ class _InspectWithClassSourceCache:
     """The ``inspect`` module as draccus' docstring reader sees it, with class sources cached."""
 
     def getsource(self, obj: object) -> str:
-        """``inspect.getsource``, cached for classes.
-
-        Raises:
-            OSError: If there is no source for ``obj`` (as ``inspect.getsource``).
-            TypeError: If ``obj`` is a built-in (as ``inspect.getsource``).
-        """
+        """``inspect.getsource``, cached for classes (raising its ``OSError`` or ``TypeError`` alike)."""
         if not isinstance(obj, type):
             return inspect.getsource(obj)
         source = _class_source(obj)
@@ -70,10 +58,7 @@ class _InspectWithClassSourceCache:
 
 
 def cache_dataclass_sources() -> None:
-    """Makes draccus read each config class's source once per process, not once per field.
-
-    The help texts draccus builds are unchanged; only the repeated parsing of the same module goes.
-    """
+    """Makes draccus read each config class's source once per process, not once per field."""
     draccus_docstring.inspect = _InspectWithClassSourceCache()
 
 
@@ -95,11 +80,7 @@ def unparsable_option(options: Sequence[str]) -> str | None:
 
 
 def missing_config_file(options: Sequence[str]) -> None:
-    """Refuses a ``--config_path`` that is not a readable file (draccus would raise FileNotFoundError).
-
-    Raises:
-        UserError: Naming the path and the fix.
-    """
+    """Refuses a ``--config_path`` that is not a readable file, with a ``UserError`` naming it and the fix."""
     for option in options:
         name, separator, value = option.partition("=")
         if name == "--config_path" and separator and not Path(value).is_file():
@@ -109,11 +90,7 @@ def missing_config_file(options: Sequence[str]) -> None:
 
 
 def command_help(config_class: type, options: Sequence[str], prog: str) -> str:
-    """The ``--help`` page of a command: one line per option (``utils/help.py``).
-
-    A config may name costly choices without importing them (``help_choices(options)``) and add a
-    footer (``HELP_FOOTER``).
-    """
+    """The ``--help`` page of a command, with a config's ``help_choices`` and ``HELP_FOOTER``."""
     from lerobot_mtdagger.utils.help import option_lines, render_help, summary_of
 
     chooser = getattr(config_class, "help_choices", None)
@@ -123,10 +100,9 @@ def command_help(config_class: type, options: Sequence[str], prog: str) -> str:
 
 
 def parse_options(config_class: type[T], options: Sequence[str], prog: str) -> T:
-    """Parses command-line options into a config, every failure a ``UserError``.
+    """Parses command-line options into a config, every failure a ``UserError`` naming the option at fault.
 
     Raises:
-        UserError: Naming the option at fault (draccus' own message, or the config's check).
         SystemExit: With status 0 after ``--help``.
     """
     if "--help" in options or "-h" in options:

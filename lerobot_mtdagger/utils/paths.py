@@ -16,11 +16,7 @@ def _nearest_existing(path: Path) -> Path:
 
 
 def _writable(folder: Path) -> bool:
-    """Whether a file can be created in ``folder`` (probed with a temporary file, removed at once).
-
-    A real probe, not ``os.access``: root passes ``os.access`` on read-only mounts (``/proc``, a
-    read-only volume) where creating a file still fails.
-    """
+    """Whether a file can be created in ``folder``, probed for real (``os.access`` lies for root)."""
     try:
         with tempfile.TemporaryFile(dir=folder):
             return True
@@ -29,15 +25,7 @@ def _writable(folder: Path) -> bool:
 
 
 def check_output_dir(path: Path | str, option: str) -> None:
-    """Refuses a folder that cannot be created or written: a file, or under a file or a read-only folder.
-
-    Args:
-        path: The folder a command will create or write into.
-        option: The option that gave it (``--output_dir``), for the message.
-
-    Raises:
-        ValueError: Naming the option, the path and the fix.
-    """
+    """Refuses a folder that cannot be created or written, with a ValueError naming ``option`` and the fix."""
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise ValueError(f"{option}={path} is a file: give a folder path.")
@@ -45,11 +33,7 @@ def check_output_dir(path: Path | str, option: str) -> None:
 
 
 def check_output_file(path: Path | str, option: str) -> None:
-    """Refuses a file path that cannot be written: a folder, or under a file or a read-only folder.
-
-    Raises:
-        ValueError: Naming the option, the path and the fix.
-    """
+    """Refuses a file path that cannot be written, with a ValueError naming ``option`` and the fix."""
     path = Path(path)
     if path.is_dir():
         raise ValueError(f"{option}={path} is a folder: give a file path.")

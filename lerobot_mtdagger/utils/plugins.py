@@ -1,8 +1,7 @@
 """Plugins installed as Python packages: the entry points a registry reads at import.
 
-A package adds a student, a suite or an expert type to the command line by declaring an entry point in its
-``pyproject.toml``; the registry registers it (lazily, as a ``"module:attribute"`` string, so nothing
-is imported until it is asked for)::
+A package adds a student, a suite or an expert type by declaring an entry point in its
+``pyproject.toml``; the registry registers it lazily, as a ``"module:attribute"`` string::
 
     [project.entry-points."lerobot_mtdagger.students"]
     mtdagger-wide = "my_package.students:WideStudent"
@@ -35,15 +34,9 @@ EXPERT_ENTRY_POINTS = "lerobot_mtdagger.experts"
 def register_installed(
     group: str, registered: Collection[str], register: Callable[[str, str], None]
 ) -> list[str]:
-    """Registers every entry point of ``group`` whose name is not taken yet.
+    """Registers each entry point of ``group`` with ``register(name, "module:attribute")``; returns the names.
 
-    Args:
-        group: The entry-point group.
-        registered: The names the registry holds already (the built-in ones win: a clash is logged).
-        register: ``register(name, "module:attribute")``.
-
-    Returns:
-        The names registered.
+    Names already in ``registered`` are skipped (the built-in ones win; a clash is logged).
     """
     added = []
     for point in sorted(entry_points(group=group), key=lambda point: point.name):

@@ -1,36 +1,15 @@
 """Silencing the third-party console noise of LeRobot calls, narrowly and only around our calls.
 
-What LeRobot (0.4.4 and 0.6.1) and the libraries under it print while an experiment writes and reads
-its rounds, and how each is handled here (all of it only while :func:`quiet_third_party` is active, and
-restored on exit; the user's logging configuration, progress-bar setting and warning filters are left as
-they were):
+While :func:`quiet_third_party` is active (all restored on exit):
 
-- ``Map: 100%|...`` progress bars of the ``datasets`` library, one per episode: ``save_episode`` runs
-  ``datasets.Dataset.map`` (``lerobot.datasets.utils.embed_images``). Turned off with
-  ``datasets.disable_progress_bars()`` and put back to the previous state on exit. (LeRobot's own
-  ``SuppressProgressBars`` re-enables them unconditionally after every dataset load, which is why a
-  global ``disable_progress_bars()`` at start-up stops working after the first load.)
-  ``ExperimentDir.write_round`` does not call ``map`` at all for vector features.
-- ``Using video codec: libsvtav1``: LeRobot logs it from every ``LeRobotDataset.create`` and every
-  ``LeRobotDataset(...)`` load, with or without videos; ``lerobot.datasets.aggregate`` (``merge_rounds``)
-  logs its six step messages alike. LeRobot 0.4 logs them through the ROOT logger (``logging.info``,
-  from the modules ``video_utils`` and ``aggregate``); LeRobot 0.6 through named loggers
-  (``lerobot.configs.video``, ``lerobot.datasets.aggregate``). A :class:`logging.Filter` is attached to
-  the root logger and to each of those named loggers (not to handlers): a logger's filters only see
-  records created on that logger, so nothing else propagating to the same handlers is affected. It
-  drops only records whose message starts with one of the known texts (its two ``tqdm`` bars, one per
-  phase, are left).
-- ``INFO OpenGL.acceleratesupport: No OpenGL_accelerate module loaded``: logged once when PyOpenGL is
-  first imported (by MetaWorld's renderer, when the suite is created). That logger's level is raised
-  to WARNING while active.
-- ``RuntimeWarning: Converting input from bool to <class 'numpy.uint8'>``: ``np.histogram`` in
-  LeRobot 0.4's ``lerobot.datasets.compute_stats`` warns on a bool feature (our ``learner_acted``
-  flag); LeRobot 0.6 casts to float32 first and never warns. Ignored by message, category and module
-  (filters other code adds inside the block are kept on exit). (``ExperimentDir.write_round``
-  computes the same statistics without calling ``np.histogram`` on bools, so it never warns.)
-- ``Loading weights from local directory``: ``PreTrainedPolicy.from_pretrained`` prints it to
-  stdout. While active, ``sys.stdout`` is wrapped by a proxy that drops exactly that line and passes
-  everything else through unchanged.
+- the ``datasets`` "Map" progress bars of ``save_episode`` are disabled (LeRobot's
+  ``SuppressProgressBars`` re-enables them after every load, so a switch at start-up does not hold);
+- LeRobot's "Using video codec" line and ``aggregate_datasets``' step messages are dropped by a
+  :class:`logging.Filter` on the root logger (LeRobot 0.4) and on the named loggers (0.6);
+- PyOpenGL's "No OpenGL_accelerate module loaded" INFO line: its logger is raised to WARNING;
+- numpy's "Converting input from bool" ``RuntimeWarning`` (LeRobot 0.4's statistics of our bool
+  ``learner_acted``) is ignored by message, category and module;
+- the "Loading weights from local directory" print of ``from_pretrained`` is dropped from stdout.
 
 Example::
 
@@ -92,7 +71,6 @@ class RootMessageFilter(logging.Filter):
     """Drops root-logger records of given modules whose message starts with given prefixes."""
 
     def __init__(self, messages: Mapping[str, Iterable[str]]) -> None:
-        """Matches a record whose ``module`` is a key and whose message starts with one of its values."""
         super().__init__()
         self.messages = {module: tuple(prefixes) for module, prefixes in messages.items()}
 
@@ -105,8 +83,7 @@ class RootMessageFilter(logging.Filter):
 class LineDroppingStream:
     r"""A text stream proxy that drops exact lines written by ``print`` and forwards everything else.
 
-    ``print(text)`` writes ``text`` and then ``"\n"`` in two calls; a write equal to a dropped line
-    (with or without its newline) is swallowed together with the newline that follows it.
+    ``print`` writes the text and the newline in two calls: a dropped line's newline is swallowed too.
     """
 
     def __init__(self, stream: TextIO, lines: Iterable[str]) -> None:
@@ -136,11 +113,10 @@ class LineDroppingStream:
 def warnings_ignored(
     specs: Iterable[tuple[str, type[Warning], str]] = IGNORED_WARNINGS,
 ) -> Iterator[None]:
-    """Ignores the given warnings (message regex, category, module regex) while active.
+    """Ignores warnings given as (message regex, category, module regex) while active.
 
-    The warning filters are put back as they were on exit (:func:`warnings.catch_warnings`), except
-    that filters other code added inside the block are kept: a module imported inside the block runs
-    its import-time ``warnings.filterwarnings`` only once.
+    The filters are restored on exit, except those other code added inside the block (a module imported
+    there runs its import-time ``warnings.filterwarnings`` only once).
     """
     added: list[tuple] = []
     try:
@@ -165,11 +141,7 @@ def warnings_ignored(
 
 @contextlib.contextmanager
 def datasets_progress_bars_disabled() -> Iterator[None]:
-    """Disables the ``datasets`` progress bars while active, then restores the previous state.
-
-    The environment variable ``HF_DATASETS_DISABLE_PROGRESS_BARS``, when set, has priority and is
-    respected (nothing is changed then).
-    """
+    """Disables the ``datasets`` progress bars while active (unless ``HF_DATASETS_DISABLE_PROGRESS_BARS``)."""
     # The module: the attribute ``datasets.utils.tqdm`` is the tqdm class.
     hf_tqdm = importlib.import_module("datasets.utils.tqdm")
     forced = hf_tqdm.HF_DATASETS_DISABLE_PROGRESS_BARS
@@ -190,7 +162,6 @@ class PrefixFilter(logging.Filter):
     """Drops every record whose message starts with one of given prefixes (for one named logger)."""
 
     def __init__(self, prefixes: Iterable[str]) -> None:
-        """Matches a record whose message starts with one of ``prefixes``."""
         super().__init__()
         self.prefixes = tuple(prefixes)
 
@@ -204,12 +175,7 @@ def root_messages_filtered(
     messages: Mapping[str, Iterable[str]] = ROOT_MESSAGES,
     named: Mapping[str, Iterable[str]] = NAMED_MESSAGES,
 ) -> Iterator[RootMessageFilter]:
-    """Drops matching LeRobot records while active, on the root logger and on the named loggers.
-
-    Args:
-        messages: Root-logger messages by module (LeRobot 0.4, see :class:`RootMessageFilter`).
-        named: Messages by logger name (LeRobot 0.6, see :class:`PrefixFilter`).
-    """
+    """Drops LeRobot records while active: root ``messages`` by module, ``named`` by logger name."""
     root = logging.getLogger()
     message_filter = RootMessageFilter(messages)
     root.addFilter(message_filter)
@@ -226,10 +192,7 @@ def root_messages_filtered(
 
 @contextlib.contextmanager
 def logger_levels(levels: dict[str, int]) -> Iterator[None]:
-    """Raises (never lowers) the level of the named loggers while active, then restores them.
-
-    A logger whose effective level is already at or above the given one is left untouched.
-    """
+    """Raises (never lowers) the level of the named loggers while active, then restores them."""
     previous: dict[str, int] = {}
     for name, level in levels.items():
         named = logging.getLogger(name)
@@ -265,10 +228,8 @@ def stdout_lines_dropped(lines: Iterable[str] = STDOUT_LINES) -> Iterator[None]:
 def quiet_third_party() -> Iterator[None]:
     """Silences the known per-call noise of LeRobot, ``datasets``, numpy and PyOpenGL while active.
 
-    See the module docstring for exactly what is silenced and how. Everything is restored on exit,
-    also when the block raises; nesting is fine. Like :func:`warnings.catch_warnings`, which it uses,
-    it changes process-wide state for its duration: other threads' matching noise is silenced too
-    (nothing else of theirs is).
+    Restored on exit, also when the block raises; nesting is fine. Like :func:`warnings.catch_warnings`,
+    it changes process-wide state: other threads' matching noise is silenced too.
     """
     with contextlib.ExitStack() as stack:
         stack.enter_context(warnings_ignored())

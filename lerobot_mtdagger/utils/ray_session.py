@@ -1,9 +1,7 @@
 """Joining (or starting) a Ray cluster for ``compare --launcher=ray`` and ``--rollout.worker_backend=ray``.
 
-Ray is an optional dependency (``pip install -e ".[ray]"``). ``connect(address)`` joins the cluster at
-``address`` (``auto``: the one ``ray start`` left on this machine; ``ray://host:10001``: a Ray client)
-or, without one, starts a local Ray on this machine's cores. A process joins at most once; later calls
-reuse the connection.
+Ray is optional (``pip install -e ".[ray]"``). A process joins at most once; later calls reuse the
+connection.
 """
 
 from __future__ import annotations
@@ -21,11 +19,7 @@ RAY_MISSING = 'Ray is not installed: pip install -e ".[ray]" (or pip install "ra
 
 
 def import_ray() -> ModuleType:
-    """The ``ray`` module.
-
-    Raises:
-        UserError: If Ray is not installed, naming the install command.
-    """
+    """The ``ray`` module (a ``UserError`` naming the install command if Ray is missing)."""
     try:
         import ray
     except ImportError:
@@ -34,13 +28,7 @@ def import_ray() -> ModuleType:
 
 
 def check_ray_address(address: str | None, option: str) -> None:
-    """Refuses a ``ray://`` address when the Ray Client's dependency (grpcio) is not installed.
-
-    Ray raises this only when it connects, after a run has started; checked here with the options.
-
-    Raises:
-        UserError: Naming the option and both fixes.
-    """
+    """Refuses a ``ray://`` address without the Ray Client's grpcio now, not on connecting."""
     if address is None or not address.startswith("ray://"):
         return
     if importlib.util.find_spec("grpc") is None:
@@ -51,7 +39,7 @@ def check_ray_address(address: str | None, option: str) -> None:
 
 
 def connect(address: str | None) -> ModuleType:
-    """The ``ray`` module, connected to the cluster at ``address`` (None: a local Ray on this machine).
+    """The ``ray`` module, connected to ``address`` (``auto``, ``ray://host:10001``; None: a local Ray).
 
     Raises:
         UserError: If Ray is missing, or there is no cluster at ``address``.

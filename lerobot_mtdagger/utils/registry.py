@@ -1,8 +1,8 @@
 """One registry idiom for the parts found by name: suites, experts and students.
 
 A ``Registry`` maps names to objects, or to ``"module:attribute"`` strings imported when first asked
-for (``resolve``), so that registering the built-in parts imports none of them; an installed package
-adds its own through an entry-point group (``load_entry_points``, ``utils.plugins``)::
+for, so registering the built-in parts imports none of them; installed packages add theirs through an
+entry-point group (``utils.plugins``)::
 
     SUITES: Registry[SuiteFactory] = Registry("suite", accepts=callable)
     SUITES.register("my-suite", "my_package.suites:make_my_suite")
@@ -24,12 +24,10 @@ T = TypeVar("T")
 class EntryPointError(UserError):
     """A ``"module:attribute"`` string that names nothing importable.
 
-    Attributes:
-        cause: The error behind it (``ImportError``, ``AttributeError``), or None for a malformed string.
+    ``cause`` is the error behind it (``ImportError``, ``AttributeError``), or None for a malformed string.
     """
 
     def __init__(self, message: str, cause: Exception | None = None) -> None:
-        """The message, and the error behind it."""
         super().__init__(message)
         self.cause = cause
 
@@ -43,8 +41,7 @@ def resolve(spec: str) -> Any:
     """The attribute a ``"module:attribute"`` string names, its module imported.
 
     Raises:
-        EntryPointError: A ``UserError`` naming the string, if it is malformed, its module cannot be
-            imported or the module has no such attribute.
+        EntryPointError: If the string is malformed, its module cannot be imported or lacks the attribute.
     """
     module_name, _, attribute = spec.partition(":")
     if not module_name or not attribute:
@@ -69,9 +66,11 @@ def resolve(spec: str) -> Any:
 class Registry(Generic[T]):
     """Objects by name, each given as itself or as a ``"module:attribute"`` string imported on first use.
 
-    Attributes:
+    Args:
         kind: What is registered, for messages ("suite", "student").
+        accepts: Whether an object (not an entry-point string) may be registered.
         entry_point_group: The entry-point group installed packages register into (None: none).
+        refusal: The ``TypeError`` message for an object refused under a name (None: a generic one).
     """
 
     def __init__(
@@ -81,14 +80,6 @@ class Registry(Generic[T]):
         entry_point_group: str | None = None,
         refusal: Callable[[Hashable, object], str] | None = None,
     ) -> None:
-        """An empty registry.
-
-        Args:
-            kind: What is registered, for messages.
-            accepts: Whether an object (not an entry-point string) may be registered.
-            entry_point_group: The entry-point group of installed packages (``load_entry_points``).
-            refusal: The ``TypeError`` message for an object refused under a name (None: a generic one).
-        """
         self.kind = kind
         self.accepts = accepts
         self.refusal = refusal
@@ -97,12 +88,7 @@ class Registry(Generic[T]):
         self._resolved: dict[Hashable, T] = {}
 
     def register(self, name: Hashable, obj: T | str | None = None, replace: bool = False) -> Any:
-        """Registers ``obj`` under ``name``; without ``obj``, a decorator that registers what it decorates.
-
-        Args:
-            name: Its name (or key).
-            obj: The object, or its ``"module:attribute"`` entry point (imported by ``get``).
-            replace: Whether a name already registered may be given a new object.
+        """Registers ``obj`` (or its ``"module:attribute"``) under ``name``; without ``obj``, a decorator.
 
         Raises:
             UserError: If ``name`` is taken and ``replace`` is false.
@@ -146,13 +132,10 @@ class Registry(Generic[T]):
     def get(self, name: Hashable, unknown: str | None = None) -> T:
         """The object registered under ``name``, its entry point imported once.
 
-        Args:
-            name: A registered name.
-            unknown: The message for a name not registered (None: one listing the registered names).
+        ``unknown`` is the message for a name not registered (None: one listing the registered names).
 
         Raises:
-            UserError: If ``name`` is not registered, or its entry point does not import
-                (``EntryPointError``).
+            UserError: If ``name`` is not registered, or its entry point does not import.
         """
         if name not in self._entries:
             raise UserError(unknown or self.unknown_message(name))
@@ -177,13 +160,9 @@ class Registry(Generic[T]):
         )
 
     def load_entry_points(self, register: Callable[[str, str], None] | None = None) -> list[str]:
-        """Registers every entry point of the registry's group whose name is not taken (the built-in win).
+        """Registers the group's entry points whose names are not taken (built-ins win); returns the names.
 
-        Args:
-            register: ``register(name, "module:attribute")`` (None: ``self.register``).
-
-        Returns:
-            The names registered.
+        ``register(name, "module:attribute")`` registers one (None: ``self.register``).
         """
         if self.entry_point_group is None:
             return []

@@ -1,24 +1,22 @@
 """Every random stream of a run, named in one place.
 
-A run has one seed (``--seed``). Each kind of random choice draws from its own stream, derived with
-numpy's ``SeedSequence`` from ``(seed, stream, *keys)``, so drawing more from one stream (more
-rounds, tasks or episodes) never shifts another. ``--training.seed``, when given, replaces the run's
-seed in ``TRAINING_STREAM`` alone (``RunConfig.training_seed``): other trainings on the same data.
+Each kind of random choice draws from its own stream, seeded with numpy's ``SeedSequence`` from
+``(seed, stream, *keys)``, so drawing more from one stream never shifts another. ``--training.seed``
+replaces the run's seed in ``TRAINING_STREAM`` alone.
 
-Streams (number; the keys after it; what it decides):
+Streams (number; keys; what it decides):
 
-- ``COLLECT_STREAM`` (0; round, task, episode): the env reset of a collected episode (``episode_seed``).
+- ``COLLECT_STREAM`` (0; round, task, episode): the env reset of a collected episode.
 - ``EVAL_STREAM`` (1; round, task, episode): the env reset of an evaluation episode (offset by 2**31).
 - ``BETA_STREAM`` (2; round, task, episode): who acts in an episode of a mixed DAgger round.
 - ``TRAINING_STREAM`` (3; round): a phase's initial weights and batch order.
-- ``NOISE_STREAM`` (4; round, task, episode): an imperfect expert's action noise (``experts/noise.py``),
-  seeded by ``--expert.noise_seed`` in place of the run's seed.
-- ``EXPERT_CHECK_STREAM`` (5; 0, task, episode): the env reset of an episode that measures a task's
-  expert for ``--expert.min_success`` (``runner/rollout/expert_check.py``).
+- ``NOISE_STREAM`` (4; round, task, episode): an imperfect expert's action noise (seeded by
+  ``--expert.noise_seed``).
+- ``EXPERT_CHECK_STREAM`` (5; 0, task, episode): the resets that measure an expert for
+  ``--expert.min_success``.
 - ``HELDOUT_STREAM`` (7; task): which episodes a run holds out of training.
 
-The frames each phase measures its per-task loss on are drawn from ``np.random.default_rng(seed)``
-itself (``splits.split_frames``), as every run since the first did.
+The frames a phase measures its per-task loss on come from ``np.random.default_rng(seed)``.
 """
 
 from __future__ import annotations
