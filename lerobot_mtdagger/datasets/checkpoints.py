@@ -12,7 +12,6 @@ policy config resolves its ``type`` through LeRobot's config registry, so neithe
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 from typing import Any
 
@@ -23,11 +22,11 @@ from lerobot.processor.pipeline import ProcessorStepRegistry
 from lerobot_mtdagger.datasets.student_types import student_policy_types
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.hub import is_hub_id, network_errors
 from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 PROCESSOR_FILES = ("policy_preprocessor.json", "policy_postprocessor.json")
 POLICY_TYPE = "mtdagger"
-HUB_ID_PATTERN = re.compile(r"[A-Za-z0-9][\w.-]*/[A-Za-z0-9][\w.-]*")
 """``owner/name``: a ``--policy_path`` of this form that is not a local folder is read from the Hub."""
 
 TRUST_HINT = "load only checkpoints you trust, with --trust_checkpoint=true"
@@ -91,11 +90,6 @@ def check_hub_policy(repo_id: str) -> None:
 
     for name in PROCESSOR_FILES:
         check_processor_config(Path(hf_hub_download(repo_id, name)))
-
-
-def is_hub_id(path: str) -> bool:
-    """Whether a policy path that is not on disk names a Hub repo (``owner/name``)."""
-    return HUB_ID_PATTERN.fullmatch(str(path)) is not None
 
 
 def check_policy_path(path: str | Path) -> None:
@@ -194,7 +188,7 @@ def load_policy(
 
     try:
         return _load_checked(path, device, trust_checkpoint)
-    except (HfHubHTTPError, LocalEntryNotFoundError, OSError) as error:
+    except (HfHubHTTPError, LocalEntryNotFoundError, OSError, *network_errors()) as error:
         raise UserError(
             f"Cannot load the Hub policy {path} ({type(error).__name__}): check the repo id, the "
             "network and HF_TOKEN, or pass a local policy folder."

@@ -24,6 +24,7 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.hub import network_errors
 
 FRAME_SUCCESS_KEY = "next.success"
 """The per-frame success column ``lerobot-eval`` and the runner's rounds write."""
@@ -117,7 +118,7 @@ def open_metadata(source: str, revision: str | None = None):
         )
     try:
         return LeRobotDatasetMetadata(source, revision=revision)
-    except (OSError, ValueError) as error:  # network, missing repo, or a bad revision
+    except (OSError, ValueError, *network_errors()) as error:  # network, missing repo, or a bad revision
         raise UserError(
             f"--datasets: cannot open {source} from the Hub or LeRobot's cache ({type(error).__name__}): "
             "check the repo id and your connection, or give its local folder."
