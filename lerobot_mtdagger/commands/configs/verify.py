@@ -1,0 +1,21 @@
+"""Options of ``lerobot-mtdagger verify``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+
+@dataclass
+class VerifyConfig:
+    """Options of ``lerobot-mtdagger verify``.
+
+    Attributes:
+        experiment_dir: The experiment's output directory.
+    """
+
+    experiment_dir: Path | None = None
+
+    def __post_init__(self) -> None:
+        if self.experiment_dir is None:
+            raise ValueError("--experiment_dir is required (the output_dir of a run).")
