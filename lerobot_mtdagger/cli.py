@@ -35,6 +35,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
+from lerobot_mtdagger.commands.configs import ChecksPaths
 from lerobot_mtdagger.commands.console import configure_console_logging, error_line
 from lerobot_mtdagger.runner.configs import RUN_OPTION_RENAMES, SUITE_OPTION_RENAMES, renamed_option_error
 from lerobot_mtdagger.utils.errors import UserError
@@ -58,7 +59,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "demo": ("configs.demo:DemoConfig", "demo:run_demo"),
 }
 """Each command's options (``commands/configs/<command>.py``) and body (``commands/<command>.py``), as
-``module:attribute`` under ``COMMANDS_PACKAGE``: the body is imported once the options parsed."""
+``module:attribute`` under ``COMMANDS_PACKAGE``: the body is imported once the options parsed and checked."""
 
 
 def command_part(spec: str) -> Any:
@@ -123,7 +124,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def run_command(command: str, options: list[str]) -> None:
-    """Parses a command's options, then imports and runs its body.
+    """Parses a command's options, checks the paths they name, then imports and runs its body.
 
     Raises:
         UserError: On a bad option, path or file.
@@ -138,6 +139,8 @@ def run_command(command: str, options: list[str]) -> None:
     if renamed is not None:
         raise UserError(renamed)
     config = parse_options(command_part(config_spec), options, f"lerobot-mtdagger {command}")
+    if isinstance(config, ChecksPaths):
+        config.check_paths()
     function = command_part(body_spec)
     function(config, passed) if command == "compare" else function(config)
 

@@ -7,6 +7,7 @@ import fnmatch
 import json
 import os
 import shutil
+import socket
 import subprocess
 import sys
 import time
@@ -231,3 +232,87 @@ def test_help_and_a_refused_option_import_neither_torch_nor_lerobot(args):
     run = run_fresh(args)
     assert run.heavy == [], (run.heavy, run.errors[-5:])
     assert run.status == (0 if "--help" in args else 2), run.errors[-5:]
+
+
+def missing_path_refusals(tmp_path: Path) -> dict[str, tuple[list[str], Path, str]]:
+    """Command lines naming a path that is not there (or, for merge, one that is): the path, the fix."""
+    missing, experiment, taken = tmp_path / "no-such-folder", tmp_path / "experiment", tmp_path / "taken"
+    return {
+        "verify": (["verify", f"--experiment_dir={missing}"], missing, "pass the --output_dir of a"),
+        "merge into an existing folder": (
+            ["merge", f"--experiment_dir={experiment}", f"--output={taken}"],
+            taken,
+            "choose another --output",
+        ),
+        "merge": (["merge", f"--experiment_dir={missing}", f"--output={taken}/merged"], missing, "pass the"),
+        "report": (["report", f"--experiments=[{missing}]"], missing, "give experiment folders"),
+        "report --results": (["report", f"--results=[{missing}]"], missing, "pass the results.json"),
+        "replay": (["replay", f"--records=[{missing}]"], missing, "give the folder"),
+        "eval": (["eval", f"--policy_path={missing}"], missing, "--policy_path takes a policy folder"),
+        "shift": (["shift", f"--policy_path={missing}"], missing, "--policy_path takes a policy folder"),
+        "push": (["push", f"--experiment_dir={missing}", "--repo_id=me/rounds"], missing, "pass the"),
+        "plan": (
+            ["plan", f"--datasets=[{missing}]", "--budget=5", f"--output={tmp_path}/p.json"],
+            missing,
+            "give",
+        ),
+        "plan --previous": (
+            [
+                "plan",
+                f"--datasets=[{missing}]",
+                "--budget=5",
+                f"--previous={missing}",
+                f"--output={tmp_path}/p.json",
+            ],
+            missing,
+            "give the plan file",
+        ),
+        "plan --verify": (["plan", f"--verify={missing}"], missing, "give the plan file"),
+    }
+
+
+@pytest.mark.parametrize("case", sorted(missing_path_refusals(Path("/unused"))), ids=str)
+def test_a_missing_path_is_refused_in_one_line_before_torch_or_lerobot_load(tmp_path, case):
+    args, path, fix = missing_path_refusals(tmp_path)[case]
+    (tmp_path / "experiment").mkdir()  # as far as the check looks: a folder with a config.json
+    (tmp_path / "experiment" / "config.json").write_text("{}")
+    (tmp_path / "taken").mkdir()
+    run = run_fresh(args)
+    assert run.status == 2 and len(run.errors) == 1, run.errors[-5:]
+    assert run.errors[0].startswith(f"lerobot-mtdagger {args[0]}: error: "), run.errors
+    assert str(path) in run.errors[0] and fix in run.errors[0], run.errors
+    assert run.heavy == [], run.heavy
+
+
+def closed_port() -> int:
+    """A local port nothing listens on (a connection to it is refused at once)."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+HUB_REFUSALS = {
+    "eval": (["eval", "--policy_path=nobody/not-a-policy"], "nobody/not-a-policy", "model repo"),
+    "shift": (["shift", "--policy_path=bad/nonexistent"], "bad/nonexistent", "model repo"),
+    "plan": (["plan", "--datasets=[data/sesion1]", "--budget=5"], "data/sesion1", "dataset repo"),
+}
+"""Repo ids (or local paths mistyped into the shape of one) that no Hub answers for: the id, the repo type."""
+
+
+@pytest.mark.parametrize("command", sorted(HUB_REFUSALS))
+@pytest.mark.parametrize("hub", ["unreachable", "offline"])
+def test_a_repo_id_the_hub_cannot_confirm_is_one_line_in_seconds(tmp_path, command, hub):
+    """No network needed: the Hub's address is a closed local port, or ``HF_HUB_OFFLINE`` is set."""
+    args, repo_id, repo_type = HUB_REFUSALS[command]
+    args = args + ([f"--output={tmp_path / 'plan.json'}"] if command == "plan" else [])
+    env = {"HF_HOME": str(tmp_path / "hf-home"), "HF_LEROBOT_HOME": str(tmp_path / "lerobot-home")}
+    if hub == "offline":
+        env["HF_HUB_OFFLINE"] = "1"
+    else:
+        env |= {"HF_HUB_OFFLINE": "0", "HF_ENDPOINT": f"http://127.0.0.1:{closed_port()}"}
+    run = run_fresh(args, env)
+    assert run.status == 2 and len(run.errors) == 1, run.errors[-5:]
+    assert repo_id in run.errors[0] and repo_type in run.errors[0], run.errors
+    expected = "HF_HUB_OFFLINE is set" if hub == "offline" else "the Hub cannot be asked"
+    assert expected in run.errors[0] and run.heavy == [], (run.errors, run.heavy)
+    assert run.seconds < 5, run.seconds

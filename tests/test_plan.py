@@ -316,6 +316,8 @@ def test_a_hub_repo_id_is_read_from_lerobots_cache_with_its_revision(tmp_path, m
             continue
         if hasattr(loaded, "HF_LEROBOT_HOME"):
             monkeypatch.setattr(loaded, "HF_LEROBOT_HOME", home)
+    # `plan` looks its inputs up (utils.hub) before LeRobot loads: from the environment variable
+    monkeypatch.setenv("HF_LEROBOT_HOME", str(home))
     status, made = plan(tmp_path, "hub", "--datasets=[me/rollouts]", "--budget=10")
     assert status == 0 and made["inputs"][0]["source"] == "me/rollouts"
     assert (

@@ -19,6 +19,7 @@ from lerobot.configs.policies import PreTrainedConfig
 from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 from lerobot.processor.pipeline import ProcessorStepRegistry
 
+from lerobot_mtdagger.datasets.experiment_files import POLICY_PATH_TAKES
 from lerobot_mtdagger.datasets.student_types import student_policy_types
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.utils.errors import UserError
@@ -102,10 +103,7 @@ def check_policy_path(path: str | Path) -> None:
     if folder.exists():
         check_local_policy(folder)
     elif not is_hub_id(str(path)):
-        raise UserError(
-            f"{path} does not exist: --policy_path takes a policy folder (config.json, model.safetensors, "
-            "processors; e.g. <experiment>/policies/round-003) or a Hub id owner/name."
-        )
+        raise UserError(f"{path} does not exist: --policy_path takes {POLICY_PATH_TAKES}.")
 
 
 def check_local_policy(folder: Path) -> None:

@@ -8,8 +8,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from lerobot_mtdagger.datasets.experiment_files import POLICY_PATH_TAKES
 from lerobot_mtdagger.envs.config import SuiteConfig
 from lerobot_mtdagger.runner.option_groups import WorkerOptions
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.hub import check_hub_repo, in_hub_cache, is_hub_id
 from lerobot_mtdagger.utils.paths import check_output_file
 
 HELDOUT_TASKS = "heldout"
@@ -86,3 +89,19 @@ class EvalConfig(WorkerOptions, EvalTarget):
         if self.suite.name is None:  # draccus builds a SuiteConfig of class defaults when one field is given
             self.suite.name = _eval_suite().name
         self.suite.check()
+
+    def check_paths(self) -> None:
+        """Refuses a ``--policy_path`` that is neither on disk nor a Hub id the Hub has or the cache holds.
+
+        A local folder is checked file by file before it is loaded (``datasets.checkpoints``); a Hub
+        id is looked up once, without retries (``utils.hub``).
+
+        Raises:
+            UserError: Naming the path and the fix.
+        """
+        path = str(self.policy_path)
+        if Path(path).exists():
+            return
+        if not is_hub_id(path):
+            raise UserError(f"{path} does not exist: --policy_path takes {POLICY_PATH_TAKES}.")
+        check_hub_repo(path, "model", "--policy_path", cached=in_hub_cache(path, "model"))

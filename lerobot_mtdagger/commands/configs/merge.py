@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from lerobot_mtdagger.datasets.experiment_files import check_experiment_folder
+from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.paths import check_output_dir
 
 
@@ -32,3 +34,13 @@ class MergeConfig:
         if self.experiment_dir is None or self.output is None:
             raise ValueError("--experiment_dir and --output are required.")
         check_output_dir(self.output, "--output")
+
+    def check_paths(self) -> None:
+        """Refuses an ``--experiment_dir`` that holds no experiment, and an ``--output`` that exists.
+
+        Raises:
+            UserError: Naming the folder and the fix.
+        """
+        check_experiment_folder(Path(self.experiment_dir))
+        if Path(self.output).exists():
+            raise UserError(f"Merge target {self.output} exists; choose another --output or delete it.")

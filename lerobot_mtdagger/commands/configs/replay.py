@@ -5,7 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from lerobot_mtdagger.utils.paths import check_output_file
+from lerobot_mtdagger.analysis.saved_records import saved_records_runs
+from lerobot_mtdagger.utils.paths import check_input_path, check_output_file
 
 
 @dataclass
@@ -71,3 +72,16 @@ class ReplayConfig:
             raise ValueError(f"--levels must be success levels in (0, 1], got {self.levels}.")
         if self.output is not None:
             check_output_file(self.output, "--output")
+
+    def check_paths(self) -> None:
+        """Refuses a ``--records``, ``--experiments`` or ``--results`` path that is not there.
+
+        Raises:
+            UserError: Naming the option, the path and the fix.
+        """
+        for folder in self.records:
+            saved_records_runs(Path(folder))  # as report --records: folders or archives of runs' records
+        for folder in self.experiments:
+            check_input_path(folder, "--experiments", "experiment folders (the --output_dir of runs)")
+        for table in self.results:
+            check_input_path(table, "--results", "a results.json that report or compare wrote, or its folder")

@@ -8,7 +8,8 @@ from pathlib import Path
 from lerobot_mtdagger.analysis.compare import runs_not_started
 from lerobot_mtdagger.analysis.saved_records import saved_records_runs
 from lerobot_mtdagger.datasets.experiment_files import CONFIG_FILE
-from lerobot_mtdagger.utils.paths import check_output_dir, check_output_file
+from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.paths import check_input_path, check_output_dir, check_output_file
 
 
 @dataclass
@@ -99,6 +100,23 @@ class ReportConfig:
             check_output_dir(self.output_dir, "--output_dir")
         if self.output is not None:
             check_output_file(self.output, "--output")
+
+    def check_paths(self) -> None:
+        """Refuses an ``--experiments`` folder or a ``--results`` table that is not there.
+
+        ``--compare_dir``, ``--variants`` and ``--records`` are checked as the options are parsed.
+
+        Raises:
+            UserError: Naming the option, the path and the fix.
+        """
+        for folder in self.experiments:
+            check_input_path(folder, "--experiments", "experiment folders (the --output_dir of runs)")
+        for table in self.results:
+            if not Path(table).exists():
+                raise UserError(
+                    f"{table} does not exist: pass the results.json that `report --output_dir` or `compare` "
+                    "wrote, or the folder that holds it."
+                )
 
     @property
     def experiment_dirs(self) -> list[Path]:
