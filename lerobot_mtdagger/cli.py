@@ -29,46 +29,42 @@ Commands:
     demo: the scheduler on synthetic tasks, each round's allocation (no simulator, no policy).
 """
 
-# The usage above is printed as it is (``_usage``). Each command's options and body live in its
-# module of ``lerobot_mtdagger/commands/``; this module parses the command line and dispatches.
-
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
+from typing import Any
 
-from lerobot_mtdagger.analysis.compare import split_arguments
-from lerobot_mtdagger.commands.compare import CompareConfig, compare_command
+from lerobot_mtdagger.commands.configs import ChecksPaths
 from lerobot_mtdagger.commands.console import configure_console_logging, error_line
-from lerobot_mtdagger.commands.demo import DemoConfig, run_demo
-from lerobot_mtdagger.commands.eval import EvalConfig, eval_command
-from lerobot_mtdagger.commands.merge import MergeConfig, merge_command
-from lerobot_mtdagger.commands.plan import PlanConfig, plan_command
-from lerobot_mtdagger.commands.push import PushConfig, push_command
-from lerobot_mtdagger.commands.records import RecordsConfig, records_command
-from lerobot_mtdagger.commands.replay import ReplayConfig, replay_command
-from lerobot_mtdagger.commands.report import ReportConfig, report_command
-from lerobot_mtdagger.commands.run import RunConfig, run_experiment
-from lerobot_mtdagger.commands.shift import ShiftConfig, shift_command
-from lerobot_mtdagger.commands.verify import VerifyConfig, verify_command
 from lerobot_mtdagger.runner.configs import RUN_OPTION_RENAMES, SUITE_OPTION_RENAMES, renamed_option_error
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parsing import parse_options
+from lerobot_mtdagger.utils.registry import resolve
 
-COMMANDS: dict[str, tuple[type, Callable]] = {
-    "run": (RunConfig, run_experiment),
-    "compare": (CompareConfig, compare_command),
-    "eval": (EvalConfig, eval_command),
-    "shift": (ShiftConfig, shift_command),
-    "verify": (VerifyConfig, verify_command),
-    "merge": (MergeConfig, merge_command),
-    "push": (PushConfig, push_command),
-    "report": (ReportConfig, report_command),
-    "plan": (PlanConfig, plan_command),
-    "replay": (ReplayConfig, replay_command),
-    "records": (RecordsConfig, records_command),
-    "demo": (DemoConfig, run_demo),
+COMMANDS_PACKAGE = "lerobot_mtdagger.commands"
+
+COMMANDS: dict[str, tuple[str, str]] = {
+    "run": ("configs.run:RunConfig", "run:run_experiment"),
+    "compare": ("configs.compare:CompareConfig", "compare:compare_command"),
+    "eval": ("configs.eval:EvalConfig", "eval:eval_command"),
+    "shift": ("configs.shift:ShiftConfig", "shift:shift_command"),
+    "verify": ("configs.verify:VerifyConfig", "verify:verify_command"),
+    "merge": ("configs.merge:MergeConfig", "merge:merge_command"),
+    "push": ("configs.push:PushConfig", "push:push_command"),
+    "report": ("configs.report:ReportConfig", "report:report_command"),
+    "plan": ("configs.plan:PlanConfig", "plan:plan_command"),
+    "replay": ("configs.replay:ReplayConfig", "replay:replay_command"),
+    "records": ("configs.records:RecordsConfig", "records:records_command"),
+    "demo": ("configs.demo:DemoConfig", "demo:run_demo"),
 }
+"""Each command's options (``commands/configs/<command>.py``) and body (``commands/<command>.py``), as
+``module:attribute`` under ``COMMANDS_PACKAGE``: the body is imported once the options parsed and checked."""
+
+
+def command_part(spec: str) -> Any:
+    """The config class or body function a ``COMMANDS`` entry names, its module imported."""
+    return resolve(f"{COMMANDS_PACKAGE}.{spec}")
 
 
 def _usage() -> str:
@@ -128,21 +124,24 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def run_command(command: str, options: list[str]) -> None:
-    """Parses a command's options and runs it.
+    """Parses a command's options, checks the paths they name, then imports and runs its body.
 
     Raises:
         UserError: On a bad option, path or file.
     """
-    config_class, function = COMMANDS[command]
+    config_spec, body_spec = COMMANDS[command]
     passed: list[str] = []
     if command == "compare" and ("--help" in options or "-h" in options):
         options = ["--help"]  # compare's own options; `run --help` lists those passed to each run
     elif command == "compare":  # compare's own options; every other option goes to each run
-        options, passed = split_arguments(options)
+        options, passed = command_part("configs.compare:split_arguments")(options)
     renamed = renamed_option_error(passed if command == "compare" else options, OPTION_RENAMES.get(command))
     if renamed is not None:
         raise UserError(renamed)
-    config = parse_options(config_class, options, f"lerobot-mtdagger {command}")
+    config = parse_options(command_part(config_spec), options, f"lerobot-mtdagger {command}")
+    if isinstance(config, ChecksPaths):
+        config.check_paths()
+    function = command_part(body_spec)
     function(config, passed) if command == "compare" else function(config)
 
 

@@ -2,19 +2,24 @@
 
 from __future__ import annotations
 
+import ast
 import fnmatch
 import json
+import os
 import shutil
+import socket
 import subprocess
 import sys
+import time
 import zipfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from lerobot_mtdagger.analysis.simulate import SyntheticTasks, simulate
-from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.cli import COMMANDS, main
 from lerobot_mtdagger.datasets_cards import card_template
 from lerobot_mtdagger.scheduler import allocation_mismatches, make_scheduler
 
@@ -111,7 +116,8 @@ def test_eval_takes_the_observation_options_the_policy_was_trained_with(inputs, 
 
     from lerobot.configs.types import FeatureType, PolicyFeature
 
-    from lerobot_mtdagger.commands.eval import EvalConfig, observation_options
+    from lerobot_mtdagger.commands.configs.eval import EvalConfig
+    from lerobot_mtdagger.commands.eval import observation_options
     from lerobot_mtdagger.envs import SuiteConfig
 
     features = {
@@ -171,17 +177,142 @@ def test_run_help_names_lerobot_students_and_describes_one_when_asked(capsys):
     assert "--policy.chunk_size=INT" in capsys.readouterr().out
 
 
+IN_A_FRESH_PROCESS = """
+import sys
+from lerobot_mtdagger.cli import main
+try:
+    status = main(sys.argv[1:])
+except SystemExit as exit_:
+    status = exit_.code
+print(status, [m for m in ('torch', 'lerobot') if m in sys.modules])
+"""
+"""The command line run in a new interpreter, which then prints its status and the heavy libraries loaded."""
+
+
+@dataclass
+class FreshRun:
+    """What ``run_fresh`` saw: the exit status, the heavy libraries loaded, the error lines, the time."""
+
+    status: int
+    heavy: list[str]
+    errors: list[str]
+    seconds: float
+
+
+def run_fresh(args: list[str], env: dict[str, str] | None = None) -> FreshRun:
+    """``lerobot-mtdagger ARGS`` in a new interpreter (``IN_A_FRESH_PROCESS``)."""
+    start = time.perf_counter()
+    result = subprocess.run(
+        [sys.executable, "-c", IN_A_FRESH_PROCESS, *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, **(env or {})},
+    )
+    seconds = time.perf_counter() - start
+    assert result.returncode == 0, result.stderr[-3000:]
+    status, heavy = result.stdout.strip().splitlines()[-1].split(" ", 1)
+    return FreshRun(int(status), ast.literal_eval(heavy), result.stderr.strip().splitlines(), seconds)
+
+
+REFUSED_OPTION = {"compare": "--seeds=[-1]"}
+"""An option each command refuses as it parses (``--nope=1``, an unknown option, unless named here:
+compare passes unknown options on to its runs)."""
+
+
 @pytest.mark.parametrize(
-    "args", [["run", "--help"], ["compare", "--help"], ["run", "--preset=nope"], ["plan", "--help"]]
+    "args",
+    [[command, "--help"] for command in COMMANDS]
+    + [[command, REFUSED_OPTION.get(command, "--nope=1")] for command in COMMANDS]
+    + [["run", "--preset=nope"], ["--help"]],
+    ids=lambda args: " ".join(args),
 )
 def test_help_and_a_refused_option_import_neither_torch_nor_lerobot(args):
     """What makes them answer in under a second instead of 9-18 s (``benchmarks/bench_cli_startup.sh``)."""
-    code = (
-        "import sys\nfrom lerobot_mtdagger.cli import main\n"
-        f"try:\n    main({args!r})\nexcept SystemExit:\n    pass\n"
-        "print(sorted(m for m in ('torch', 'lerobot') if m in sys.modules))"
-    )
-    result = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
-    )
-    assert result.stdout.strip().splitlines()[-1] == "[]", result.stdout[-2000:]
+    run = run_fresh(args)
+    assert run.heavy == [], (run.heavy, run.errors[-5:])
+    assert run.status == (0 if "--help" in args else 2), run.errors[-5:]
+
+
+def missing_path_refusals(tmp_path: Path) -> dict[str, tuple[list[str], Path, str]]:
+    """Command lines naming a path that is not there (or, for merge, one that is): the path, the fix."""
+    missing, experiment, taken = tmp_path / "no-such-folder", tmp_path / "experiment", tmp_path / "taken"
+    return {
+        "verify": (["verify", f"--experiment_dir={missing}"], missing, "pass the --output_dir of a"),
+        "merge into an existing folder": (
+            ["merge", f"--experiment_dir={experiment}", f"--output={taken}"],
+            taken,
+            "choose another --output",
+        ),
+        "merge": (["merge", f"--experiment_dir={missing}", f"--output={taken}/merged"], missing, "pass the"),
+        "report": (["report", f"--experiments=[{missing}]"], missing, "give experiment folders"),
+        "report --results": (["report", f"--results=[{missing}]"], missing, "pass the results.json"),
+        "replay": (["replay", f"--records=[{missing}]"], missing, "give the folder"),
+        "eval": (["eval", f"--policy_path={missing}"], missing, "--policy_path takes a policy folder"),
+        "shift": (["shift", f"--policy_path={missing}"], missing, "--policy_path takes a policy folder"),
+        "push": (["push", f"--experiment_dir={missing}", "--repo_id=me/rounds"], missing, "pass the"),
+        "plan": (
+            ["plan", f"--datasets=[{missing}]", "--budget=5", f"--output={tmp_path}/p.json"],
+            missing,
+            "give",
+        ),
+        "plan --previous": (
+            [
+                "plan",
+                f"--datasets=[{missing}]",
+                "--budget=5",
+                f"--previous={missing}",
+                f"--output={tmp_path}/p.json",
+            ],
+            missing,
+            "give the plan file",
+        ),
+        "plan --verify": (["plan", f"--verify={missing}"], missing, "give the plan file"),
+    }
+
+
+@pytest.mark.parametrize("case", sorted(missing_path_refusals(Path("/unused"))), ids=str)
+def test_a_missing_path_is_refused_in_one_line_before_torch_or_lerobot_load(tmp_path, case):
+    args, path, fix = missing_path_refusals(tmp_path)[case]
+    (tmp_path / "experiment").mkdir()  # as far as the check looks: a folder with a config.json
+    (tmp_path / "experiment" / "config.json").write_text("{}")
+    (tmp_path / "taken").mkdir()
+    run = run_fresh(args)
+    assert run.status == 2 and len(run.errors) == 1, run.errors[-5:]
+    assert run.errors[0].startswith(f"lerobot-mtdagger {args[0]}: error: "), run.errors
+    assert str(path) in run.errors[0] and fix in run.errors[0], run.errors
+    assert run.heavy == [], run.heavy
+
+
+def closed_port() -> int:
+    """A local port nothing listens on (a connection to it is refused at once)."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+HUB_REFUSALS = {
+    "eval": (["eval", "--policy_path=nobody/not-a-policy"], "nobody/not-a-policy", "model repo"),
+    "shift": (["shift", "--policy_path=bad/nonexistent"], "bad/nonexistent", "model repo"),
+    "plan": (["plan", "--datasets=[data/sesion1]", "--budget=5"], "data/sesion1", "dataset repo"),
+}
+"""Repo ids (or local paths mistyped into the shape of one) that no Hub answers for: the id, the repo type."""
+
+
+@pytest.mark.parametrize("command", sorted(HUB_REFUSALS))
+@pytest.mark.parametrize("hub", ["unreachable", "offline"])
+def test_a_repo_id_the_hub_cannot_confirm_is_one_line_in_seconds(tmp_path, command, hub):
+    """No network needed: the Hub's address is a closed local port, or ``HF_HUB_OFFLINE`` is set."""
+    args, repo_id, repo_type = HUB_REFUSALS[command]
+    args = args + ([f"--output={tmp_path / 'plan.json'}"] if command == "plan" else [])
+    env = {"HF_HOME": str(tmp_path / "hf-home"), "HF_LEROBOT_HOME": str(tmp_path / "lerobot-home")}
+    if hub == "offline":
+        env["HF_HUB_OFFLINE"] = "1"
+    else:
+        env |= {"HF_HUB_OFFLINE": "0", "HF_ENDPOINT": f"http://127.0.0.1:{closed_port()}"}
+    run = run_fresh(args, env)
+    assert run.status == 2 and len(run.errors) == 1, run.errors[-5:]
+    assert repo_id in run.errors[0] and repo_type in run.errors[0], run.errors
+    expected = "HF_HUB_OFFLINE is set" if hub == "offline" else "the Hub cannot be asked"
+    assert expected in run.errors[0] and run.heavy == [], (run.errors, run.heavy)
+    assert run.seconds < 5, run.seconds

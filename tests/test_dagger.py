@@ -267,7 +267,8 @@ def test_drawer_suite_runs_with_point_clouds_and_evaluates_the_unseen_drawers(tm
         assert all(0 <= p <= 3 for p in record.heldout_eval["progress"] + record.eval["progress"])
     assert experiment.read_round_record(1).episodes_per_task == [1, 1]
 
-    from lerobot_mtdagger.commands.eval import EvalConfig, eval_command
+    from lerobot_mtdagger.commands.configs.eval import EvalConfig
+    from lerobot_mtdagger.commands.eval import eval_command
 
     policy = experiment.policy_root(1)
     # No --suite.obs_mode / --suite.num_points: eval reads them from the policy's inputs (a 128-point cloud).

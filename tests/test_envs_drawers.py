@@ -9,7 +9,7 @@ import warnings
 import numpy as np
 import pytest
 
-from lerobot_mtdagger.commands.eval import EvalConfig
+from lerobot_mtdagger.commands.configs.eval import EvalConfig
 from lerobot_mtdagger.envs import (
     IMAGE_KEY,
     POINTCLOUD_KEY,

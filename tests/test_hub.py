@@ -15,13 +15,19 @@ import filecmp
 import hashlib
 import json
 import os
+import re
 import shutil
+import socket
 import subprocess
 import sys
+import threading
+import time
 from dataclasses import dataclass, field
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from types import SimpleNamespace
 
+import httpx
 import pyarrow.parquet as pq
 import pytest
 import requests
@@ -34,6 +40,7 @@ from lerobot_mtdagger.datasets.experiment_dir import RECORD_FILES, ExperimentDir
 from lerobot_mtdagger.datasets.hub import PushConfig, push_command, push_experiment, render_dataset_card
 from lerobot_mtdagger.datasets.integrity import folder_digests
 from lerobot_mtdagger.utils.errors import CorruptExperimentError, UserError
+from lerobot_mtdagger.utils.hub import check_hub_repo, in_hub_cache, is_hub_id, lerobot_dataset_cache
 from tests.helpers import edit_round_record
 
 TASKS = ["toy-left", "toy-right"]
@@ -72,8 +79,10 @@ class FakeHfApi:
         self.calls.append("whoami")
         if self.access == "no token":
             raise LocalTokenNotFoundError("Token is required (`token=True`), but no token found.")
-        if self.access == "offline":
+        if self.access == "offline":  # huggingface_hub 0.x sends with requests
             raise requests.ConnectionError("Failed to resolve 'huggingface.co'")
+        if self.access == "offline (httpx)":  # 1.x sends with httpx
+            raise httpx.ConnectError("[Errno -2] Name or service not known")
         return {"name": "tester"}
 
     def _repo(self, repo_id: str, repo_type: str | None) -> FakeRepo:
@@ -259,7 +268,12 @@ def test_nothing_is_sent_for_a_directory_that_is_not_an_experiment(tmp_path, fak
 
 
 @pytest.mark.parametrize(
-    ("access", "message"), [("no token", "No Hugging Face token"), ("offline", "Cannot reach the Hub")]
+    ("access", "message"),
+    [
+        ("no token", "No Hugging Face token"),
+        ("offline", "Cannot reach the Hub"),
+        ("offline (httpx)", "Cannot reach the Hub"),
+    ],
 )
 def test_the_token_and_network_are_checked_before_anything_is_sent(experiment_dir, fake_api, access, message):
     fake_api.access = access
@@ -344,6 +358,112 @@ def test_push_command_pushes_with_the_default_client(experiment_dir, fake_api, m
     pushed = push_command(config)
     assert list(pushed["dataset"]) == list(pushed["policy"]) == ["round-000", "round-001"]
     assert not fake_api.repos[("dataset", DATASET_REPO)].private
+
+
+# -------------------------------------------------------------------------------------------------
+# Looking a repo id up before loading it (utils/hub.py), against a local stand-in for the Hub's API
+# -------------------------------------------------------------------------------------------------
+
+
+class _HubStandIn(BaseHTTPRequestHandler):
+    """Answers every request with the server's ``status`` (404: the Hub's "repository not found")."""
+
+    def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+        body = b'{"error": "Repository Not Found"}'
+        self.send_response(self.server.status)
+        if self.server.status == 404:
+            self.send_header("X-Error-Code", "RepoNotFound")
+        self.send_header("Content-Type", "application/json")
+        self.send_header("Content-Length", str(len(body)))
+        self.end_headers()
+        self.wfile.write(body)
+
+    def log_message(self, *args: object) -> None:
+        del args
+
+
+@pytest.fixture
+def hub_answering(monkeypatch):
+    """``hub_answering(status)``: points huggingface_hub at a local server answering ``status``."""
+    import huggingface_hub.constants
+
+    servers = []
+
+    def start(status: int | None) -> None:
+        if status is None:  # nothing listens: the connection is refused at once
+            with socket.socket() as probe:
+                probe.bind(("127.0.0.1", 0))
+                port = probe.getsockname()[1]
+        else:
+            server = ThreadingHTTPServer(("127.0.0.1", 0), _HubStandIn)
+            server.status = status
+            threading.Thread(target=server.serve_forever, daemon=True).start()
+            servers.append(server)
+            port = server.server_address[1]
+        monkeypatch.setattr(huggingface_hub.constants, "ENDPOINT", f"http://127.0.0.1:{port}")
+        monkeypatch.setattr(huggingface_hub.constants, "HF_HUB_OFFLINE", False)
+
+    yield start
+    for server in servers:
+        server.shutdown()
+
+
+@pytest.mark.parametrize(
+    ("status", "message"),
+    [
+        (404, "the Hub has no model repo of that id (or it is private or gated"),
+        (500, "the Hub cannot be asked about a model repo of that id (HTTP 500)"),
+        (None, "the Hub cannot be asked about a model repo of that id (Connect"),
+    ],
+    ids=["no such repo", "server error", "unreachable"],
+)
+def test_a_repo_id_the_hub_does_not_confirm_is_refused_in_one_line(hub_answering, status, message):
+    hub_answering(status)
+    start = time.perf_counter()
+    with pytest.raises(UserError, match=re.escape(message)) as refused:
+        check_hub_repo("nobody/not-a-policy", "model", "--policy_path", cached=False)
+    assert str(refused.value).startswith("--policy_path=nobody/not-a-policy is not a local path")
+    assert time.perf_counter() - start < 5  # one request, no retries
+
+
+def test_a_cached_repo_is_read_when_the_hub_is_out_of_reach_but_not_when_it_is_gone(hub_answering, caplog):
+    hub_answering(None)
+    check_hub_repo("me/policy", "model", "--policy_path", cached=True)
+    assert "reading the cached copy" in caplog.text
+    hub_answering(404)
+    with pytest.raises(UserError, match="the Hub has no model repo"):
+        check_hub_repo("me/policy", "model", "--policy_path", cached=True)
+
+
+def test_offline_only_the_cache_is_asked(monkeypatch, tmp_path):
+    import huggingface_hub.constants
+
+    monkeypatch.setattr(huggingface_hub.constants, "HF_HUB_OFFLINE", True)
+    monkeypatch.setattr(huggingface_hub.constants, "HF_HUB_CACHE", str(tmp_path))
+    with pytest.raises(UserError, match="not in the cache while HF_HUB_OFFLINE is set"):
+        check_hub_repo("me/policy", "model", "--policy_path", cached=in_hub_cache("me/policy", "model"))
+    (tmp_path / "models--me--policy" / "snapshots" / "0123abc").mkdir(parents=True)
+    check_hub_repo("me/policy", "model", "--policy_path", cached=in_hub_cache("me/policy", "model"))
+
+
+def test_lerobots_dataset_cache_follows_its_environment_variables(monkeypatch, tmp_path):
+    monkeypatch.setenv("HF_LEROBOT_HOME", str(tmp_path / "home"))
+    assert lerobot_dataset_cache("me/rollouts") == tmp_path / "home" / "me" / "rollouts"
+    monkeypatch.delenv("HF_LEROBOT_HOME")
+    import huggingface_hub.constants
+
+    assert (
+        lerobot_dataset_cache("me/rollouts")
+        == Path(huggingface_hub.constants.HF_HOME) / "lerobot/me/rollouts"
+    )
+
+
+@pytest.mark.parametrize(
+    ("text", "is_id"),
+    [("me/policy", True), ("data/sesion1", True), ("policy", False), ("/abs/path", False), ("a/b/c", False)],
+)
+def test_a_hub_id_is_owner_slash_name(text, is_id):
+    assert is_hub_id(text) is is_id
 
 
 # -------------------------------------------------------------------------------------------------

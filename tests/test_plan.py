@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 from lerobot_mtdagger.cli import main
+from lerobot_mtdagger.planning.episodes import open_metadata
 from lerobot_mtdagger.scheduler import KalmanSuccessEstimator
+from lerobot_mtdagger.utils.errors import UserError
 
 FIXTURE_ROUND = Path(__file__).parent / "data" / "experiment-lerobot-0.4.4" / "rounds" / "round-001"
 
@@ -314,6 +316,8 @@ def test_a_hub_repo_id_is_read_from_lerobots_cache_with_its_revision(tmp_path, m
             continue
         if hasattr(loaded, "HF_LEROBOT_HOME"):
             monkeypatch.setattr(loaded, "HF_LEROBOT_HOME", home)
+    # `plan` looks its inputs up (utils.hub) before LeRobot loads: from the environment variable
+    monkeypatch.setenv("HF_LEROBOT_HOME", str(home))
     status, made = plan(tmp_path, "hub", "--datasets=[me/rollouts]", "--budget=10")
     assert status == 0 and made["inputs"][0]["source"] == "me/rollouts"
     assert (
@@ -324,6 +328,30 @@ def test_a_hub_repo_id_is_read_from_lerobots_cache_with_its_revision(tmp_path, m
     assert "neither a folder nor a Hub repo id" in _refused(
         tmp_path, capsys, "--datasets=[not-a-repo]", "--budget=5"
     )
+
+
+def test_a_repo_id_lerobot_cannot_fetch_is_one_line(tmp_path, monkeypatch):
+    """As ``plan --verify`` re-reads a recorded Hub dataset: a Hub out of reach (here a closed local port)
+    is one ``UserError`` with huggingface_hub 0.x (requests) and 1.x (httpx) alike."""
+    import importlib
+    import socket
+
+    import huggingface_hub.constants
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    monkeypatch.setattr(huggingface_hub.constants, "ENDPOINT", f"http://127.0.0.1:{port}")
+    monkeypatch.setattr(huggingface_hub.constants, "HF_HUB_OFFLINE", False)
+    for module in ("lerobot.datasets.dataset_metadata", "lerobot.datasets.lerobot_dataset"):
+        try:
+            loaded = importlib.import_module(module)
+        except ImportError:  # LeRobot 0.4 has no dataset_metadata module
+            continue
+        if hasattr(loaded, "HF_LEROBOT_HOME"):
+            monkeypatch.setattr(loaded, "HF_LEROBOT_HOME", tmp_path / "empty-home")
+    with pytest.raises(UserError, match="cannot open me/rollouts from the Hub or LeRobot's cache"):
+        open_metadata("me/rollouts")
 
 
 def test_the_curve_scheduler_plans_from_the_demos_each_session_adds(tmp_path, capsys):

@@ -507,7 +507,8 @@ def test_eval_of_a_hub_id_that_cannot_be_fetched_is_one_error_line(monkeypatch, 
     monkeypatch.setattr(huggingface_hub.constants, "HF_HUB_OFFLINE", True)  # no network in the test
     assert main(["eval", "--policy_path=nobody/no-such-policy"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "Cannot load the Hub policy nobody/no-such-policy" in err[0], err
+    assert len(err) == 1 and "--policy_path=nobody/no-such-policy is not a local path" in err[0], err
+    assert "not in the cache while HF_HUB_OFFLINE is set" in err[0], err
 
 
 def test_eval_of_an_rgb_policy_runs_and_a_wrong_image_size_is_named(tmp_path, capsys):

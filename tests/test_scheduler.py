@@ -397,7 +397,7 @@ def test_tampered_record_is_detected():
 def test_scheduler_config_parses_from_command_line():
     import draccus
 
-    from lerobot_mtdagger.commands.demo import DemoConfig
+    from lerobot_mtdagger.commands.configs.demo import DemoConfig
 
     config = draccus.parse(DemoConfig, args=["--scheduler.type=gain", "--scheduler.temperature=0.25"])
     assert config.scheduler.type == "gain"
@@ -472,7 +472,7 @@ def squared_need_method():
 def test_a_method_added_as_one_class_schedules_parses_and_verifies(squared_need_method):
     import draccus
 
-    from lerobot_mtdagger.commands.demo import DemoConfig
+    from lerobot_mtdagger.commands.configs.demo import DemoConfig
 
     assert squared_need_method in scheduling_methods()
     scheduler = make_scheduler(squared_need_method, 3)

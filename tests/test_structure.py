@@ -326,25 +326,78 @@ def test_imports_run_one_way_between_wings():
 MAX_CLI_LINES = 150
 """``cli.py`` parses the command line and dispatches; the commands live in ``commands/``."""
 
+COMMANDS_WING = "lerobot_mtdagger.commands"
+CONFIGS_PACKAGE = f"{COMMANDS_WING}.configs"
+"""Each command's options, one module per command (imports neither torch nor LeRobot: ``test_cli.py``)."""
+
 SHARED_CONFIGS = {
     "run": "lerobot_mtdagger.runner.configs",
     "compare": "lerobot_mtdagger.analysis.compare",
     "push": "lerobot_mtdagger.datasets.push_config",
     "plan": "lerobot_mtdagger.planning.plan",
 }
-"""Commands whose config a lower wing reads too: it is defined there, and the command's module imports it."""
+"""Commands whose config a lower wing reads too: it is defined there, and the command's config module
+names it."""
+
+NOT_COMMANDS = {f"{COMMANDS_WING}.console", CONFIGS_PACKAGE}
+"""Modules of the commands wing that are no command's body: the console helpers, the options package."""
 
 
-def test_cli_only_dispatches_to_one_module_per_command():
-    """Each command's function, and its config, sit in ``commands/<command>.py``; ``cli.py`` stays short."""
+def command_parts() -> dict[str, tuple[type, object]]:
+    """Each command of ``cli.COMMANDS`` with its config class and body function, resolved."""
+    from lerobot_mtdagger.cli import COMMANDS, command_part
+
+    return {name: (command_part(config), command_part(body)) for name, (config, body) in COMMANDS.items()}
+
+
+def test_cli_names_one_options_module_and_one_body_module_per_command():
+    """``cli.COMMANDS`` names ``configs/<command>.py``'s dataclass and ``<command>.py``'s function."""
+    import dataclasses
+
     from lerobot_mtdagger.cli import COMMANDS
 
     assert len(module_path("lerobot_mtdagger.cli").read_text().splitlines()) <= MAX_CLI_LINES
-    for name, (config_class, function) in COMMANDS.items():
-        home = f"lerobot_mtdagger.commands.{name}"
-        assert function.__module__ == home, (name, function.__module__)
-        assert config_class.__module__ == SHARED_CONFIGS.get(name, home), (name, config_class.__module__)
-        assert vars(sys.modules[home]).get(config_class.__name__) is config_class, (name, "config not named")
+    for name, (config_class, function) in command_parts().items():
+        config_module, body_module = (f"{COMMANDS_WING}.{spec.partition(':')[0]}" for spec in COMMANDS[name])
+        assert (config_module, body_module) == (f"{CONFIGS_PACKAGE}.{name}", f"{COMMANDS_WING}.{name}"), name
+        assert dataclasses.is_dataclass(config_class), (name, config_class)
+        assert config_class.__module__ == SHARED_CONFIGS.get(name, config_module), name
+        assert vars(sys.modules[config_module]).get(config_class.__name__) is config_class, name
+        assert callable(function) and function.__module__ == body_module, (name, function)
+    bodies = submodules(COMMANDS_WING) - {m.rpartition(".")[2] for m in NOT_COMMANDS}
+    assert submodules(CONFIGS_PACKAGE) == set(COMMANDS) == bodies, (submodules(CONFIGS_PACKAGE), bodies)
+
+
+def submodules(package: str) -> set[str]:
+    """The names of the modules and packages directly in ``package``."""
+    prefix = package + "."
+    return {
+        m.removeprefix(prefix)
+        for m in package_modules()
+        if m.startswith(prefix) and "." not in m[len(prefix) :]
+    }
+
+
+def function_level_imports(name: str) -> list[str]:
+    """The import statements inside the functions of module ``name``, as ``line N``."""
+    tree = ast.parse(module_path(name).read_text())
+    functions = [node for node in ast.walk(tree) if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)]
+    return sorted(
+        {
+            f"line {node.lineno}"
+            for function in functions
+            for node in ast.walk(function)
+            if isinstance(node, ast.Import | ast.ImportFrom)
+        }
+    )
+
+
+def test_command_bodies_import_what_they_use_at_their_top():
+    """The CLI imports a body only after its options parsed, so a body hides no import in a function."""
+    from lerobot_mtdagger.cli import COMMANDS
+
+    hidden = {name: function_level_imports(f"{COMMANDS_WING}.{name}") for name in COMMANDS}
+    assert {name: found for name, found in hidden.items() if found} == {}
 
 
 WORKER_FIELDS = {"workers", "worker_backend"}
@@ -372,11 +425,10 @@ def test_every_command_takes_its_worker_options_from_one_group():
     """A command's option group with env worker options inherits them from ``WorkerOptions``."""
     import dataclasses
 
-    from lerobot_mtdagger.cli import COMMANDS
     from lerobot_mtdagger.runner.option_groups import WorkerOptions
 
     own, with_workers = [], []
-    for name, (config_class, _) in COMMANDS.items():
+    for name, (config_class, _) in command_parts().items():
         for group in option_groups(config_class):
             fields = {field.name for field in dataclasses.fields(group)} & WORKER_FIELDS
             if fields:

@@ -11,7 +11,8 @@ import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
 
 from lerobot_mtdagger.cli import main
-from lerobot_mtdagger.commands.eval import EvalConfig, eval_command
+from lerobot_mtdagger.commands.configs.eval import EvalConfig
+from lerobot_mtdagger.commands.eval import eval_command
 from lerobot_mtdagger.envs import make_suite
 from lerobot_mtdagger.envs.drawers.catalogue import HELDOUT_DRAWERS, TRAINING_DRAWERS, VARIANTS
 from lerobot_mtdagger.envs.drawers.variants import nearest_variant

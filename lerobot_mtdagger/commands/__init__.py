@@ -1,6 +1,6 @@
-"""The ``lerobot-mtdagger`` commands, one module each: its options and its body (``cli.py`` dispatches).
+"""The ``lerobot-mtdagger`` commands: each one's options in ``configs/<command>.py``, its body here.
 
-A command whose config a lower wing reads too (``run``: ``runner.configs.RunConfig``; ``compare``,
-``push``, ``plan``) imports it from there. Heavy libraries (torch, LeRobot) are imported inside the
-functions that need them, so that ``--help`` and a refused option answer at once.
+``cli.py`` imports a command's options (light: no torch, no LeRobot) to parse and check them, and its
+body module (``<command>.py``, which imports what it needs at its top) only once they are good, so
+that ``--help``, a refused option and a missing path answer at once.
 """

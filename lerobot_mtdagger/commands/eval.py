@@ -1,7 +1,8 @@
 """``lerobot-mtdagger eval``: success per task of a pretrained policy (mtdagger, ACT, Diffusion).
 
-The suite's observations default to those the policy was trained on; ``shift`` (``commands/shift.py``)
-loads its suite and policy the same way (``suite_and_policy``).
+Its options are ``EvalConfig`` (``configs/eval.py``). The suite's observations default to those the
+policy was trained on; ``shift`` (``commands/shift.py``) loads its suite and policy the same way
+(``suite_and_policy``).
 """
 
 from __future__ import annotations
@@ -9,97 +10,24 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
+from lerobot_mtdagger.commands.configs.eval import HELDOUT_TASKS, EvalConfig
+from lerobot_mtdagger.datasets.verify import check_policy_folder
+from lerobot_mtdagger.envs import suite_from_config
+from lerobot_mtdagger.envs.base import TaskSuite
 from lerobot_mtdagger.envs.config import DEFAULT_IMAGE_SIZE, DEFAULT_NUM_POINTS, SuiteConfig
-from lerobot_mtdagger.runner.option_groups import WorkerOptions
+from lerobot_mtdagger.policies.mtdagger.configuration_mtdagger import is_pointcloud_feature
+from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner, evaluate
 from lerobot_mtdagger.utils.errors import UserError
-from lerobot_mtdagger.utils.paths import check_output_file
 
-if TYPE_CHECKING:
-    from lerobot_mtdagger.envs.base import TaskSuite
-    from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
-
-HELDOUT_TASKS = "heldout"
-"""``--suite.tasks='[heldout]'``: the suite's unseen tasks (``eval``, ``shift``)."""
-UNSEEN_RULES: tuple[str, ...] = ("shared", "nearest")
-"""``eval --unseen_rule``: how a policy acts on a task it was not trained on (``EvalConfig``)."""
+__all__ = ["EvalConfig", "check_policy", "eval_command", "observation_options", "suite_and_policy"]
 
 logger = logging.getLogger(__name__)
-
-
-def _eval_suite() -> SuiteConfig:
-    """``eval``'s default suite: MT10, its observations those the policy was trained on."""
-    return SuiteConfig(name="metaworld-mt10")
-
-
-@dataclass
-class EvalTarget:
-    """The policy evaluated, on which suite, over which episodes (``EvalConfig``'s first options).
-
-    Attributes:
-        policy_path: Pretrained model folder or Hub id (with its processors).
-        suite: The suite (``SuiteConfig``, spelt as for ``run``: ``--suite.name=drawers``).
-            ``--suite.tasks='[heldout]'`` evaluates the suite's unseen tasks, which a policy trained
-            with ``task_dropout > 0`` acts on with its shared embedding. ``suite.tasks``,
-            ``suite.obs_mode``, ``suite.num_points`` and ``suite.image_size`` default to what the
-            policy was trained on (its tasks that the suite has, else all the suite's).
-        episodes: Episodes per task.
-        seed: Seed of the evaluation episodes.
-        output: Optional JSON file for the results.
-    """
-
-    policy_path: str | None = None
-    suite: SuiteConfig = field(default_factory=_eval_suite)
-    episodes: int = 10
-    seed: int = 0
-    output: Path | None = None
-
-
-@dataclass
-class EvalConfig(WorkerOptions, EvalTarget):
-    """Options of ``lerobot-mtdagger eval``: success per task of a policy (mtdagger, ACT, Diffusion).
-
-    The options of ``EvalTarget``, then the env workers (``WorkerOptions``, as ``run``'s
-    ``--rollout.*``; the same episodes on any backend), then these: a dataclass takes the fields of
-    its last base first, which keeps this order in ``--help``.
-
-    Attributes:
-        trust_checkpoint: Let the policy's processor configs name Python classes, which LeRobot's
-            loader imports and calls (default: only LeRobot registry names are accepted).
-        unseen_rule: How the policy acts on a task it was not trained on (an unseen drawer):
-            ``shared`` with its shared "any task" embedding (a policy trained with task dropout;
-            what a run's unseen-drawer evaluation does), ``nearest`` with the task input of the
-            training task most like it (the drawers: the same handle type, the nearest handle size
-            and height; ``docs/drawers.md``).
-        unverified: Evaluate a policy whose files differ from the checksums its ``training.json``
-            carries, or a policy of an experiment that fails verification, as it is (with a warning; the
-            output lists the problems under ``unverified``); by default it is refused before loading.
-        allow_changed_policy: The former spelling of ``unverified``.
-    """
-
-    trust_checkpoint: bool = False
-    unseen_rule: str = "shared"
-    unverified: bool = False
-    allow_changed_policy: bool = False
-
-    def __post_init__(self) -> None:
-        self.check_workers()  # before anything runs
-        if self.policy_path is None:
-            raise ValueError("--policy_path is required (a pretrained model folder or a Hub id).")
-        if self.output is not None:  # before evaluating, not after: the results would be lost
-            check_output_file(self.output, "--output")
-        if self.episodes <= 0:
-            raise ValueError(f"episodes must be > 0, got {self.episodes}.")
-        if self.unseen_rule not in UNSEEN_RULES:
-            raise ValueError(f"unseen_rule must be one of {list(UNSEEN_RULES)}, got {self.unseen_rule!r}.")
-        if self.suite.name is None:  # draccus builds a SuiteConfig of class defaults when one field is given
-            self.suite.name = _eval_suite().name
-        self.suite.check()
 
 
 def check_policy(config: EvalConfig) -> list[str]:
@@ -114,9 +42,6 @@ def check_policy(config: EvalConfig) -> list[str]:
     Raises:
         CorruptExperimentError: In one line naming what changed and the fix.
     """
-    from lerobot_mtdagger.datasets.verify import check_policy_folder
-    from lerobot_mtdagger.runner.configs import RunConfig
-
     folder = Path(config.policy_path)
     if not folder.is_dir():
         logger.info("%s is not a local folder: its files are not checked against checksums", folder)
@@ -130,9 +55,6 @@ def suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
 
     The policy folder's files are checked first (``check_policy``) by the command.
     """
-    from lerobot_mtdagger.envs import suite_from_config
-    from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
-
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
     suite_config = dataclasses.replace(config.suite, **observation_options(runner, config.suite))
     if list(suite_config.tasks) == [HELDOUT_TASKS]:
@@ -170,8 +92,6 @@ def observation_options(runner: PolicyRunner, suite: SuiteConfig) -> dict[str, A
     A policy with a point-cloud input was trained on clouds of its input's point count, one with an
     image input on images of its side, any other on state.
     """
-    from lerobot_mtdagger.policies.mtdagger.configuration_mtdagger import is_pointcloud_feature
-
     features = runner.policy.config.input_features
     clouds = [f for key, f in features.items() if is_pointcloud_feature(key, f)]
     images = [f for key, f in features.items() if key.startswith("observation.image")]
@@ -185,8 +105,6 @@ def observation_options(runner: PolicyRunner, suite: SuiteConfig) -> dict[str, A
 
 def eval_command(config: EvalConfig) -> dict:
     """Evaluates a pretrained policy per task with the pure policy acting."""
-    from lerobot_mtdagger.runner.rollout.evaluate import evaluate
-
     unverified = check_policy(config)
     suite, runner = suite_and_policy(config)
     with config.env_workers(suite) as workers:

@@ -1,46 +1,23 @@
-"""``lerobot-mtdagger merge``: rounds 0..k of an experiment as ONE LeRobotDataset."""
+"""``lerobot-mtdagger merge``: rounds 0..k of an experiment as ONE LeRobotDataset.
+
+Its options are ``MergeConfig`` (``configs/merge.py``).
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
+from lerobot_mtdagger.commands.configs.merge import MergeConfig
+from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir, merge_rounds
+from lerobot_mtdagger.datasets.verify import check_before_reading
+from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.utils.errors import UserError
-from lerobot_mtdagger.utils.paths import check_output_dir
 
-
-@dataclass
-class MergeConfig:
-    """Options of ``lerobot-mtdagger merge``: D(k) = rounds 0..k as ONE LeRobotDataset.
-
-    Attributes:
-        experiment_dir: The experiment's output directory.
-        output: Folder of the merged dataset (must not exist).
-        up_to_round: Last round to merge (None: the last committed one).
-        repo_id: Repo id written into the merged dataset's metadata.
-        unverified: Merge an experiment that fails verification (a changed record or file, a missing
-            ledger) as it is, with a warning; the merged record lists the problems under ``unverified``.
-            By default such an experiment is refused before anything is written.
-    """
-
-    experiment_dir: Path | None = None
-    output: Path | None = None
-    up_to_round: int | None = None
-    repo_id: str = "local/merged"
-    unverified: bool = False
-
-    def __post_init__(self) -> None:
-        if self.experiment_dir is None or self.output is None:
-            raise ValueError("--experiment_dir and --output are required.")
-        check_output_dir(self.output, "--output")
+__all__ = ["MergeConfig", "merge_command"]
 
 
 def merge_command(config: MergeConfig) -> Path:
     """Merges rounds 0..k with LeRobot's aggregation; the result trains with stock lerobot-train."""
-    from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir, merge_rounds
-    from lerobot_mtdagger.datasets.verify import check_before_reading
-    from lerobot_mtdagger.runner.configs import RunConfig
-
     experiment = ExperimentDir(config.experiment_dir)
     experiment.read_config()  # refuses a folder that is not an experiment
     unverified = check_before_reading(experiment, config.unverified, RunConfig.option_defaults())

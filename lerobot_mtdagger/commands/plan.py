@@ -1,21 +1,22 @@
 """``lerobot-mtdagger plan``: the next collection session's episodes per task, or a plan checked.
 
-Its options are ``PlanConfig`` (``planning/plan.py``).
+Its options are ``PlanConfig`` (``configs/plan.py``; defined in ``planning/plan.py``).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from lerobot_mtdagger.planning.plan import PlanConfig
+from lerobot_mtdagger.analysis.headroom import TaskPoint, best_splits, fit_curves, headroom_at
+from lerobot_mtdagger.commands.configs.plan import PlanConfig
+from lerobot_mtdagger.planning.plan import make_plan, plan_table, read_plan, verify_plan, write_plan
+from lerobot_mtdagger.utils.errors import UserError
 
 __all__ = ["PlanConfig", "plan_command"]
 
 
 def plan_command(config: PlanConfig) -> dict | list[str]:
     """Prints and writes the next session's plan, or (``--verify``) checks a plan; exits 1 on a problem."""
-    from lerobot_mtdagger.planning.plan import make_plan, plan_table, verify_plan, write_plan
-
     if config.verify is not None:
         problems = verify_plan(config.verify)
         for problem in problems:
@@ -38,10 +39,6 @@ def history_headroom_lines(plan: dict) -> list[str]:
     Each plan of the chain (this one and its ``--previous`` ones) gives one point per task: the success
     of the session's policy over its own episodes, at the expert demos it was trained on.
     """
-    from lerobot_mtdagger.analysis.headroom import TaskPoint, best_splits, fit_curves, headroom_at
-    from lerobot_mtdagger.planning.plan import read_plan
-    from lerobot_mtdagger.utils.errors import UserError
-
     points, session = [], plan
     while session is not None:
         measured, demos = session["measurements"], session.get("demos")

@@ -1,6 +1,6 @@
 """``lerobot-mtdagger replay``: the schedulers replayed against measured learning curves.
 
-The bench itself is ``analysis/replay.py``.
+The bench itself is ``analysis/replay.py``; the options are ``ReplayConfig`` (``configs/replay.py``).
 
 Tells, before a study is run, whether scheduling can pay on a task set and by how much: the share
 of the oracle's headroom each scheduler captures, and the seeds a study needs to see it.
@@ -9,87 +9,35 @@ of the oracle's headroom each scheduler captures, and the seeds a study needs to
 from __future__ import annotations
 
 import json
-import logging
 import math
 import time
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, fields
 from pathlib import Path
 
+from lerobot_mtdagger.analysis.headroom import fit_curves, points_from_rows
+from lerobot_mtdagger.analysis.replay import (
+    ONLINE_ORACLE,
+    STATIC_ORACLE,
+    UNIFORM,
+    ArmSpec,
+    ReplaySetting,
+    default_arms,
+    extend_curves,
+    run_bench,
+    seeds_for_half_width,
+    synthetic_curves,
+)
+from lerobot_mtdagger.analysis.results import merge_tables, read_results, results_rows
+from lerobot_mtdagger.analysis.saved_records import saved_records_runs
+from lerobot_mtdagger.commands.configs.replay import ReplayConfig
+from lerobot_mtdagger.datasets.experiment_dir import open_run
 from lerobot_mtdagger.utils.errors import UserError
-from lerobot_mtdagger.utils.paths import check_output_file
 
-logger = logging.getLogger(__name__)
-
-
-@dataclass
-class ReplayConfig:
-    """Options of ``lerobot-mtdagger replay``.
-
-    Attributes:
-        records: Runs' saved records (as ``report --records``) whose per-task curves are replayed.
-        experiments: Experiment folders whose per-task curves are replayed.
-        results: Saved results tables (``results.json`` or its folder) whose curves are replayed.
-        synthetic_tasks: With no records: this many synthetic tasks of the ``demo`` command.
-        easiest: Synthetic tasks' easiest difficulty (demos per e-fold of failure).
-        hardest: Synthetic tasks' hardest difficulty.
-        curves: Which runs make the curves: ``bc`` (BC runs and every DAgger run's round 0), ``all``
-            (every evaluated phase), or one method's name.
-        methods: Schedulers to replay, each ``method`` or ``method:key=value,...``; empty: every
-            registered method that needs no loss curves.
-        initial_demos: Expert demos per task in round 0.
-        rounds: DAgger rounds after round 0.
-        budget_per_round: Episodes per round over all tasks; 0: 3 per task.
-        eval_episodes: Episodes behind each measured success rate.
-        n_min: Minimum episodes per task per round.
-        lag: Rounds between a policy and the allocation its success informs (1: the runner's timing).
-        extrapolation: Beyond the measured demos: ``flat`` or ``slope``.
-        replicates: Replicate runs per scheduler.
-        seed: Seed of the replicates.
-        levels: Success levels of the "demos per task to reach" columns.
-        output: Optional JSON file for the summaries.
-    """
-
-    records: list[Path] = field(default_factory=list)
-    experiments: list[Path] = field(default_factory=list)
-    results: list[Path] = field(default_factory=list)
-    synthetic_tasks: int = 0
-    easiest: float = 1.0
-    hardest: float = 30.0
-    curves: str = "bc"
-    methods: list[str] = field(default_factory=list)
-    initial_demos: int = 3
-    rounds: int = 9
-    budget_per_round: int = 0
-    eval_episodes: int = 20
-    n_min: int = 1
-    lag: int = 1
-    extrapolation: str = "flat"
-    replicates: int = 2000
-    seed: int = 0
-    levels: list[float] = field(default_factory=lambda: [0.7, 0.8])
-    output: Path | None = None
-
-    def __post_init__(self) -> None:
-        sources = (
-            bool(self.records) + bool(self.experiments) + bool(self.results) + bool(self.synthetic_tasks)
-        )
-        if sources != 1:
-            raise ValueError(
-                "Give one source of curves: --records, --experiments, --results or --synthetic_tasks=N, e.g. "
-                "--records='[experiments/paper-regime-training-dev/records]'."
-            )
-        if self.synthetic_tasks < 0 or not 0 < self.easiest <= self.hardest:
-            raise ValueError("--synthetic_tasks must be >= 0 and 0 < --easiest <= --hardest.")
-        if any(not 0.0 < level <= 1.0 for level in self.levels):
-            raise ValueError(f"--levels must be success levels in (0, 1], got {self.levels}.")
-        if self.output is not None:
-            check_output_file(self.output, "--output")
+__all__ = ["ReplayConfig", "replay_command"]
 
 
 def replay_command(config: ReplayConfig) -> list[dict]:
     """Replays every scheduler, prints the comparison, writes ``--output``; returns the summaries."""
-    from lerobot_mtdagger.analysis.replay import ArmSpec, default_arms, run_bench
-
     start = time.perf_counter()
     curves, source, setting = _curves_and_setting(config)
     arms = [ArmSpec.parse(text) for text in config.methods] if config.methods else default_arms()
@@ -109,9 +57,6 @@ def replay_command(config: ReplayConfig) -> list[dict]:
 
 def _curves_and_setting(config: ReplayConfig):
     """The replayed curves, a line saying where they come from, and the replay's setting."""
-    from lerobot_mtdagger.analysis.headroom import fit_curves, points_from_rows
-    from lerobot_mtdagger.analysis.replay import ReplaySetting, extend_curves, synthetic_curves
-
     num_tasks = config.synthetic_tasks
     rows, task_names = ([], []) if num_tasks else _rows(config)
     num_tasks = num_tasks or len(task_names)
@@ -134,10 +79,6 @@ def _curves_and_setting(config: ReplayConfig):
 
 def _rows(config: ReplayConfig) -> tuple[list[dict], list[str]]:
     """Results rows and task names of the runs or tables the options name."""
-    from lerobot_mtdagger.analysis.results import merge_tables, read_results, results_rows
-    from lerobot_mtdagger.analysis.saved_records import saved_records_runs
-    from lerobot_mtdagger.datasets.experiment_dir import open_run
-
     if config.results:
         saved = merge_tables([read_results(path) for path in config.results])
         return saved.rows, saved.task_names
@@ -174,8 +115,6 @@ def _table(summaries, levels) -> list[str]:
 
 def _footer(summaries, source: str, setting, seconds: float) -> list[str]:
     """Where the curves come from, how to read the table, and the seeds a study would need."""
-    from lerobot_mtdagger.analysis.replay import ONLINE_ORACLE, STATIC_ORACLE, UNIFORM, seeds_for_half_width
-
     schedulers = [s for s in summaries if s.label not in (UNIFORM, ONLINE_ORACLE, STATIC_ORACLE)]
     lines = [
         f"curves: {source}",

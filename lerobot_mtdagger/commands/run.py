@@ -5,7 +5,8 @@ Its options are ``RunConfig`` (``runner/configs.py``), which the runner reads to
 
 from __future__ import annotations
 
-from lerobot_mtdagger.runner.configs import RunConfig
+from lerobot_mtdagger.commands.configs.run import RunConfig
+from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.utils.parent import follow_parent
 
 __all__ = ["RunConfig", "run_experiment"]
@@ -13,8 +14,6 @@ __all__ = ["RunConfig", "run_experiment"]
 
 def run_experiment(config: RunConfig) -> list[str]:
     """Runs ``lerobot-mtdagger run`` and prints the per-round summary."""
-    from lerobot_mtdagger.runner.dagger import run
-
     follow_parent()
     header = f"experiment {config.output_dir} ({config.method}, seed {config.seed}):"
     return run(

@@ -1,38 +1,24 @@
 """``lerobot-mtdagger shift``: a pretrained policy's covariate shift, per task.
 
 Its action error on the states of its own rollouts against on the expert's: whether DAgger's relabelled
-rollouts have much to add over more demonstrations. The options are ``eval``'s (``commands/eval.py``).
+rollouts have much to add over more demonstrations. The options are ``eval``'s (``configs/shift.py``).
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lerobot_mtdagger.commands.eval import EvalConfig, check_policy, suite_and_policy
+from lerobot_mtdagger.analysis.shift import ShiftResult, measure_shift
+from lerobot_mtdagger.commands.configs.shift import ShiftConfig
+from lerobot_mtdagger.commands.eval import check_policy, suite_and_policy
 
-if TYPE_CHECKING:
-    from lerobot_mtdagger.analysis.shift import ShiftResult
-
-
-@dataclass
-class ShiftConfig(EvalConfig):
-    """Options of ``lerobot-mtdagger shift``: a policy's action error on its own states vs the expert's.
-
-    The attributes are ``EvalConfig``'s; ``episodes`` episodes per task are run by the policy and
-    again by the expert from the same reset seeds (``shift.measure_shift``).
-    """
-
-    episodes: int = 5
+__all__ = ["ShiftConfig", "shift_command", "shift_table"]
 
 
 def shift_command(config: ShiftConfig) -> dict:
     """Measures a pretrained policy's covariate shift per task and prints it."""
-    from lerobot_mtdagger.analysis.shift import measure_shift
-
     unverified = check_policy(config)
     suite, runner = suite_and_policy(config)
     with config.env_workers(suite) as workers:

@@ -9,7 +9,6 @@ step must name a registered processor step.
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 from typing import Any
 
@@ -17,14 +16,15 @@ from lerobot.configs.policies import PreTrainedConfig
 from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 from lerobot.processor.pipeline import ProcessorStepRegistry
 
+from lerobot_mtdagger.datasets.experiment_files import POLICY_PATH_TAKES
 from lerobot_mtdagger.datasets.student_types import student_policy_types
 from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.hub import is_hub_id, network_errors
 from lerobot_mtdagger.utils.quiet import quiet_third_party
 
 PROCESSOR_FILES = ("policy_preprocessor.json", "policy_postprocessor.json")
 POLICY_TYPE = "mtdagger"
-HUB_ID_PATTERN = re.compile(r"[A-Za-z0-9][\w.-]*/[A-Za-z0-9][\w.-]*")
 """``owner/name``: a ``--policy_path`` of this form that is not a local folder is read from the Hub."""
 
 TRUST_HINT = "load only checkpoints you trust, with --trust_checkpoint=true"
@@ -78,21 +78,13 @@ def check_hub_policy(repo_id: str) -> None:
         check_processor_config(Path(hf_hub_download(repo_id, name)))
 
 
-def is_hub_id(path: str) -> bool:
-    """Whether a policy path that is not on disk names a Hub repo (``owner/name``)."""
-    return HUB_ID_PATTERN.fullmatch(str(path)) is not None
-
-
 def check_policy_path(path: str | Path) -> None:
     """Refuses a path that is neither a loadable policy folder nor a Hub id (``UserError`` naming the fix)."""
     folder = Path(path)
     if folder.exists():
         check_local_policy(folder)
     elif not is_hub_id(str(path)):
-        raise UserError(
-            f"{path} does not exist: --policy_path takes a policy folder (config.json, model.safetensors, "
-            "processors; e.g. <experiment>/policies/round-003) or a Hub id owner/name."
-        )
+        raise UserError(f"{path} does not exist: --policy_path takes {POLICY_PATH_TAKES}.")
 
 
 def check_local_policy(folder: Path) -> None:
@@ -163,7 +155,7 @@ def load_policy(
 
     try:
         return _load_checked(path, device, trust_checkpoint)
-    except (HfHubHTTPError, LocalEntryNotFoundError, OSError) as error:
+    except (HfHubHTTPError, LocalEntryNotFoundError, OSError, *network_errors()) as error:
         raise UserError(
             f"Cannot load the Hub policy {path} ({type(error).__name__}): check the repo id, the "
             "network and HF_TOKEN, or pass a local policy folder."

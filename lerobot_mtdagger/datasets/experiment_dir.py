@@ -50,6 +50,7 @@ from lerobot_mtdagger.datasets.experiment_files import (
     ROUNDS_DIR,
     STAGING_DIR,
     TRAINING_FILE,
+    check_experiment_folder,
 )
 from lerobot_mtdagger.datasets.integrity import digest_mismatches, folder_digests
 from lerobot_mtdagger.datasets.ledger import LEDGER_FILE, Ledger
@@ -328,11 +329,7 @@ class ExperimentDir:
     def read_config(self) -> dict[str, Any]:
         """The stored run config in today's layout (``NotAnExperimentError`` if there is no readable one)."""
         config_path = self.root / CONFIG_FILE
-        if not self.root.is_dir():
-            raise NotAnExperimentError(
-                f"{self.root} does not exist or is not a folder: pass the --output_dir of a "
-                "`lerobot-mtdagger run`."
-            )
+        check_experiment_folder(self.root)
         try:
             return migrate_run_config(json.loads(config_path.read_text()))
         except FileNotFoundError:

@@ -26,6 +26,7 @@ from lerobot_mtdagger.datasets.push_config import PushConfig
 from lerobot_mtdagger.datasets.records import PhaseRecord, RoundRecord
 from lerobot_mtdagger.datasets_cards import card_template
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.hub import network_errors
 from lerobot_mtdagger.utils.markdown import markdown_table
 
 logger = logging.getLogger(__name__)
@@ -277,7 +278,7 @@ def check_hub_access(api: HfApi) -> str:
             f"The Hub refused the token (HTTP {status}): set HF_TOKEN to a token with write access; "
             "nothing was pushed."
         ) from None
-    except OSError as error:  # requests' connection errors, timeouts
+    except (OSError, *network_errors()) as error:  # requests' (huggingface_hub 0.x) or httpx's (1.x)
         raise UserError(
             f"Cannot reach the Hub ({type(error).__name__}): check the network (or HF_ENDPOINT) and "
             "push again; nothing was pushed."

@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from lerobot_mtdagger.datasets.experiment_files import check_experiment_folder
+
 
 @dataclass
 class PushConfig:
@@ -33,3 +35,11 @@ class PushConfig:
                 "--repo_id is required: the Hub dataset repo to push the rounds to, "
                 "e.g. --repo_id=<user>/mtdagger-mt10."
             )
+
+    def check_paths(self) -> None:
+        """Refuses an ``--experiment_dir`` that holds no experiment, before anything is sent.
+
+        Raises:
+            NotAnExperimentError: Naming the folder and what to pass instead.
+        """
+        check_experiment_folder(Path(self.experiment_dir))

@@ -24,6 +24,7 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from lerobot_mtdagger.utils.errors import UserError
+from lerobot_mtdagger.utils.hub import check_hub_repo, is_hub_id, lerobot_dataset_cache, network_errors
 
 FRAME_SUCCESS_KEY = "next.success"
 """The per-frame success column ``lerobot-eval`` and the runner's rounds write."""
@@ -94,6 +95,36 @@ def dataset_checksum(root: Path) -> str:
     return hasher.hexdigest()
 
 
+def check_dataset_source(source: str, option: str = "--datasets") -> None:
+    """Refuses a dataset that is neither a LeRobot dataset folder nor a repo id LeRobot can read.
+
+    A repo id in LeRobot's cache (``$HF_LEROBOT_HOME/<repo_id>``) is read from there; any other is
+    looked up on the Hub once, without retries (``utils.hub``), before LeRobot is imported.
+
+    Raises:
+        UserError: In one line naming the dataset and the fix.
+    """
+    _check_local_source(source, option)
+    if not Path(source).expanduser().exists():
+        cached = (lerobot_dataset_cache(source) / "meta" / "info.json").is_file()
+        check_hub_repo(source, "dataset", option, cached)
+
+
+def _check_local_source(source: str, option: str) -> None:
+    """Refuses a folder that is not a LeRobot dataset, and a missing path that is not a repo id."""
+    path = Path(source).expanduser()
+    if path.exists() and not (path / "meta" / "info.json").is_file():
+        raise UserError(
+            f"{option}: {source} is not a LeRobot dataset (no meta/info.json): give the folder "
+            "lerobot-record or lerobot-rollout wrote (its --dataset.root), or a Hub repo id."
+        )
+    if not path.exists() and not is_hub_id(source):
+        raise UserError(
+            f"{option}: {source} is neither a folder nor a Hub repo id (user/name): give the "
+            "dataset's local folder or its repo id."
+        )
+
+
 def open_metadata(source: str, revision: str | None = None):
     """LeRobot's metadata of a local dataset folder or a Hub repo id (read from LeRobot's cache first).
 
@@ -102,22 +133,13 @@ def open_metadata(source: str, revision: str | None = None):
     """
     from lerobot.datasets.lerobot_dataset import LeRobotDatasetMetadata
 
+    _check_local_source(source, "--datasets")
     path = Path(source).expanduser()
     if path.exists():
-        if not (path / "meta" / "info.json").is_file():
-            raise UserError(
-                f"--datasets: {source} is not a LeRobot dataset (no meta/info.json): give the folder "
-                "lerobot-record or lerobot-rollout wrote (its --dataset.root), or a Hub repo id."
-            )
         return LeRobotDatasetMetadata(f"local/{path.name}", root=path)
-    if source.count("/") != 1:
-        raise UserError(
-            f"--datasets: {source} is neither a folder nor a Hub repo id (user/name): give the "
-            "dataset's local folder or its repo id."
-        )
     try:
         return LeRobotDatasetMetadata(source, revision=revision)
-    except (OSError, ValueError) as error:  # network, missing repo, or a bad revision
+    except (OSError, ValueError, *network_errors()) as error:  # network, missing repo, or a bad revision
         raise UserError(
             f"--datasets: cannot open {source} from the Hub or LeRobot's cache ({type(error).__name__}): "
             "check the repo id and your connection, or give its local folder."

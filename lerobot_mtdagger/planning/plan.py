@@ -31,6 +31,7 @@ import numpy as np
 from lerobot_mtdagger.planning.episodes import (
     INTERVENTION_KEY,
     DatasetEpisodes,
+    check_dataset_source,
     dataset_checksum,
     read_dataset,
 )
@@ -43,10 +44,12 @@ from lerobot_mtdagger.scheduler import (
     allocation_mismatches,
 )
 from lerobot_mtdagger.utils.errors import UserError
-from lerobot_mtdagger.utils.paths import check_output_file
+from lerobot_mtdagger.utils.paths import check_input_path, check_output_file
 
 PLAN_FORMAT = "lerobot-mtdagger-plan"
 PLAN_VERSION = 1
+PLAN_FILE_TAKES = "the plan file an earlier `plan --output` wrote"
+"""What ``--previous`` and ``--verify`` take, for messages."""
 
 
 @dataclass
@@ -150,6 +153,30 @@ class PlanConfig:
                 f"--scheduler.type={self.scheduler.type} needs each task's loss drop: give --policy_path, "
                 "--previous_policy_path and --loss_datasets (the data the policy was trained on)."
             )
+
+    def check_paths(self) -> None:
+        """Refuses an input that is not there: a plan file, the labels, a policy folder, a dataset.
+
+        A dataset given by repo id is looked up on the Hub unless LeRobot's cache holds it
+        (``episodes.check_dataset_source``).
+
+        Raises:
+            UserError: In one line naming the option, the path and the fix.
+        """
+        if self.verify is not None:
+            check_input_path(self.verify, "--verify", PLAN_FILE_TAKES)
+            return
+        for option, path, takes in (
+            ("--previous", self.previous, PLAN_FILE_TAKES),
+            ("--success_labels", self.success_labels, "the JSON file of success labels"),
+            ("--policy_path", self.policy_path, "the policy folder trained since the last session"),
+            ("--previous_policy_path", self.previous_policy_path, "the policy folder of the last session"),
+        ):
+            if path is not None:
+                check_input_path(path, option, takes)
+        for option, sources in (("--datasets", self.datasets), ("--loss_datasets", self.loss_datasets)):
+            for source in sources:
+                check_dataset_source(source, option)
 
 
 @dataclass(frozen=True)
@@ -316,7 +343,7 @@ def file_sha256(path: Path) -> str:
 def read_plan(path: Path) -> dict:
     """A plan file's contents; refuses a file that is not one (one line)."""
     if not path.is_file():
-        raise UserError(f"{path} does not exist: give the plan file an earlier `plan --output` wrote.")
+        raise UserError(f"{path} does not exist: give {PLAN_FILE_TAKES}.")
     try:
         plan = json.loads(path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError):

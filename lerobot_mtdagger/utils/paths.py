@@ -1,10 +1,16 @@
-"""Output paths probed before a command does any work, so a bad one is refused in one line, up front."""
+"""Paths probed before a command does any work, so a bad one is refused in one line, up front.
+
+Outputs are probed for being writable (``check_output_dir``, ``check_output_file``), inputs for being
+there (``check_input_path``).
+"""
 
 from __future__ import annotations
 
 import os
 import tempfile
 from pathlib import Path
+
+from lerobot_mtdagger.utils.errors import UserError
 
 
 def _nearest_existing(path: Path) -> Path:
@@ -52,3 +58,18 @@ def _check_creatable(folder: Path, option: str, shown: Path | None = None) -> No
         raise ValueError(
             f"{option}={shown} cannot be written: {existing} is not writable here; choose another."
         )
+
+
+def check_input_path(path: Path | str, option: str, takes: str) -> None:
+    """Refuses an input path that does not exist.
+
+    Args:
+        path: The file or folder a command will read.
+        option: The option that gave it (``--previous``), for the message.
+        takes: What the option takes, for the message ("the previous session's plan file").
+
+    Raises:
+        UserError: Naming the option, the path and what to give instead.
+    """
+    if not Path(path).exists():
+        raise UserError(f"{option}={path} does not exist: give {takes}.")
