@@ -2,31 +2,8 @@
 
 Usage: ``lerobot-mtdagger <command> [--option=value ...]``. Options are parsed by draccus, so nested
 configs are set with dots, for example ``--scheduler.type=need --scheduler.temperature=0.5``.
-
-Commands:
-    run: one Multitask DAgger experiment (``--preset``, ``--suite.name``, ``--suite.tasks``,
-        ``--scheduler.type``, ``--dagger.rounds``, ``--dagger.budget``, ``--output_dir``, ``--resume``,
-        ...; see ``RunConfig``), or the one-round behaviour-cloning baseline with ``--mode=bc``.
-    eval: success per task of a pretrained policy (``--policy_path``, ``--suite.name``, ``--episodes``).
-    shift: covariate shift of a pretrained policy: its action error on its own rollouts' states against
-        on the expert's, per task (``eval``'s options): what DAgger's relabelled rollouts can add.
-    verify: recompute every round's allocation from its record (``--experiment_dir``).
-    merge: rounds 0..k as one LeRobotDataset (``--experiment_dir``, ``--output``).
-    compare: every method over every seed, and BC at every budget, as runs in a process pool, then
-        the results table (``--methods``, ``--seeds``, ``--bc_budgets``, ``--jobs``, ``--output_dir``;
-        any other option goes to every run).
-    report: eval success against expert demos per method, mean and std over seeds (``--experiments``
-        or ``--compare_dir``); with ``--output_dir`` (default for a compare folder) also the figures
-        and a summary with paired differences.
-    push: round datasets and policies to the Hub (``--experiment_dir``, ``--repo_id``, ``--policy_repo_id``).
-    plan: the next collection session's episodes per task from LeRobot datasets of the policy's
-        episodes (``--datasets``, ``--budget`` or ``--budget_minutes``, ``--output``, ``--previous``);
-        ``--verify=PLAN`` recomputes a plan from its recorded inputs (``planning/plan.py``).
-    replay: the schedulers replayed against measured per-task learning curves (``--records``,
-        ``--methods``, ``--rounds``, ``--replicates``): the share of the headroom each captures and the
-        seeds a study needs to see it, before the study is run (``analysis/replay.py``).
-    records: save and compact a study's run records (``--action``, ``--source``, ``--dest``).
-    demo: the scheduler on synthetic tasks, each round's allocation (no simulator, no policy).
+``COMMANDS`` names each command's modules and ``HELP`` is the page ``lerobot-mtdagger --help`` prints;
+``docs/usage.md`` shows each command in use.
 """
 
 from __future__ import annotations
@@ -62,15 +39,45 @@ COMMANDS: dict[str, tuple[str, str]] = {
 ``module:attribute`` under ``COMMANDS_PACKAGE``: the body is imported once the options parsed and checked."""
 
 
+HELP = """Options are parsed by draccus, so nested configs are set with dots, for example
+``--scheduler.type=need --scheduler.temperature=0.5``.
+
+Commands:
+    run: one Multitask DAgger experiment (``--preset``, ``--suite.name``, ``--suite.tasks``,
+        ``--scheduler.type``, ``--dagger.rounds``, ``--dagger.budget``, ``--output_dir``, ``--resume``,
+        ...; see ``RunConfig``), or the one-round behaviour-cloning baseline with ``--mode=bc``.
+    eval: success per task of a pretrained policy (``--policy_path``, ``--suite.name``, ``--episodes``).
+    shift: covariate shift of a pretrained policy: its action error on its own rollouts' states against
+        on the expert's, per task (``eval``'s options): what DAgger's relabelled rollouts can add.
+    verify: recompute every round's allocation from its record (``--experiment_dir``).
+    merge: rounds 0..k as one LeRobotDataset (``--experiment_dir``, ``--output``).
+    compare: every method over every seed, and BC at every budget, as runs in a process pool, then
+        the results table (``--methods``, ``--seeds``, ``--bc_budgets``, ``--jobs``, ``--output_dir``;
+        any other option goes to every run).
+    report: eval success against expert demos per method, mean and std over seeds (``--experiments``
+        or ``--compare_dir``); with ``--output_dir`` (default for a compare folder) also the figures
+        and a summary with paired differences.
+    push: round datasets and policies to the Hub (``--experiment_dir``, ``--repo_id``, ``--policy_repo_id``).
+    plan: the next collection session's episodes per task from LeRobot datasets of the policy's
+        episodes (``--datasets``, ``--budget`` or ``--budget_minutes``, ``--output``, ``--previous``);
+        ``--verify=PLAN`` recomputes a plan from its recorded inputs (``planning/plan.py``).
+    replay: the schedulers replayed against measured per-task learning curves (``--records``,
+        ``--methods``, ``--rounds``, ``--replicates``): the share of the headroom each captures and the
+        seeds a study needs to see it, before the study is run (``analysis/replay.py``).
+    records: save and compact a study's run records (``--action``, ``--source``, ``--dest``).
+    demo: the scheduler on synthetic tasks, each round's allocation (no simulator, no policy).
+"""
+
+
 def command_part(spec: str) -> Any:
     """The config class or body function a ``COMMANDS`` entry names, its module imported."""
     return resolve(f"{COMMANDS_PACKAGE}.{spec}")
 
 
 def _usage() -> str:
-    """The page of ``lerobot-mtdagger --help``: the commands, then this module's docstring."""
+    """The page of ``lerobot-mtdagger --help``: the command names, then ``HELP``."""
     names = ", ".join(COMMANDS)
-    return f"usage: lerobot-mtdagger <command> [--option=value ...]\ncommands: {names}\n" + (__doc__ or "")
+    return f"usage: lerobot-mtdagger <command> [--option=value ...]\ncommands: {names}\n{HELP}"
 
 
 OPTION_RENAMES: dict[str, dict[str, str]] = {
