@@ -39,31 +39,23 @@ COMMANDS: dict[str, tuple[str, str]] = {
 ``module:attribute`` under ``COMMANDS_PACKAGE``: the body is imported once the options parsed and checked."""
 
 
-HELP = """Options are parsed by draccus, so nested configs are set with dots, for example
-``--scheduler.type=need --scheduler.temperature=0.5``.
+HELP = """Options are parsed by draccus: nested configs are set with dots (``--scheduler.temperature=0.5``).
 
-Commands:
-    run: one Multitask DAgger experiment (``--preset``, ``--suite.name``, ``--suite.tasks``,
-        ``--scheduler.type``, ``--dagger.rounds``, ``--dagger.budget``, ``--output_dir``, ``--resume``,
-        ...; see ``RunConfig``), or the one-round behaviour-cloning baseline with ``--mode=bc``.
+Commands (``lerobot-mtdagger <command> --help`` lists a command's options):
+    run: one Multitask DAgger experiment (``--preset``, ``--suite.name``, ``--scheduler.type``,
+        ``--dagger.rounds``, ``--output_dir``, ``--resume``, ...), or behaviour cloning (``--mode=bc``).
     eval: success per task of a pretrained policy (``--policy_path``, ``--suite.name``, ``--episodes``).
-    shift: covariate shift of a pretrained policy: its action error on its own rollouts' states against
-        on the expert's, per task (``eval``'s options): what DAgger's relabelled rollouts can add.
+    shift: a pretrained policy's action error on its own rollouts' states against on the expert's, per task.
     verify: recompute every round's allocation from its record (``--experiment_dir``).
     merge: rounds 0..k as one LeRobotDataset (``--experiment_dir``, ``--output``).
     compare: every method over every seed, and BC at every budget, as runs in a process pool, then
-        the results table (``--methods``, ``--seeds``, ``--bc_budgets``, ``--jobs``, ``--output_dir``;
-        any other option goes to every run).
-    report: eval success against expert demos per method, mean and std over seeds (``--experiments``
-        or ``--compare_dir``); with ``--output_dir`` (default for a compare folder) also the figures
-        and a summary with paired differences.
+        the results table (``--methods``, ``--seeds``, ``--bc_budgets``, ``--jobs``, ``--output_dir``).
+    report: eval success against expert demos per method over seeds, figures and paired differences.
     push: round datasets and policies to the Hub (``--experiment_dir``, ``--repo_id``, ``--policy_repo_id``).
     plan: the next collection session's episodes per task from LeRobot datasets of the policy's
-        episodes (``--datasets``, ``--budget`` or ``--budget_minutes``, ``--output``, ``--previous``);
-        ``--verify=PLAN`` recomputes a plan from its recorded inputs (``planning/plan.py``).
-    replay: the schedulers replayed against measured per-task learning curves (``--records``,
-        ``--methods``, ``--rounds``, ``--replicates``): the share of the headroom each captures and the
-        seeds a study needs to see it, before the study is run (``analysis/replay.py``).
+        episodes (``--datasets``, ``--budget``, ``--output``); ``--verify=PLAN`` recomputes a plan.
+    replay: the schedulers replayed against measured per-task learning curves (``--records``): the
+        share of the headroom each captures and the seeds a study needs to see it.
     records: save and compact a study's run records (``--action``, ``--source``, ``--dest``).
     demo: the scheduler on synthetic tasks, each round's allocation (no simulator, no policy).
 """

@@ -49,12 +49,37 @@ def module_level_imports(name: str) -> set[str]:
     return imports_of(name, everywhere=False)
 
 
+def _is_type_checking_block(node: ast.AST) -> bool:
+    return isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING"
+
+
+def _run_time_nodes(tree: ast.Module) -> list[ast.AST]:
+    """Every node but those under ``if TYPE_CHECKING:`` (imports for the type checker, never run)."""
+    nodes: list[ast.AST] = []
+    pending: list[ast.AST] = [tree]
+    while pending:
+        node = pending.pop()
+        nodes.append(node)
+        pending.extend(child for child in ast.iter_child_nodes(node) if not _is_type_checking_block(child))
+    return nodes
+
+
+def type_checking_imports(name: str) -> set[str]:
+    """Our modules ``name`` imports for the type checker only (under ``if TYPE_CHECKING:``)."""
+    tree = ast.parse(module_path(name).read_text())
+    blocks = [node for node in tree.body if _is_type_checking_block(node)]
+    modules = {
+        node.module for block in blocks for node in ast.walk(block) if isinstance(node, ast.ImportFrom)
+    }
+    return {module for module in modules if module and module.startswith("lerobot_mtdagger")}
+
+
 def imports_of(name: str, everywhere: bool = True) -> set[str]:
-    """Our modules imported by ``name``: anywhere in it, or at module level only."""
+    """Our modules imported at run time by ``name``: anywhere in it, or at module level only."""
     tree = ast.parse(module_path(name).read_text())
     imported: set[str] = set()
     is_package = module_path(name).name == "__init__.py"
-    for node in ast.walk(tree) if everywhere else tree.body:
+    for node in _run_time_nodes(tree) if everywhere else tree.body:
         targets = []
         if isinstance(node, ast.Import):
             targets = [alias.name for alias in node.names]
@@ -505,7 +530,8 @@ def student_classes(sources: dict[str, str]) -> dict[str, str]:
     for module, source in sources.items():
         for node in ast.walk(ast.parse(source)):
             if isinstance(node, ast.ClassDef):
-                names = {getattr(base, "id", getattr(base, "attr", None)) for base in node.bases}
+                plain = [base.value if isinstance(base, ast.Subscript) else base for base in node.bases]
+                names = {getattr(base, "id", getattr(base, "attr", None)) for base in plain}
                 bases[node.name] = (module, names)
     students = {"Student"}
     while True:
@@ -566,3 +592,37 @@ def test_the_rules_about_older_runs_live_in_the_migrations():
     assert older_run_messages(module_path(MIGRATIONS_MODULE).read_text())  # the hints are there
     assert older_run_messages('x = f" (a run made before {date})"') == [1]
     assert older_run_messages('def f():\n    """A config stored before the groups."""\n') == []
+
+
+def untyped_contract_annotations(source: str, class_name: str) -> list[str]:
+    """``method: annotation`` of ``class_name``'s parameters and returns that are ``Any`` or unannotated."""
+    tree = ast.parse(source)
+    klass = next(node for node in tree.body if isinstance(node, ast.ClassDef) and node.name == class_name)
+    loose = []
+    for method in (node for node in klass.body if isinstance(node, ast.FunctionDef)):
+        arguments = [a for a in method.args.args if a.arg not in ("self", "cls")]
+        for label, annotation in [(a.arg, a.annotation) for a in arguments] + [("return", method.returns)]:
+            text = "" if annotation is None else ast.unparse(annotation)
+            if text in ("", "Any", "object") or text.startswith("tuple[Any"):
+                loose.append(f"{method.name}.{label}: {text or 'unannotated'}")
+    return loose
+
+
+def test_the_student_contract_names_its_types():
+    """``Student`` takes and returns LeRobot's and the runner's named types (mypy checks them in CI)."""
+    source = module_path(f"{RUNNER}.student").read_text()
+    assert untyped_contract_annotations(source, "Student") == []
+    assert untyped_contract_annotations(source, "TrainingOps") == []
+    loose = "class Student:\n    def phase_ops(self, policy: Any, data) -> Any: ...\n"
+    assert untyped_contract_annotations(loose, "Student") == [
+        "phase_ops.policy: Any",
+        "phase_ops.data: unannotated",
+        "phase_ops.return: Any",
+    ]
+
+
+def test_type_only_imports_leave_the_run_time_graph():
+    """``runner.student`` names the runner's types for mypy only: at run time it imports none of them."""
+    student = f"{RUNNER}.student"
+    assert f"{RUNNER}.training.steps" in type_checking_imports(student)
+    assert f"{RUNNER}.training.steps" not in imports_of(student)

@@ -14,7 +14,7 @@ import abc
 import dataclasses
 import functools
 from collections.abc import Hashable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar
 
 from lerobot_mtdagger.datasets.student_types import (
     BUILTIN_STUDENT_TYPES,
@@ -25,8 +25,44 @@ from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.plugins import STUDENT_ENTRY_POINTS
 from lerobot_mtdagger.utils.registry import Registry
 
+if TYPE_CHECKING:  # the contract's types, without importing torch or LeRobot here
+    import torch
+    from _typeshed import DataclassInstance
+    from lerobot.policies.pretrained import PreTrainedPolicy
+    from lerobot.processor import PolicyProcessorPipeline
+    from torch.optim.lr_scheduler import LRScheduler
 
-class Student(abc.ABC):
+    from lerobot_mtdagger.runner.configs import RunConfig
+    from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
+    from lerobot_mtdagger.runner.training.normalise import NormalisedData
+    from lerobot_mtdagger.runner.training.steps import StepOptions
+
+OptionsT = TypeVar("OptionsT", bound="DataclassInstance")
+"""A student's ``--policy.*`` options dataclass."""
+PolicyConfigT = TypeVar("PolicyConfigT")
+"""A student's policy config for a suite (what ``make_policy`` builds from)."""
+Stats = dict[str, dict[str, Any]]
+"""Normalisation statistics per feature (``mean``, ``std``, ``min``, ``max``: arrays)."""
+
+
+class TrainingOps(Protocol):
+    """One phase's training operations on a student's policy (what ``Student.phase_ops`` returns)."""
+
+    @property
+    def policy(self) -> PreTrainedPolicy:
+        """The policy being trained."""
+
+    def step_loss(self, index: torch.Tensor, first_of_interval: bool) -> torch.Tensor:
+        """The training loss on the frames at ``index`` (the first of a log interval may log more)."""
+
+    def task_losses(self, index: torch.Tensor, num_tasks: int) -> tuple[list[float | None], list[int]]:
+        """The loss per task over frames ``index`` (None where a task has none) and the frame counts."""
+
+    def optimizer(self, steps: int) -> tuple[torch.optim.Optimizer, LRScheduler | None, float]:
+        """The optimiser, its learning-rate schedule over ``steps`` (or None) and the gradient clip norm."""
+
+
+class Student(abc.ABC, Generic[OptionsT, PolicyConfigT]):
     """What the runner needs from a student policy (one per ``--policy.type``).
 
     Attributes:
@@ -52,48 +88,54 @@ class Student(abc.ABC):
     def options_class(self) -> type:
         """The dataclass of its ``--policy.*`` options (with ``batch_size`` and ``device``)."""
 
-    def options_dict(self, options: Any) -> dict[str, Any]:
+    def options_dict(self, options: OptionsT) -> dict[str, Any]:
         """JSON-ready options for the run's record, with ``type`` (the default student's omits it)."""
         values = dataclasses.asdict(options)
         return values if self.name == MTDAGGER_TYPE else {"type": self.name, **values}
 
-    def check_run(self, config: Any) -> None:
+    def check_run(self, config: RunConfig) -> None:
         """Refuses run options the student cannot train with (none by default) with a ``ValueError``."""
         del config
 
     @abc.abstractmethod
     def policy_config(
-        self, options: Any, suite_features: dict[str, Any], task_names: Sequence[str], unseen: bool
-    ) -> Any:
+        self, options: OptionsT, suite_features: dict[str, Any], task_names: Sequence[str], unseen: bool
+    ) -> PolicyConfigT:
         """Its policy config for a suite: ``task_names``, ``image_features``, ``task_dropout`` and ``device``.
 
         ``unseen``: the suite has held-out tasks (task dropout may then apply).
         """
 
     @abc.abstractmethod
-    def make_policy(self, policy_cfg: Any, stats: dict[str, dict[str, Any]]) -> tuple[Any, Any, Any]:
+    def make_policy(
+        self, policy_cfg: PolicyConfigT, stats: Stats
+    ) -> tuple[PreTrainedPolicy, PolicyProcessorPipeline, PolicyProcessorPipeline]:
         """A freshly initialised policy on its config's device, its pre- and its post-processor for ``stats``.
 
         Draw the weights on the CPU (then move them), so a seed gives the same weights on every device.
         """
 
     @abc.abstractmethod
-    def phase_ops(self, policy: Any, data: Any, options: Any) -> Any:
-        """Its training seam for one phase (``step_loss``, ``task_losses``, ``optimizer``).
-
-        ``data`` are the phase's ``NormalisedData``; ``options`` its ``steps.StepOptions``.
-        """
+    def phase_ops(self, policy: PreTrainedPolicy, data: NormalisedData, options: StepOptions) -> TrainingOps:
+        """Its training operations for one phase on the phase's frames ``data``."""
 
     @abc.abstractmethod
-    def previous_losses(self, runner: Any, data: Any, index: Any, options: Any) -> list[float | None]:
+    def previous_losses(
+        self, runner: PolicyRunner, data: NormalisedData, index: torch.Tensor, options: StepOptions
+    ) -> list[float | None]:
         """The previous phase's policy's (``runner``) per-task loss on this phase's frames ``index``."""
 
     @abc.abstractmethod
-    def make_runner(self, policy: Any, preprocessor: Any, postprocessor: Any) -> Any:
+    def make_runner(
+        self,
+        policy: PreTrainedPolicy,
+        preprocessor: PolicyProcessorPipeline,
+        postprocessor: PolicyProcessorPipeline,
+    ) -> PolicyRunner:
         """Its evaluation runner (``evaluate.PolicyRunner`` or a subclass): batched actions."""
 
 
-StudentEntry = type[Student] | str
+StudentEntry = type[Student[Any, Any]] | str
 """A ``Student`` subclass, or its ``"module:attribute"`` entry point."""
 
 
@@ -104,7 +146,7 @@ def _refusal(name: Hashable, student: object) -> str:
     return f"The student {name!r} must be a Student subclass, got {student!r}."
 
 
-STUDENTS: Registry[type[Student]] = Registry(
+STUDENTS: Registry[type[Student[Any, Any]]] = Registry(
     "student",
     accepts=lambda student: isinstance(student, type) and issubclass(student, Student),
     entry_point_group=STUDENT_ENTRY_POINTS,
@@ -127,7 +169,7 @@ def register_student(name: str, student: StudentEntry) -> None:
 
 def student_names() -> list[str]:
     """Every registered ``--policy.type``, the built-in ones first."""
-    return STUDENTS.names()
+    return [str(name) for name in STUDENTS.names()]
 
 
 def check_student_name(name: str) -> str:
@@ -141,14 +183,14 @@ def check_student_name(name: str) -> str:
     return name
 
 
-def get_student(name: str) -> Student:
+def get_student(name: str) -> Student[Any, Any]:
     """The student of a ``--policy.type`` (``UserError`` on an unregistered name or a failing entry point)."""
     check_student_name(name)
     return _student(name, STUDENTS.entry(name), STUDENTS.get(name))
 
 
 @functools.cache
-def _student(name: str, entry: StudentEntry, student_class: type[Student]) -> Student:
+def _student(name: str, entry: StudentEntry, student_class: type[Student[Any, Any]]) -> Student[Any, Any]:
     """The student built from a registry entry (once per name and entry)."""
     del entry  # the cache key: a name registered anew builds anew
     student = student_class(name)
@@ -156,7 +198,7 @@ def _student(name: str, entry: StudentEntry, student_class: type[Student]) -> St
     return student
 
 
-def student_of_options(options: Any) -> Student:
+def student_of_options(options: object) -> Student[Any, Any]:
     """The student whose options class ``options`` is exactly (``ValueError`` if none)."""
     for name in student_names():
         student = get_student(name)
@@ -165,7 +207,7 @@ def student_of_options(options: Any) -> Student:
     raise ValueError(f"{type(options)} is not a student policy's options class.")
 
 
-def student_of_policy(policy: Any) -> Student:
+def student_of_policy(policy: PreTrainedPolicy) -> Student[Any, Any]:
     """The student that built ``policy`` (by its config's ``type``); a ``UserError`` if none."""
     policy_type = policy.config.type
     if policy_type in STUDENTS:

@@ -13,8 +13,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import torch
+from lerobot.configs.policies import PreTrainedConfig
 from lerobot.configs.types import FeatureType, PolicyFeature
 from lerobot.policies.factory import get_policy_class, make_pre_post_processors
+from lerobot.policies.pretrained import PreTrainedPolicy
+from lerobot.processor import PolicyProcessorPipeline
 from lerobot.utils.constants import OBS_IMAGES
 
 from lerobot_mtdagger.policies.task_conditioning import (
@@ -23,8 +26,12 @@ from lerobot_mtdagger.policies.task_conditioning import (
     task_feature,
     task_one_hot,
 )
+from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.policy_options import UNSEEN_TASK_DROPOUT
-from lerobot_mtdagger.runner.student import Student
+from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
+from lerobot_mtdagger.runner.student import Stats, Student
+from lerobot_mtdagger.runner.training.normalise import NormalisedData
+from lerobot_mtdagger.runner.training.steps import StepOptions
 from lerobot_mtdagger.students.chunk_runner import ChunkRunner
 from lerobot_mtdagger.students.options import (
     UNSUPPORTED_STUDENT_OPTIONS,
@@ -131,7 +138,9 @@ class EpisodeWindows:
 class LeRobotOps:
     """The training seam for a LeRobot policy on a phase's normalised frames (see the module docstring)."""
 
-    def __init__(self, policy: Any, data: Any, task_dropout: float, seed: int) -> None:
+    def __init__(
+        self, policy: PreTrainedPolicy, data: NormalisedData, task_dropout: float, seed: int
+    ) -> None:
         """Prepares the frame windows; ``seed`` seeds the task dropout and the loss measurements."""
         self.policy = policy
         self.data = data
@@ -174,7 +183,7 @@ class LeRobotOps:
         return loss
 
     @torch.no_grad()
-    def task_losses(self, index: torch.Tensor, num_tasks: int) -> tuple[list, list]:
+    def task_losses(self, index: torch.Tensor, num_tasks: int) -> tuple[list[float | None], list[int]]:
         """The policy's loss per task over frames ``index`` (None where none) and the frame counts."""
         was_training = self.policy.training
         self.policy.train()  # ACT's loss needs its VAE encoder, which runs in training mode only
@@ -195,7 +204,9 @@ class LeRobotOps:
         losses = [float(sums[i] / counts[i]) if counts[i] > 0 else None for i in range(num_tasks)]
         return losses, [int(c) for c in counts.tolist()]
 
-    def optimizer(self, steps: int) -> tuple[torch.optim.Optimizer, Any, float]:
+    def optimizer(
+        self, steps: int
+    ) -> tuple[torch.optim.Optimizer, torch.optim.lr_scheduler.LRScheduler | None, float]:
         """The policy config's optimiser and scheduler presets (over ``steps``) and gradient clip norm."""
         preset = self.policy.config.get_optimizer_preset()
         optimizer = preset.build(self.policy.get_optim_params())
@@ -204,7 +215,7 @@ class LeRobotOps:
         return optimizer, scheduler, float(preset.grad_clip_norm)
 
 
-class LeRobotStudent(Student):
+class LeRobotStudent(Student[PreTrainedConfig, "LeRobotStudentConfig"]):
     """A LeRobot policy as the DAgger student, for LeRobot's ``--policy.type`` (``act``, ``diffusion``).
 
     Options: LeRobot's config plus ``batch_size``; training: ``LeRobotOps``; evaluation: ``ChunkRunner``.
@@ -216,14 +227,14 @@ class LeRobotStudent(Student):
         """LeRobot's config of the policy type, with ``batch_size`` (``lerobot_options_class``)."""
         return lerobot_options_class(self.saved_type)
 
-    def options_dict(self, options: Any) -> dict[str, Any]:
+    def options_dict(self, options: PreTrainedConfig) -> dict[str, Any]:
         """``type``, ``batch_size`` and LeRobot's own encoding of its config."""
         import draccus
 
         encoded = draccus.encode(lerobot_policy_config(options))
         return {"type": self.name, "batch_size": options.batch_size, **encoded}
 
-    def check_run(self, config: Any) -> None:
+    def check_run(self, config: RunConfig) -> None:
         """Refuses point clouds, temporal ensembling, ``lr_schedule``, unsupported options: ``ValueError``."""
         for name, reason in UNSUPPORTED_STUDENT_OPTIONS.items():
             if getattr(config.policy, name, None) not in (None, False):
@@ -245,29 +256,42 @@ class LeRobotStudent(Student):
             )
 
     def policy_config(
-        self, options: Any, suite_features: dict[str, Any], task_names: Sequence[str], unseen: bool
+        self,
+        options: PreTrainedConfig,
+        suite_features: dict[str, Any],
+        task_names: Sequence[str],
+        unseen: bool,
     ) -> LeRobotStudentConfig:
         """``lerobot_student_config`` (task dropout ``UNSEEN_TASK_DROPOUT`` with held-out tasks, else 0)."""
         task_dropout = UNSEEN_TASK_DROPOUT if unseen else 0.0
         return lerobot_student_config(options, suite_features, task_names, task_dropout)
 
-    def make_policy(self, policy_cfg: Any, stats: dict[str, dict[str, Any]]) -> tuple[Any, Any, Any]:
+    def make_policy(
+        self, policy_cfg: LeRobotStudentConfig, stats: Stats
+    ) -> tuple[PreTrainedPolicy, PolicyProcessorPipeline, PolicyProcessorPipeline]:
         """``make_lerobot_student`` and ``make_lerobot_processors``."""
         return make_lerobot_student(policy_cfg), *make_lerobot_processors(policy_cfg, stats)
 
-    def phase_ops(self, policy: Any, data: Any, options: Any) -> LeRobotOps:
+    def phase_ops(self, policy: PreTrainedPolicy, data: NormalisedData, options: StepOptions) -> LeRobotOps:
         """``LeRobotOps`` with the phase's task dropout and seed."""
         return LeRobotOps(policy, data, options.task_dropout, options.seed)
 
-    def previous_losses(self, runner: Any, data: Any, index: Any, options: Any) -> list[float | None]:
+    def previous_losses(
+        self, runner: PolicyRunner, data: NormalisedData, index: torch.Tensor, options: StepOptions
+    ) -> list[float | None]:
         """Its own training loss per task on this phase's normalised frames (``LeRobotOps.task_losses``)."""
         return self.phase_ops(runner.policy, data, options).task_losses(index, len(data.task_names))[0]
 
-    def make_runner(self, policy: Any, preprocessor: Any, postprocessor: Any) -> Any:
+    def make_runner(
+        self,
+        policy: PreTrainedPolicy,
+        preprocessor: PolicyProcessorPipeline,
+        postprocessor: PolicyProcessorPipeline,
+    ) -> ChunkRunner:
         """``ChunkRunner``: an action queue per running episode, chunks from ``predict_chunk``."""
         return ChunkRunner(policy, preprocessor, postprocessor, predict_chunk=self.predict_chunk)
 
-    def predict_chunk(self, policy: Any, batch: dict[str, torch.Tensor]) -> torch.Tensor:
+    def predict_chunk(self, policy: PreTrainedPolicy, batch: dict[str, torch.Tensor]) -> torch.Tensor:
         """Normalised action chunks (B, n, action_dim) from LeRobot's ``predict_action_chunk``.
 
         ``batch`` holds current observations, or histories (B, n_obs_steps, ...) for ``DiffusionStudent``.
@@ -282,7 +306,7 @@ class DiffusionStudent(LeRobotStudent):
     keeps one per episode, so the images are stacked as ``forward`` does and ``generate_actions`` called.
     """
 
-    def predict_chunk(self, policy: Any, batch: dict[str, torch.Tensor]) -> torch.Tensor:
+    def predict_chunk(self, policy: PreTrainedPolicy, batch: dict[str, torch.Tensor]) -> torch.Tensor:
         """Normalised action chunks (B, horizon, action_dim) for current observations or histories."""
         if policy.config.n_obs_steps == 1:
             return policy.predict_action_chunk(batch)

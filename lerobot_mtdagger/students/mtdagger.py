@@ -14,13 +14,16 @@ from typing import Any
 import numpy as np
 import torch
 from lerobot.configs.types import FeatureType, PolicyFeature
+from lerobot.policies.pretrained import PreTrainedPolicy
+from lerobot.processor import PolicyProcessorPipeline
 
 from lerobot_mtdagger.policies import MTDAggerConfig, MTDAggerPolicy, make_mtdagger_pre_post_processors
 from lerobot_mtdagger.policies.mtdagger.modeling_mtdagger import per_task_means
 from lerobot_mtdagger.runner.policy_options import PolicyOptions
 from lerobot_mtdagger.runner.rollout.evaluate import PolicyRunner
-from lerobot_mtdagger.runner.student import Student
+from lerobot_mtdagger.runner.student import Stats, Student
 from lerobot_mtdagger.runner.training.normalise import NormalisedData
+from lerobot_mtdagger.runner.training.steps import StepOptions
 from lerobot_mtdagger.utils.lerobot_compat import dataset_to_policy_features
 
 logger = logging.getLogger(__name__)
@@ -91,14 +94,16 @@ class MTDAggerOps:
         logger.debug("loss %s, per task %s", info.get("loss"), info.get("per_task_loss"))
         return loss
 
-    def task_losses(self, index: torch.Tensor, num_tasks: int) -> tuple[list, list]:
+    def task_losses(self, index: torch.Tensor, num_tasks: int) -> tuple[list[float | None], list[int]]:
         """Mean action MSE per task (``per_task_loss``)."""
         return per_task_loss(self.policy, self.data, index, num_tasks)
 
-    def optimizer(self, steps: int) -> tuple[torch.optim.Optimizer, Any, float]:
+    def optimizer(
+        self, steps: int
+    ) -> tuple[torch.optim.Optimizer, torch.optim.lr_scheduler.LRScheduler | None, float]:
         """Fused AdamW, its schedule over ``steps`` (none, or ``cosine`` to 0), the gradient clip norm."""
         optimizer = make_optimizer(self.policy, self.lr)
-        scheduler = None
+        scheduler: torch.optim.lr_scheduler.LRScheduler | None = None
         if self.lr_schedule == "cosine":
             scheduler = torch.optim.lr_scheduler.CosineAnnealingLR(optimizer, T_max=max(steps, 1))
         return optimizer, scheduler, self.policy.config.optimizer_grad_clip_norm
@@ -107,7 +112,7 @@ class MTDAggerOps:
 @torch.no_grad()
 def per_task_loss(
     policy: MTDAggerPolicy, data: NormalisedData, index: torch.Tensor, num_tasks: int
-) -> tuple[list, list]:
+) -> tuple[list[float | None], list[int]]:
     """Mean MSE per task over the frames at ``index`` (None where a task has none) and the counts."""
     policy.eval()
     sums = torch.zeros(num_tasks, dtype=torch.float64, device=data.device)
@@ -151,7 +156,7 @@ def per_task_loss_of(
     return [float(sums[i] / counts[i]) if counts[i] > 0 else None for i in range(num_tasks)]
 
 
-class MTDAggerStudent(Student):
+class MTDAggerStudent(Student[PolicyOptions, MTDAggerConfig]):
     """The ``mtdagger`` policy as the DAgger student (see the module docstring)."""
 
     lr_option = "lr"
@@ -161,25 +166,36 @@ class MTDAggerStudent(Student):
         return PolicyOptions
 
     def policy_config(
-        self, options: Any, suite_features: dict[str, Any], task_names: Sequence[str], unseen: bool
-    ) -> Any:
+        self, options: PolicyOptions, suite_features: dict[str, Any], task_names: Sequence[str], unseen: bool
+    ) -> MTDAggerConfig:
         """An ``MTDAggerConfig`` (task dropout ``options.resolved_task_dropout(unseen)``)."""
         task_dropout = options.resolved_task_dropout(unseen)
         return policy_config(suite_features, task_names, options, options.device, task_dropout)
 
-    def make_policy(self, policy_cfg: Any, stats: dict[str, dict[str, Any]]) -> tuple[Any, Any, Any]:
+    def make_policy(
+        self, policy_cfg: MTDAggerConfig, stats: Stats
+    ) -> tuple[MTDAggerPolicy, PolicyProcessorPipeline, PolicyProcessorPipeline]:
         """An ``MTDAggerPolicy`` moved to its config's device, and its processors for ``stats``."""
         return MTDAggerPolicy(policy_cfg).to(policy_cfg.device), *build_processors(policy_cfg, stats)
 
-    def phase_ops(self, policy: Any, data: Any, options: Any) -> Any:
+    def phase_ops(self, policy: PreTrainedPolicy, data: NormalisedData, options: StepOptions) -> MTDAggerOps:
         """``MTDAggerOps`` with the phase's learning rate and schedule."""
+        if not isinstance(policy, MTDAggerPolicy):
+            raise TypeError(f"The mtdagger student trains an MTDAggerPolicy, got {type(policy).__name__}.")
         return MTDAggerOps(policy, data, options.lr, options.lr_schedule)
 
-    def previous_losses(self, runner: Any, data: Any, index: Any, options: Any) -> list[float | None]:
+    def previous_losses(
+        self, runner: PolicyRunner, data: NormalisedData, index: torch.Tensor, options: StepOptions
+    ) -> list[float | None]:
         """The MSE of its actions (through its own processors) in this phase's normalisation."""
         del options
         return per_task_loss_of(runner.predict, data, index, len(data.task_names))
 
-    def make_runner(self, policy: Any, preprocessor: Any, postprocessor: Any) -> Any:
+    def make_runner(
+        self,
+        policy: PreTrainedPolicy,
+        preprocessor: PolicyProcessorPipeline,
+        postprocessor: PolicyProcessorPipeline,
+    ) -> PolicyRunner:
         """``evaluate.PolicyRunner``: one action per observation."""
         return PolicyRunner(policy, preprocessor, postprocessor)

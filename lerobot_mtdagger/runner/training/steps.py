@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import torch
+from lerobot.policies.pretrained import PreTrainedPolicy
 
-from lerobot_mtdagger.policies import MTDAggerPolicy
 from lerobot_mtdagger.policies.task_conditioning import TASK_FEATURE
-from lerobot_mtdagger.runner.student import Student, student_of_policy
+from lerobot_mtdagger.runner.student import Student, TrainingOps, student_of_policy
 from lerobot_mtdagger.runner.training.normalise import NormalisedData
 from lerobot_mtdagger.runner.training.phase_progress import PhaseProgress, loop_state, restore_loop
 from lerobot_mtdagger.runner.training.plateau import PlateauStop, PlateauTracker
@@ -70,7 +70,12 @@ class PhaseResult:
     earlier_steps_s: float = field(default=0.0, compare=False)
 
 
-def phase_ops(policy: Any, data: NormalisedData, options: StepOptions, student: Student | None = None) -> Any:
+def phase_ops(
+    policy: PreTrainedPolicy,
+    data: NormalisedData,
+    options: StepOptions,
+    student: Student[Any, Any] | None = None,
+) -> TrainingOps:
     """The training seam of ``policy``: ``student.phase_ops`` (None: the one registered for its type)."""
     student = student_of_policy(policy) if student is None else student
     return student.phase_ops(policy, data, options)
@@ -130,13 +135,13 @@ class StepOptions:
 
 
 def train_phase(
-    policy: MTDAggerPolicy,
+    policy: PreTrainedPolicy,
     data: NormalisedData,
     train_index: torch.Tensor,
     loss_index: torch.Tensor,
     options: StepOptions,
     on_step: Callable[[int, float], None] | None = None,
-    student: Student | None = None,
+    student: Student[Any, Any] | None = None,
 ) -> PhaseResult:
     """Trains ``policy`` in place for ``options.steps`` steps (or to a plateau); measures the loss drop.
 
@@ -181,7 +186,7 @@ class StepLoop:
 
     def __init__(
         self,
-        ops: Any,
+        ops: TrainingOps,
         data: NormalisedData,
         train_index: torch.Tensor,
         options: StepOptions,
@@ -250,7 +255,7 @@ class StepLoop:
 
 
 def _check_phase_inputs(
-    policy: Any, data: NormalisedData, log_interval: int, plateau: PlateauStop | None
+    policy: PreTrainedPolicy, data: NormalisedData, log_interval: int, plateau: PlateauStop | None
 ) -> None:
     """Refuses a policy of other tasks, a log interval < 1 and a plateau stop without held-out frames."""
     task_names = getattr(policy.config, "task_names", None)
