@@ -48,11 +48,16 @@ class LeRobotSuiteEnv(gym.Env):
 
         Raises:
             TypeError: On an option that is not such a field.
+            ValueError: If ``task`` is None.
         """
         config = MTDAggerSuiteEnvConfig(**suite_options)
         task = config.task
         self._suite = suite_from_config(config.task_suite)
-        self._env = self._suite.make_env(task)
+        if task is None:  # every suite's make_env refuses it (ValueError)
+            raise ValueError("LeRobotSuiteEnv runs one task: give --env.task, got None.")
+        # A suite's task env: a gym.Env with ``max_episode_steps`` and a ``Dict`` observation space.
+        env: Any = self._suite.make_env(task)
+        self._env = env
         self.task_description = task
         self.task = task  # LeRobot 0.6 warns on every eval unless an env has both
         self.render_mode = render_mode

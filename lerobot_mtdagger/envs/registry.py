@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import importlib
 import logging
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import cast
 
 from lerobot_mtdagger.envs.base import ObservationConfig, TaskSuite
 from lerobot_mtdagger.utils.errors import UserError
@@ -44,7 +45,7 @@ class SuiteOptions:
     def __post_init__(self) -> None:
         object.__setattr__(self, "tasks", tuple(self.tasks or ()))
 
-    def task_list(self, default: Sequence[str]) -> list[str]:
+    def task_list(self, default: Iterable[str]) -> list[str]:
         """The tasks asked for, or ``default`` (the suite's own list) when none were."""
         return list(self.tasks) if self.tasks else list(default)
 
@@ -83,7 +84,7 @@ def register_suite(name: str, factory: SuiteFactory | str) -> None:
 
 def suite_names() -> list[str]:
     """Every registered suite name, in the order of registration (the built-in suites first)."""
-    return SUITES.names()
+    return cast("list[str]", SUITES.names())  # register_suite takes str names
 
 
 def build_suite(options: SuiteOptions) -> TaskSuite:

@@ -60,7 +60,7 @@ class ToyEnv(gym.Env):
         self.action_space = gym.spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
         self._goal = np.asarray(task.goal, dtype=np.float64)
         self._wind = np.asarray(task.wind, dtype=np.float64)
-        self._position = np.zeros(2)
+        self._position: np.ndarray = np.zeros(2)
         self._steps = 0
         self._first_seed = seed
 

@@ -12,7 +12,7 @@ import copy
 import inspect
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from lerobot_mtdagger.datasets.checkpoints import check_local_policy, load_policy
 from lerobot_mtdagger.experts.base import Expert, LeRobotPolicyExpert
@@ -40,7 +40,7 @@ def expert_type_factory(name: str) -> Callable[[Any, str], Expert]:
     """The ``--expert.type`` factory: a registered name or ``module:attribute`` (else a ``UserError``)."""
     if name in EXPERT_TYPES:
         return EXPERT_TYPES.get(name)
-    known = sorted(EXPERT_TYPES.names()) or "none"
+    known = sorted(cast("list[str]", EXPERT_TYPES.names())) or "none"  # registered by str name
     hint = (
         f"--expert.type={name} is neither a registered expert type ({known}) nor an importable "
         "module:attribute factory(suite, task) -> Expert"

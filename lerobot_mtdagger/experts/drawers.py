@@ -44,7 +44,7 @@ BRANCHES = ("align", "clear", "descend", "grip", "pull", "release")
 onto the grasp pose, close on the handle (or hold it closed), pull, open the gripper and back off."""
 
 
-def _unpack(state: np.ndarray) -> dict[str, np.ndarray | float]:
+def _unpack(state: np.ndarray) -> dict[str, Any]:
     def vec(prefix: str) -> np.ndarray:
         return np.array([state[STATE_INDEX[f"{prefix}_{axis}"]] for axis in "xyz"])
 

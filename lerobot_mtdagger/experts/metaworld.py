@@ -25,7 +25,7 @@ class MetaWorldScriptedExpert:
                 f"MetaWorld has no scripted policy for {task_name!r}; known: {sorted(ENV_POLICY_MAP)}."
             )
         self.task_name = task_name
-        self._policy = ENV_POLICY_MAP[task_name]()
+        self._policy = ENV_POLICY_MAP[task_name]()  # type: ignore[abstract]  # stub: type[Policy]; concrete
 
     def reset(self) -> None:
         """The scripted policies are stateless."""

@@ -11,8 +11,8 @@ factory for ``(family, task)``, or the family's; wrapped in ``ActionCheckedExper
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Hashable
+from typing import Any, cast
 
 from lerobot_mtdagger.experts.base import ActionCheckedExpert, Expert
 from lerobot_mtdagger.utils.errors import UserError
@@ -24,13 +24,17 @@ ANY_TASK = "*"
 ExpertFactory = Callable[[Any, str], Expert]
 """``factory(suite, task_name) -> Expert``."""
 
-EXPERTS: Registry[ExpertFactory] = Registry(
-    "expert factory",
-    refusal=lambda key, factory: (
-        f"The expert factory for {key[0]}/{key[1]} must be callable or a 'module:attribute' string, "
-        f"got {factory!r}."
-    ),
-)
+
+def _refusal(key: Hashable, factory: object) -> str:
+    """The message refusing ``factory`` under ``key``, a ``(suite family, task)`` pair."""
+    family_task = cast("tuple[str, str]", key)
+    return (
+        f"The expert factory for {family_task[0]}/{family_task[1]} must be callable or a "
+        f"'module:attribute' string, got {factory!r}."
+    )
+
+
+EXPERTS: Registry[ExpertFactory] = Registry("expert factory", refusal=_refusal)
 """Expert factories by ``(suite family, task)`` (``ANY_TASK``: every task of the family)."""
 
 

@@ -9,10 +9,10 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS, former_option_values
 from lerobot_mtdagger.envs.config import SuiteConfig
@@ -74,7 +74,7 @@ class RunConfig:
     rollout: RolloutConfig = field(default_factory=RolloutConfig)
     training: TrainingConfig = field(default_factory=TrainingConfig)
     scheduler: SchedulerConfig = field(default_factory=NeedSchedulerConfig)
-    policy: StudentOptions = field(default_factory=PolicyOptions)
+    policy: StudentOptions = field(default_factory=cast("Callable[[], StudentOptions]", PolicyOptions))
     expert: ExpertConfig = field(default_factory=ExpertConfig)
     output_dir: Path | None = None
     seed: int = 0
@@ -140,6 +140,7 @@ class RunConfig:
                 f"got {self.policy.batch_size}, {lr}."
             )
         check_device(self.policy.device)
+        assert self.output_dir is not None  # __post_init__ fills it
         check_output_dir(self.output_dir, "--output_dir")
         self.student.check_run(self)
 
@@ -178,8 +179,11 @@ class RunConfig:
         if training.steps_rule == "plateau":
             return training.plateau_max_steps
         if training.steps_rule == "epochs":
+            assert training.epochs is not None  # filled by the preset
             return max(1, math.ceil(training.epochs * frames / self.policy.batch_size))
+        assert training.steps_per_round is not None  # filled by the preset
         if self.is_bc and training.warm_start:
+            assert self.dagger.rounds is not None  # filled by the preset
             return training.steps_per_round * (self.dagger.rounds + 1)
         return training.steps_per_round
 

@@ -24,7 +24,7 @@ import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from tqdm import tqdm
@@ -94,8 +94,10 @@ class RunContext:
 def initial_allocation(ctx: RunContext) -> list[int]:
     """Round-0 episodes per task: n0, plus the DAgger rounds' budget for BC (split uniformly)."""
     num_tasks = len(ctx.task_names)
+    assert ctx.config.dagger.initial_demos is not None  # filled by RunConfig's preset
     if not ctx.config.is_bc:
         return [ctx.config.dagger.initial_demos] * num_tasks
+    assert ctx.config.dagger.rounds is not None  # filled by RunConfig's preset
     extra = ctx.config.dagger.rounds * ctx.config.dagger.budget_for(num_tasks)
     uniform = allocate_probabilities(np.full(num_tasks, 1.0 / num_tasks), extra, 0)
     return [ctx.config.dagger.initial_demos + int(n) for n in uniform]
@@ -223,6 +225,7 @@ def round_record(
             scheduler_state=None,
             notes=notes,
         )
+    assert scheduler is not None  # it gave the allocation
     phase = ctx.experiment.read_phase_record(round_index - 1)
     alloc = allocation.to_dict()
     return RoundRecord(
@@ -282,7 +285,8 @@ def evaluate_student(
         # They run while the run's own workers wait, on the CPUs those hold (Ray: no reservation).
         with ctx.config.rollout.env_workers(ctx.heldout_suite, reserve_cpus=False) as heldout_workers:
             results[1] = evaluate_phase(ctx, runner, heldout_workers)
-    return tuple(None if result is None else result.to_dict() for result in results)
+    both = tuple(None if result is None else result.to_dict() for result in results)
+    return cast("tuple[dict | None, dict | None]", both)  # results: the training and the unseen tasks'
 
 
 def evaluate_phase(ctx: RunContext, runner: PolicyRunner, workers: EnvWorkers) -> EvalResult | None:
@@ -292,6 +296,7 @@ def evaluate_phase(ctx: RunContext, runner: PolicyRunner, workers: EnvWorkers) -
     """
     if ctx.config.rollout.eval_episodes == 0:
         return None
+    assert ctx.config.rollout.eval_episodes is not None  # filled by RunConfig's preset
     episodes = ctx.config.rollout.eval_episodes * len(workers.suite.task_names)
     with tqdm(total=episodes, desc="eval", leave=False, disable=not ctx.show_progress) as bar:
         result, _ = evaluate(
@@ -326,6 +331,7 @@ def run(
         FloatingPointError: If training diverges.
         WorkerDiedError: If an env worker process dies.
     """
+    assert config.output_dir is not None  # RunConfig.__post_init__ fills it
     experiment = ExperimentDir(config.output_dir)
     if config.resume:
         experiment.check_resumable(config.to_dict(), added_defaults=RunConfig.option_defaults())
@@ -345,6 +351,7 @@ def run(
             experiment.check_committed_files()  # refuses foreign, corrupt or changed rounds and policies
             experiment.update_ledger()  # a record committed just before a cut-off, and older experiments
             experiment.clear_staging()
+            assert config.dagger.rounds is not None  # filled by RunConfig's preset
             experiment.extend_rounds(config.dagger.rounds)  # a DAgger run resumed with more rounds
         if on_start is not None:
             on_start()

@@ -56,7 +56,7 @@ def _require_positive(owner: Any, group: str, names: Sequence[str]) -> None:
             raise ValueError(f"{group}.{name} must be > 0, got {value}.")
 
 
-def _require_choice(value: str, option: str, choices: Sequence[str]) -> None:
+def _require_choice(value: str | None, option: str, choices: Sequence[str]) -> None:
     """Refuses a ``value`` of ``option`` outside ``choices``."""
     if value not in choices:
         raise ValueError(f"{option} must be one of {list(choices)}, got {value!r}.")
@@ -89,6 +89,7 @@ class DAggerConfig:
 
     def check(self) -> None:
         """Refuses impossible values (one line naming the option)."""
+        assert self.rounds is not None and self.initial_demos is not None  # filled by RunConfig's preset
         if self.rounds < 0:
             raise ValueError(f"dagger.rounds must be >= 0, got {self.rounds}.")
         if self.initial_demos <= 0:
@@ -106,7 +107,10 @@ class DAggerConfig:
 
     def budget_for(self, num_tasks: int) -> int:
         """Expert episodes per DAgger round."""
-        return self.budget if self.budget is not None else self.budget_per_task * num_tasks
+        if self.budget is not None:
+            return self.budget
+        assert self.budget_per_task is not None  # filled by RunConfig's preset
+        return self.budget_per_task * num_tasks
 
 
 @dataclass

@@ -10,7 +10,7 @@ import contextlib
 import contextvars
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from lerobot_mtdagger.datasets.student_types import MTDAGGER_TYPE
 from lerobot_mtdagger.runner.student import check_student_name, get_student, student_names, student_of_options
@@ -90,6 +90,10 @@ class StudentOptions:
 
     Each registered student gives its options class; a stored config without ``type`` is ``mtdagger``.
     """
+
+    if TYPE_CHECKING:  # what every student's options hold once ``RunConfig`` has filled its preset
+        batch_size: int
+        device: str
 
     @classmethod
     def get_choice_class(cls, name: str) -> type:

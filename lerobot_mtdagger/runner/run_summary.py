@@ -34,7 +34,10 @@ PHASE_DETAIL_TIMINGS = ("steps_s", "task_loss_s")
 
 def last_round(config: RunConfig) -> int:
     """Index of the last round of a run (0 for BC, whose one round holds every demo)."""
-    return 0 if config.is_bc else config.dagger.rounds
+    if config.is_bc:
+        return 0
+    assert config.dagger.rounds is not None  # filled by RunConfig's preset
+    return config.dagger.rounds
 
 
 def is_finished(experiment: ExperimentDir, last: int) -> bool:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
@@ -35,7 +35,7 @@ _LIP_THICKNESS = 0.004
 _LIP_OVERHANG = 0.012
 
 
-def _vec(values: Sequence[float]) -> str:
+def _vec(values: Iterable[float]) -> str:
     return " ".join(f"{v:.5g}" for v in values)
 
 

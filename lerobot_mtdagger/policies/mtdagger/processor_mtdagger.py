@@ -40,6 +40,7 @@ def _pool_channel_stats(stats: dict[str, Any]) -> dict[str, Any]:
             pooled[name] = stats[name]
             continue
         if name == "mean":
+            assert mean is not None  # set whenever "mean" is among the arrays
             channel = mean
         elif name == "std" and mean is not None:
             second_moment = (value**2 + arrays["mean"] ** 2).mean(axis=0)

@@ -13,6 +13,7 @@ import logging
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -236,11 +237,13 @@ def _learner_actions(
     ready = [handle for handle in members if lanes[handle].observation is not None]
     if policy is None or not ready:
         return dict.fromkeys(ready)
-    observations = [lanes[handle].observation for handle in ready]
-    tasks = [task_names[lanes[handle].task_index] for handle in ready]
+    # A lane with an observation runs an episode: its task_index is set.
+    observations = cast("list[dict[str, np.ndarray]]", [lanes[handle].observation for handle in ready])
+    tasks = [task_names[cast(int, lanes[handle].task_index)] for handle in ready]
     if getattr(policy, "tracks_episodes", False):
+        tracking: Callable[..., np.ndarray] = policy  # also takes lanes= and starts=
         starts = [lanes[handle].fresh for handle in ready]
-        actions = np.asarray(policy(observations, tasks, lanes=ready, starts=starts), dtype=np.float32)
+        actions = np.asarray(tracking(observations, tasks, lanes=ready, starts=starts), dtype=np.float32)
     else:
         actions = np.asarray(policy(observations, tasks), dtype=np.float32)
     for handle in ready:

@@ -195,9 +195,9 @@ def evaluate(
         workers, [episodes_per_task] * len(suite.task_names), options, policy=runner, progress=progress
     )
     rates, counts = success_by_task(episodes, len(suite.task_names))
-    progress = None
+    task_progress = None
     if suite.reports_progress:
         totals = np.bincount([e.task_index for e in episodes], [e.progress for e in episodes], len(counts))
-        progress = [float(total / max(count, 1)) for total, count in zip(totals, counts, strict=True)]
+        task_progress = [float(total / max(count, 1)) for total, count in zip(totals, counts, strict=True)]
     success = [r if r is not None else 0.0 for r in rates]
-    return EvalResult(list(suite.task_names), success, counts, progress), episodes
+    return EvalResult(list(suite.task_names), success, counts, task_progress), episodes

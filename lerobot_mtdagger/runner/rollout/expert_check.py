@@ -88,13 +88,13 @@ def expert_success(suite: Any, task_index: int, episodes: int, seed: int) -> flo
 
 def measure_expert_check(suite: Any, min_success: float, episodes: int, seed: int) -> ExpertCheck:
     """Measures every task's expert, keeping those at or above ``min_success`` (``UserError`` if none)."""
-    success = {}
+    success: dict[str, float] = {}
     for task_index, task in enumerate(suite.task_names):
         success[task] = expert_success(suite, task_index, episodes, seed)
         logger.info("expert success %s: %.3f over %d episodes", task, success[task], episodes)
     kept = [task for task, rate in success.items() if rate >= min_success]
     if not kept:
-        best = max(success, key=success.get)
+        best = max(success, key=success.__getitem__)
         raise UserError(
             f"No task's expert reaches --expert.min_success={min_success} (best: {best} at "
             f"{success[best]:.2f} over {episodes} episodes): lower the threshold or the expert noise."

@@ -104,6 +104,12 @@ class RolloutWorker:
         self.running: dict[int, _Running] = {}
         self.rules: RolloutRules | None = None
 
+    @property
+    def _rules(self) -> RolloutRules:
+        """The rules of the running episodes (the main process sends them before any episode)."""
+        assert self.rules is not None, "the rules are set before any episode starts"
+        return self.rules
+
     def handle(self, command: tuple[str, Any]) -> Any:
         """Executes one command of the main process and returns its reply."""
         name, payload = command
@@ -137,7 +143,7 @@ class RolloutWorker:
                 observations[handle] = running.observation
         for spec in starts:
             running = self._start(spec)
-            if not self.rules.learner:
+            if not self._rules.learner:
                 while not self._step(running, None):
                     pass
                 finished.append((spec.handle, running.episode))
@@ -160,19 +166,18 @@ class RolloutWorker:
     def _start(self, spec: EpisodeSpec) -> _Running:
         task_name = self.suite.task_names[spec.task_index]
         pool = self.free_envs[spec.task_index]
-        env = pool.pop() if pool else self.suite.make_env(task_name)
-        expert = self._expert(spec.task_index) if self.rules.need_expert else None
-        expert_episode = self.rules.mixing == "episode" and expert_episode_coin(
-            spec.beta_seed, self.rules.beta
-        )
-        max_steps = self.rules.max_steps
-        if self.rules.expert_multiple is not None and self.rules.learner and not expert_episode:
+        env: Any = pool.pop() if pool else self.suite.make_env(task_name)
+        rules = self._rules
+        expert = self._expert(spec.task_index) if rules.need_expert else None
+        expert_episode = rules.mixing == "episode" and expert_episode_coin(spec.beta_seed, rules.beta)
+        max_steps = rules.max_steps
+        if rules.expert_multiple is not None and rules.learner and not expert_episode:
             max_steps = self._expert_step_limit(env, expert, spec.reset_seed)
         observation, info = env.reset(seed=spec.reset_seed)
         rng = np.random.default_rng(np.random.SeedSequence(list(spec.beta_seed)))
         noise = None
         if expert is not None and self.suite.expert_noise is not None:
-            key = (self.rules.round_index, spec.task_index, spec.episode)
+            key = (rules.round_index, spec.task_index, spec.episode)
             bounds = (env.action_space.low, env.action_space.high)
             noise = self.suite.expert_noise.episode_process(key, *bounds, task=task_name)
         return _Running(
@@ -192,7 +197,7 @@ class RolloutWorker:
         """``max_steps`` capped at ``expert_multiple`` times the expert's steps to success on ``env``."""
         expert_steps = _expert_steps_to_success(env, expert, reset_seed)
         expert.reset()
-        return step_limit(self.rules, expert_steps)
+        return step_limit(self._rules, expert_steps)
 
     def _expert(self, task_index: int) -> Any:
         """A reset expert of the task that no running episode uses (else a deep copy of the first)."""
@@ -215,7 +220,7 @@ class RolloutWorker:
 
     def _step(self, running: _Running, learner_action: np.ndarray | None) -> bool:
         """Steps one episode; returns whether it ended."""
-        rules = self.rules
+        rules = self._rules
         episode = running.episode
         expert_action, label = _expert_action(running)
         expert_acts = expert_acts_now(rules, learner_action is not None, running.expert_episode, running.rng)
@@ -236,6 +241,7 @@ class RolloutWorker:
         )
         if rules.record:
             outcome = StepOutcome(reward=float(reward), success=bool(info["success"]), done=ended)
+            assert executed is not None  # recording queries the expert, and the expert acts without a learner
             columns = dagger_columns(executed, not expert_acts, rules.round_index, outcome)
             episode.frames.append({**observation, "action": label, **columns})
         return ended

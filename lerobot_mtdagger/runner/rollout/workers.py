@@ -129,7 +129,7 @@ class EnvWorkers:
         self.workers = workers
         self._local = RolloutWorker(suite) if workers == 0 else None
         self._processes: list[Any] = []
-        self._connections: list[Connection] = []
+        self._connections: list[Any] = []  # pipe ends (Connection); Ray's: actors seen as pipes
         if workers:
             self._start_processes(workers)
 

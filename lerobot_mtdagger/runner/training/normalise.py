@@ -117,5 +117,9 @@ def normalise_inputs(preprocessor: Any, vector: dict[str, FrameTensor]) -> dict[
     result: dict[str, FrameTensor] = {k: normalised[k] for k in whole}
     for key, parts in vector.items():
         if isinstance(parts, FrameParts):
-            result[key] = parts.map(lambda part, key=key: preprocessor({key: part})[key])
+
+            def normalise_part(part: torch.Tensor, key: str = key) -> torch.Tensor:
+                return preprocessor({key: part})[key]
+
+            result[key] = parts.map(normalise_part)
     return result

@@ -75,11 +75,14 @@ class PhaseProgress:
         try:
             saved = torch.load(self.path, map_location="cpu", weights_only=True)
         except (OSError, RuntimeError, EOFError, pickle.UnpicklingError, zipfile.BadZipFile) as error:
-            return self._discard(f"it cannot be read ({error})")
+            self._discard(f"it cannot be read ({error})")
+            return None
         if not isinstance(saved, dict) or saved.get("format") != FORMAT:
-            return self._discard(f"it is not progress of format {FORMAT}")
+            self._discard(f"it is not progress of format {FORMAT}")
+            return None
         if saved.get("key") != self.key:
-            return self._discard(f"it belongs to another phase ({saved.get('key')}, this one: {self.key})")
+            self._discard(f"it belongs to another phase ({saved.get('key')}, this one: {self.key})")
+            return None
         done, steps_s = saved.pop("done"), saved.pop("steps_s")
         for name in ("format", "key"):
             saved.pop(name)

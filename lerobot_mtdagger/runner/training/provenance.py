@@ -15,7 +15,7 @@ ENVIRONMENT_PACKAGES = ("torch", "numpy", "lerobot", "mujoco", "metaworld", "ler
 
 def training_environment(device: torch.device) -> dict[str, Any]:
     """Where a phase trains: package versions, CPU, torch's kernel level and threads, device, Python."""
-    versions = {}
+    versions: dict[str, str | None] = {}
     for name in ENVIRONMENT_PACKAGES:
         try:
             versions[name] = importlib.metadata.version(name)

@@ -11,6 +11,7 @@ import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import pyarrow as pa
@@ -71,7 +72,9 @@ class TrainingData:
 
 def _join_input(tensors: Sequence[FrameTensor]) -> FrameTensor:
     """One input of several parts: vectors concatenated, images and point clouds as ``FrameParts``."""
-    return torch.cat(tensors) if len(tensors[0].shape) <= 2 else join_frames(tensors)
+    if len(tensors[0].shape) <= 2:  # vectors: always plain tensors (only images and clouds are parts)
+        return torch.cat(cast("list[torch.Tensor]", tensors))
+    return join_frames(tensors)
 
 
 def load_round(root: Path, round_position: int, input_keys: Sequence[str]) -> TrainingData:
@@ -95,7 +98,7 @@ def load_round(root: Path, round_position: int, input_keys: Sequence[str]) -> Tr
         raise FileNotFoundError(f"Round dataset {root} has no parquet file under data/.")
     columns = list(dict.fromkeys([*input_keys, "action", "task_index", "episode_index"]))
     table = pa.concat_tables([pq.read_table(path, columns=columns) for path in paths])
-    inputs = {}
+    inputs: dict[str, FrameTensor] = {}
     for key in input_keys:
         dtype = features[key]["dtype"]
         if dtype == "image":
@@ -126,7 +129,7 @@ def _column_values(column: pa.ChunkedArray, shape: Sequence[int], dtype: type = 
         array = array.flatten()
         if isinstance(array, pa.ExtensionArray):
             array = array.storage
-    values = np.array(array.to_numpy(zero_copy_only=False), dtype=dtype)  # owned, writable
+    values: np.ndarray = np.array(array.to_numpy(zero_copy_only=False), dtype=dtype)  # owned, writable
     return values.reshape(len(column), *shape)
 
 

@@ -152,6 +152,7 @@ def train_on_rounds(
     if runner is not None and config.training.warm_start:
         policy.load_state_dict(runner.policy.state_dict())
     normalised = NormalisedData(data, preprocessor, image_keys, list(policy_cfg.task_names))
+    assert config.training.sampling is not None  # filled by RunConfig's preset
     options = StepOptions(
         steps=config.phase_steps(len(split.train)),
         batch_size=config.policy.batch_size,
@@ -200,6 +201,7 @@ def check_heldout(config: RunConfig, num_tasks: int) -> None:
     training, demos = config.training, config.dagger.initial_demos
     if training.steps_rule != "plateau":
         return
+    assert demos is not None  # filled by RunConfig's preset
     fraction = training.heldout_fraction
     if not any(heldout_mask(demos, fraction, config.seed, task).any() for task in range(num_tasks)):
         raise UserError(
