@@ -14,7 +14,7 @@ import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 import draccus
 import numpy as np
@@ -99,8 +99,8 @@ class KalmanSuccessEstimator:
                 raise ValueError(f"{name} must be a finite variance >= 0, got {value}.")
         self.p0, self.P0, self.Q = float(p0), float(P0), float(Q)
         self.R0 = _require_positive(R0, "R0")
-        self.p = np.full(self.num_tasks, self.p0)
-        self.P = np.full(self.num_tasks, self.P0)
+        self.p: np.ndarray = np.full(self.num_tasks, self.p0)
+        self.P: np.ndarray = np.full(self.num_tasks, self.P0)
 
     def update(self, success_rate: ArrayLike, episodes: ArrayLike) -> None:
         """Runs one predict and one update step per task (ValueError on a bad measurement).
@@ -599,6 +599,7 @@ def _current_demos(state: SchedulerState) -> np.ndarray:
     """Demos per task now: ``demos_so_far``, else those behind the last measurement."""
     if state.demos_so_far is not None:
         return np.asarray(state.demos_so_far, dtype=np.float64)
+    assert state.history is not None  # called only once curves were fitted to it
     return state.history.demos[-1]
 
 
@@ -688,8 +689,9 @@ class Allocation:
 
     def config(self) -> SchedulerConfig:
         """The scheduler config this allocation was made with (ValueError if the method is not registered)."""
+        kalman: Mapping[str, Any] = self.kalman
         return scheduler_config_class(self.method)(
-            temperature=self.temperature, n_min=self.n_min, **self.kalman, **self.options
+            temperature=self.temperature, n_min=self.n_min, **kalman, **self.options
         )
 
 
@@ -729,8 +731,8 @@ class Scheduler:
         self.method = config.type
         self.kalman = config.new_kalman(num_tasks)
         self.num_tasks = self.kalman.num_tasks
-        self.raw_success = np.full(self.num_tasks, config.p0)
-        self.gain = np.zeros(self.num_tasks)
+        self.raw_success: np.ndarray = np.full(self.num_tasks, config.p0)
+        self.gain: np.ndarray = np.zeros(self.num_tasks)
         self.last_success_rate: np.ndarray | None = None
         self.last_episodes: np.ndarray | None = None
         self.last_gain: np.ndarray | None = None
@@ -765,6 +767,7 @@ class Scheduler:
             _require_finite(checked_gain, "gain")
         checked_demos = self._checked_demos(demos, demos_so_far, success_rate is not None)
         if success_rate is not None:
+            assert episodes is not None  # refused above: success_rate and episodes go together
             rate, counts = check_measurements(success_rate, episodes, self.num_tasks)
             if checked_demos[0] is not None:
                 self.history = self.history.appended(checked_demos[0], rate, counts)
@@ -791,7 +794,7 @@ class Scheduler:
             )
         if demos is not None and not has_success:
             raise ValueError("demos describes a success measurement: pass it with success_rate and episodes.")
-        checked = []
+        checked: list[np.ndarray | None] = []
         for name, values in (("demos", demos), ("demos_so_far", demos_so_far)):
             if values is None or not reads_demos:
                 checked.append(None)
@@ -859,7 +862,7 @@ class Scheduler:
     def state_dict(self) -> dict[str, Any]:
         """Returns the full state as JSON-ready builtins (round-trips exactly through ``json``)."""
 
-        def optional(array: np.ndarray | None) -> list[float] | None:
+        def optional(array: np.ndarray | None) -> list[float | None] | None:
             if array is None:
                 return None
             return [None if math.isnan(v) else v for v in array.tolist()]
@@ -917,7 +920,7 @@ class Scheduler:
         self.demos_so_far = None if so_far is None else _as_vector(so_far, "demos_so_far", self.num_tasks)
 
 
-def make_scheduler(method: str, num_tasks: int, **hyperparameters: float | int | None) -> Scheduler:
+def make_scheduler(method: str, num_tasks: int, **hyperparameters: Any) -> Scheduler:
     """Creates a scheduler by method name and ``SchedulerConfig`` fields (ValueError on a bad one)."""
     config_class = scheduler_config_class(method)
     known = {f.name for f in dataclasses.fields(config_class)}
@@ -939,7 +942,8 @@ def recompute_allocation(record: Mapping[str, Any]) -> Allocation:
     kalman = config.new_kalman(num_tasks)
     kalman.load_snapshot(stored.kalman_prior)
     if stored.success_rate is not None:
-        kalman.update(stored.success_rate, stored.episodes)
+        # a record's episodes go with its success rate (a null one is refused as not 1-D by update)
+        kalman.update(stored.success_rate, cast("list[int]", stored.episodes))
     gain = (
         np.zeros(num_tasks)
         if stored.gain is None

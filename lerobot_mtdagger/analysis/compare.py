@@ -95,7 +95,8 @@ LAUNCHERS: tuple[str, ...] = ("local", "ray")
 def split_arguments(argv: Sequence[str]) -> tuple[list[str], list[str]]:
     """Separates ``compare``'s own options from the run options passed through to every run."""
     own_names = {f"--{name}" for name in CompareConfig.__dataclass_fields__}
-    own, passed = [], []
+    own: list[str] = []
+    passed: list[str] = []
     for arg in argv:
         (own if arg.split("=", 1)[0] in own_names else passed).append(arg)
     return own, passed
@@ -112,6 +113,8 @@ def base_run_config(run_args: Sequence[str]) -> RunConfig:
 def bc_rounds_for(config: RunConfig, budgets: Sequence[int], num_tasks: int) -> dict[int, int]:
     """BC budget (demos per task) -> the ``--dagger.rounds`` that gives it (ValueError if none does)."""
     dagger = config.dagger
+    # RunConfig fills both from its preset
+    assert dagger.rounds is not None and dagger.initial_demos is not None
     per_round = dagger.budget_for(num_tasks) / num_tasks
     if not budgets:
         return {int(dagger.initial_demos + k * per_round): k for k in range(dagger.rounds + 1)}
@@ -131,6 +134,7 @@ def bc_rounds_for(config: RunConfig, budgets: Sequence[int], num_tasks: int) -> 
 def jobs_for(compare: CompareConfig, run_args: Sequence[str], num_tasks: int) -> list[Job]:
     """Every run of the comparison, with the same seeds and run options for every method."""
     config = base_run_config(run_args)
+    assert config.dagger.rounds is not None  # RunConfig fills it from its preset
     jobs = []
     for seed in compare.seeds:
         for method in compare.methods:
@@ -224,6 +228,7 @@ def compare(compare_config: CompareConfig, run_args: Sequence[str]) -> list[dict
             indent=1,
         )
     )
+    pool: RunPool | RayRunPool
     if compare_config.launcher == "ray":
         pool = RayRunPool(
             runs_dir,

@@ -14,8 +14,9 @@ from __future__ import annotations
 import json
 import math
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -348,8 +349,8 @@ def _row_in_source(row: dict, source: str) -> bool:
     return source == ALL_CURVES or row["method"] == source
 
 
-def _as_list(value: object) -> list:
+def _as_list(value: str | Iterable[Any]) -> list:
     """A list column, stored as a list or as its JSON text in a CSV."""
     if isinstance(value, str):
         return json.loads(value)
-    return list(value)  # type: ignore[arg-type]
+    return list(value)

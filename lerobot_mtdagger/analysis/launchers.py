@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.parent import PARENT_PID_ENV
@@ -150,11 +150,11 @@ class RunPool:
             raise
         finally:
             executor.shutdown(wait=True)
-        errors = [future.exception() for future in futures if future.exception() is not None]
+        errors = [error for error in (future.exception() for future in futures) if error is not None]
         for error in errors:
             if not isinstance(error, UserError):
                 raise error  # a fault of this code rather than of one run: keep its traceback
-        raise_for_errors(errors, len(jobs))
+        raise_for_errors(cast("list[UserError]", errors), len(jobs))  # the others were raised above
         return [future.result() for future in futures]
 
     def run_one(self, job: Job) -> Path:

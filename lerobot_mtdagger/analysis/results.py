@@ -270,6 +270,7 @@ def merge_tables(tables: Sequence[SavedTable]) -> SavedTable:
     configs: dict[str, dict] = {}
     sources: dict[str, str] = {}
     for table in tables:
+        assert table.configs is not None  # refused above
         for method, config in table.configs.items():
             differing = config_differences(configs.get(method, config), config)
             if differing:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +43,7 @@ def check_policy(config: EvalConfig) -> list[str]:
     Raises:
         CorruptExperimentError: In one line naming what changed and the fix.
     """
+    assert config.policy_path is not None  # EvalConfig refuses None
     folder = Path(config.policy_path)
     if not folder.is_dir():
         logger.info("%s is not a local folder: its files are not checked against checksums", folder)
@@ -55,6 +57,7 @@ def suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
 
     The policy folder's files are checked first (``check_policy``) by the command.
     """
+    assert config.policy_path is not None  # EvalConfig refuses None
     runner = PolicyRunner.from_pretrained(config.policy_path, trust_checkpoint=config.trust_checkpoint)
     suite_config = dataclasses.replace(config.suite, **observation_options(runner, config.suite))
     if list(suite_config.tasks) == [HELDOUT_TASKS]:
@@ -76,6 +79,7 @@ def suite_and_policy(config: EvalConfig) -> tuple[TaskSuite, PolicyRunner]:
         if not suite_config.tasks and trained and len(trained) < len(suite.task_names):
             logger.info("Evaluating the %d tasks of %s the policy knows", len(trained), suite_config.name)
             suite = suite_from_config(suite_config, tasks=trained)
+    assert suite_config.obs_mode is not None  # observation_options gives one
     runner.check_inputs(suite.features, suite_config.obs_mode)
     if config.unseen_rule == "nearest":
         unseen = [name for name in suite.task_names if name not in runner.task_names]
@@ -109,7 +113,7 @@ def eval_command(config: EvalConfig) -> dict:
     suite, runner = suite_and_policy(config)
     with config.env_workers(suite) as workers:
         result, _ = evaluate(workers, runner, config.episodes, config.seed)
-    progress = result.progress or [None] * len(result.task_names)
+    progress: Sequence[float | None] = result.progress or [None] * len(result.task_names)
     for task, success, score in zip(result.task_names, result.success, progress, strict=True):
         line = f"{task:<32} {success:.3f}" + ("" if score is None else f"  progress {score:.2f}/3")
         proxy = runner.task_aliases.get(task)

@@ -18,6 +18,7 @@ __all__ = ["MergeConfig", "merge_command"]
 
 def merge_command(config: MergeConfig) -> Path:
     """Merges rounds 0..k with LeRobot's aggregation; the result trains with stock lerobot-train."""
+    assert config.experiment_dir is not None and config.output is not None  # MergeConfig refuses None
     experiment = ExperimentDir(config.experiment_dir)
     experiment.read_config()  # refuses a folder that is not an experiment
     unverified = check_before_reading(experiment, config.unverified, RunConfig.option_defaults())

@@ -25,6 +25,7 @@ def plan_command(config: PlanConfig) -> dict | list[str]:
         if problems:
             raise SystemExit(1)
         return problems
+    assert config.output is not None  # PlanConfig refuses a plan without --output
     plan = make_plan(config)
     write_plan(plan, config.output)
     print(plan_table(plan))
@@ -39,7 +40,8 @@ def history_headroom_lines(plan: dict) -> list[str]:
     Each plan of the chain (this one and its ``--previous`` ones) gives one point per task: the success
     of the session's policy over its own episodes, at the expert demos it was trained on.
     """
-    points, session = [], plan
+    points: list[TaskPoint] = []
+    session: dict | None = plan
     while session is not None:
         measured, demos = session["measurements"], session.get("demos")
         for task, (n, successes, d) in enumerate(

@@ -115,6 +115,7 @@ def _report_saved_tables(config: ReportConfig) -> str:
     Several tables joined are also saved as one (``results.csv``, ``results.json``, beside the figures),
     as ``report`` saves the table of the runs it reads; one table is where it was read from.
     """
+    assert config.output_dir is not None  # ReportConfig sets it for --results
     saved = merge_tables([read_results(path) for path in config.results])
     if len(config.results) > 1:
         assert saved.configs is not None  # merge_tables refuses tables without them
@@ -147,6 +148,7 @@ def _write_figures(
     verification: Sequence[str] = (),
 ) -> None:
     """Writes every figure and ``report.md`` into ``--output_dir`` and prints where."""
+    assert config.output_dir is not None  # the callers write figures only with an --output_dir
     path = write_report(
         rows, task_names, config.output_dir, config.levels, unfinished=unfinished, verification=verification
     )

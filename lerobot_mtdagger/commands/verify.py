@@ -15,6 +15,7 @@ __all__ = ["VerifyConfig", "verify_command"]
 
 def verify_command(config: VerifyConfig) -> list[str]:
     """Checks every committed round and policy against its files and record; exits 1 on a problem."""
+    assert config.experiment_dir is not None  # VerifyConfig refuses None
     experiment = ExperimentDir(config.experiment_dir)
     num_rounds, num_policies, problems = verify_experiment(experiment, RunConfig.option_defaults())
     note = experiment.ledger_note()

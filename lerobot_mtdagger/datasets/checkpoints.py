@@ -155,7 +155,7 @@ def load_policy(
 
     try:
         return _load_checked(path, device, trust_checkpoint)
-    except (HfHubHTTPError, LocalEntryNotFoundError, OSError, *network_errors()) as error:
+    except (HfHubHTTPError, LocalEntryNotFoundError, OSError) + network_errors() as error:
         raise UserError(
             f"Cannot load the Hub policy {path} ({type(error).__name__}): check the repo id, the "
             "network and HF_TOKEN, or pass a local policy folder."

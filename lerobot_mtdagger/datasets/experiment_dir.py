@@ -161,12 +161,13 @@ def fill_added_options(stored: dict[str, Any], given: Mapping[str, Any], added: 
 
 def adds_dagger_rounds(stored: Mapping[str, Any], given: Mapping[str, Any]) -> bool:
     """Whether ``given`` asks a stored DAgger run for more rounds (and maybe nothing else)."""
-    rounds = stored.get(ROUNDS_OPTION), given.get(ROUNDS_OPTION)
+    stored_rounds, given_rounds = stored.get(ROUNDS_OPTION), given.get(ROUNDS_OPTION)
     return (
         stored.get("mode") != "bc"
         and given.get("mode") == stored.get("mode")
-        and all(isinstance(r, int) for r in rounds)
-        and rounds[1] > rounds[0]
+        and isinstance(stored_rounds, int)
+        and isinstance(given_rounds, int)
+        and given_rounds > stored_rounds
     )
 
 
@@ -394,7 +395,7 @@ class ExperimentDir:
 
     def committed_rounds(self) -> list[int]:
         """Indices of the committed rounds, ascending (``UserError`` on a folder that is not one)."""
-        indices = []
+        indices: list[int] = []
         if not self.rounds.exists():
             return indices
         for path in sorted(self.rounds.glob("round-*")):

@@ -100,8 +100,12 @@ def eval_table(task_names: Sequence[str], evals: dict[int, dict[str, Any] | None
         entry = evals[k]
         return None if entry is None else float(entry["success"][i])
 
+    def mean(k: int) -> float | None:
+        entry = evals[k]
+        return None if entry is None else float(entry["mean"])
+
     rows = [[name, *(success(k, i) for k in rounds)] for i, name in enumerate(task_names)]
-    rows.append(["**mean**", *(None if evals[k] is None else float(evals[k]["mean"]) for k in rounds)])
+    rows.append(["**mean**", *(mean(k) for k in rounds)])
     episodes = sorted({e for entry in evals.values() if entry for e in entry.get("episodes", [])})
     note = (
         "Column `round k` is the success rate of the policy trained on rounds 0..k (revision `round-{k:03d}` "
@@ -278,7 +282,7 @@ def check_hub_access(api: HfApi) -> str:
             f"The Hub refused the token (HTTP {status}): set HF_TOKEN to a token with write access; "
             "nothing was pushed."
         ) from None
-    except (OSError, *network_errors()) as error:  # requests' (huggingface_hub 0.x) or httpx's (1.x)
+    except (OSError,) + network_errors() as error:  # requests' (huggingface_hub 0.x) or httpx's (1.x)
         raise UserError(
             f"Cannot reach the Hub ({type(error).__name__}): check the network (or HF_ENDPOINT) and "
             "push again; nothing was pushed."
@@ -340,6 +344,7 @@ def push_command(
     config: PushConfig, added_defaults: Mapping[str, Any] | None = None
 ) -> dict[str, dict[str, str]]:
     """Pushes the experiment as configured; returns what was pushed (see ``push_experiment``)."""
+    assert config.experiment_dir is not None and config.repo_id is not None  # PushConfig refuses None
     return push_experiment(
         config.experiment_dir,
         config.repo_id,

@@ -42,4 +42,5 @@ class PushConfig:
         Raises:
             NotAnExperimentError: Naming the folder and what to pass instead.
         """
+        assert self.experiment_dir is not None  # __post_init__ refused None
         check_experiment_folder(Path(self.experiment_dir))

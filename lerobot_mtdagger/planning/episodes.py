@@ -139,7 +139,7 @@ def open_metadata(source: str, revision: str | None = None):
         return LeRobotDatasetMetadata(f"local/{path.name}", root=path)
     try:
         return LeRobotDatasetMetadata(source, revision=revision)
-    except (OSError, ValueError, *network_errors()) as error:  # network, missing repo, or a bad revision
+    except (OSError, ValueError) + network_errors() as error:  # network, missing repo, or a bad revision
         raise UserError(
             f"--datasets: cannot open {source} from the Hub or LeRobot's cache ({type(error).__name__}): "
             "check the repo id and your connection, or give its local folder."

@@ -24,7 +24,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -308,6 +308,7 @@ def episode_budget(config: PlanConfig, scheduler: Scheduler, seconds: Sequence[f
     """``--budget``, or the most episodes whose allocation fits in ``--budget_minutes``."""
     if config.budget is not None:
         return int(config.budget)
+    assert config.budget_minutes is not None  # PlanConfig refuses neither budget given
     available = float(config.budget_minutes) * 60.0
     n_min = scheduler.config.min_episodes
     if n_min * sum(seconds) > available:
@@ -332,7 +333,8 @@ def task_seconds(config: PlanConfig, measured: Measurements) -> list[float]:
     """Seconds per episode of each task: ``--episode_seconds`` or the datasets' mean duration."""
     if config.episode_seconds is not None:
         return [float(config.episode_seconds)] * len(measured.seconds)
-    return [float(s) for s in measured.seconds]  # plan_tasks guarantees episodes on every task
+    # plan_tasks guarantees episodes on every task, so no mean duration is None
+    return [float(s) for s in cast("list[float]", measured.seconds)]
 
 
 def file_sha256(path: Path) -> str:
@@ -646,7 +648,7 @@ def _allocation_problems(plan: dict) -> list[str]:
 
 def _recorded_episodes(dataset: dict) -> DatasetEpisodes:
     """A dataset's episodes as the plan recorded them."""
-    fields = {
+    fields: dict[str, Any] = {
         name: tuple(dataset[name]) for name in ("episodes", "tasks", "success", "policy_only", "seconds")
     }
     scalars = ("source", "root", "checksum", "revision", "fps", "success_key", "intervention_key")

@@ -71,7 +71,7 @@ def option_lines(
     cls: type,
     options: Sequence[str],
     prefix: str = "",
-    choices: Callable[[type], dict[str, type]] | None = None,
+    choices: Callable[[type], dict[str, type | None] | None] | None = None,
 ) -> Iterator[tuple[str, str]]:
     """``(--option=TYPE, help)`` for every option of the dataclass ``cls``, groups flattened.
 

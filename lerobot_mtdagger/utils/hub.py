@@ -127,7 +127,7 @@ def check_hub_repo(repo_id: str, repo_type: str, option: str, cached: bool) -> N
             f"{where}, and the Hub has no {repo_type} repo of that id (or it is private or gated: log in "
             "with `hf auth login` or set HF_TOKEN): check the path or the repo id."
         ) from None
-    except (*network_errors(), HfHubHTTPError) as error:
+    except network_errors() + (HfHubHTTPError,) as error:
         reason = _unanswered(error)
         if not cached:
             raise UserError(

@@ -59,7 +59,7 @@ def unsaved_frames(dataset: Any) -> int:
     """Frames added to a ``LeRobotDataset`` and not saved in an episode yet (its episode buffer's size)."""
     # LeRobot >= 0.5.1 keeps the buffer in its writer; 0.4 in the dataset (whose ``writer`` is then a
     # ParquetWriter once a data file is open, or None)
-    writer = getattr(dataset, "writer", None)
+    writer: Any = getattr(dataset, "writer", None)
     buffer = writer.episode_buffer if hasattr(writer, "episode_buffer") else dataset.episode_buffer
     return int((buffer or {}).get("size", 0))
 

@@ -13,9 +13,10 @@ import functools
 import inspect
 import io
 import threading
+import types
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar, cast
 
 import draccus
 import yaml
@@ -44,7 +45,7 @@ def _class_source(cls: type) -> str | OSError | TypeError:
 class _InspectWithClassSourceCache:
     """The ``inspect`` module as draccus' docstring reader sees it, with class sources cached."""
 
-    def getsource(self, obj: object) -> str:
+    def getsource(self, obj: Any) -> str:
         """``inspect.getsource``, cached for classes (raising its ``OSError`` or ``TypeError`` alike)."""
         if not isinstance(obj, type):
             return inspect.getsource(obj)
@@ -59,7 +60,8 @@ class _InspectWithClassSourceCache:
 
 def cache_dataclass_sources() -> None:
     """Makes draccus read each config class's source once per process, not once per field."""
-    draccus_docstring.inspect = _InspectWithClassSourceCache()
+    # not a module, but it answers every name of ``inspect`` that draccus reads
+    draccus_docstring.inspect = cast(types.ModuleType, _InspectWithClassSourceCache())
 
 
 def unparsable_option(options: Sequence[str]) -> str | None:

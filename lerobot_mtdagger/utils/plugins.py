@@ -16,7 +16,7 @@ A package adds a student, a suite or an expert type by declaring an entry point 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Hashable
 from importlib.metadata import entry_points
 
 logger = logging.getLogger(__name__)
@@ -32,7 +32,7 @@ EXPERT_ENTRY_POINTS = "lerobot_mtdagger.experts"
 
 
 def register_installed(
-    group: str, registered: Collection[str], register: Callable[[str, str], None]
+    group: str, registered: Collection[Hashable], register: Callable[[str, str], None]
 ) -> list[str]:
     """Registers each entry point of ``group`` with ``register(name, "module:attribute")``; returns the names.
 

@@ -41,6 +41,7 @@ class MergeConfig:
         Raises:
             UserError: Naming the folder and the fix.
         """
+        assert self.experiment_dir is not None and self.output is not None  # __post_init__ refused None
         check_experiment_folder(Path(self.experiment_dir))
         if Path(self.output).exists():
             raise UserError(f"Merge target {self.output} exists; choose another --output or delete it.")

@@ -28,4 +28,5 @@ class VerifyConfig:
         Raises:
             NotAnExperimentError: Naming the folder and what to pass instead.
         """
+        assert self.experiment_dir is not None  # __post_init__ refused None
         check_experiment_folder(Path(self.experiment_dir))
