@@ -128,7 +128,7 @@ def _from_mapping(cls: type, values: Mapping[str, Any], where: str) -> Any:
     required = [
         f.name
         for f in fields
-        if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING  # type: ignore[misc]
+        if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
     ]
     missing = [name for name in required if name not in values]
     if missing:

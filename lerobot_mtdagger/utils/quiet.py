@@ -214,7 +214,7 @@ def stdout_lines_dropped(lines: Iterable[str] = STDOUT_LINES) -> Iterator[None]:
         yield
         return
     proxy = LineDroppingStream(original, lines)
-    sys.stdout = proxy  # type: ignore[assignment]
+    sys.stdout = proxy
     try:
         yield
     finally:

@@ -87,7 +87,7 @@ class DrawerSceneEnv(SawyerXYZEnv):
         return self._model_path
 
     @property
-    def sawyer_observation_space(self) -> gym.spaces.Box:  # type: ignore[override]
+    def sawyer_observation_space(self) -> gym.spaces.Box:
         """Unbounded box of the privileged state (``DRAWER_STATE_NAMES``)."""
         size = len(DRAWER_STATE_NAMES)
         return gym.spaces.Box(np.full(size, -np.inf), np.full(size, np.inf), dtype=np.float64)
