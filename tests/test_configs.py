@@ -19,10 +19,12 @@ from lerobot_mtdagger.datasets.config_layout import flatten
 from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.datasets.migrations import FLAT_OPTION_PATHS, is_flat, migrate_run_config, stored_option
 from lerobot_mtdagger.datasets.verify import verify_experiment
+from lerobot_mtdagger.envs import suite_from_config
 from lerobot_mtdagger.runner.configs import RunConfig
 from lerobot_mtdagger.runner.dagger import run
 from lerobot_mtdagger.runner.option_groups import DAggerConfig, TrainingConfig
 from lerobot_mtdagger.runner.presets import PRESET_FIELDS, PRESETS
+from lerobot_mtdagger.runner.run_setup import unseen_task_suite
 from lerobot_mtdagger.utils import parsing
 from lerobot_mtdagger.utils.errors import UserError
 
@@ -348,3 +350,20 @@ def test_options_parsed_in_many_threads_at_once_leave_stderr_as_it_was():
     for thread in threads:
         thread.join()
     assert sys.stderr is before
+
+
+@pytest.mark.parametrize(
+    ("policy_options", "evaluated"),
+    [
+        (["--policy.type=act"], True),  # LeRobot's students hide the task of some frames with held-out tasks
+        (["--policy.type=mtdagger"], True),
+        (["--policy.type=mtdagger", "--policy.task_dropout=0"], False),  # no task-free embedding to act with
+    ],
+)
+def test_each_student_says_whether_its_run_evaluates_unseen_drawers(policy_options, evaluated):
+    """A LeRobot student on drawers once failed here (its options have no ``resolved_task_dropout``)."""
+    config = parse(
+        "--suite.name=drawers", "--suite.obs_mode=state", "--rollout.eval_episodes=1", *policy_options
+    )
+    suite = suite_from_config(config.suite)
+    assert (unseen_task_suite(config, suite) is not None) is evaluated

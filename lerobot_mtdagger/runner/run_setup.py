@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import logging
-from typing import Any
 
 from lerobot_mtdagger.datasets.experiment_dir import ExperimentDir
 from lerobot_mtdagger.envs.base import TaskSuite
@@ -53,8 +52,7 @@ def unseen_task_suite(config: RunConfig, suite: TaskSuite) -> TaskSuite | None:
     heldout = suite.heldout_suite()
     if heldout is None or config.rollout.eval_episodes == 0:
         return None
-    policy: Any = config.policy  # mtdagger's options (PolicyOptions) resolve the task dropout
-    if policy.resolved_task_dropout(True) == 0.0:
+    if config.student.task_dropout(config.policy, True) == 0.0:
         logger.info(
             "Unseen tasks are not evaluated: --policy.task_dropout=0 gives no embedding to act on them."
         )

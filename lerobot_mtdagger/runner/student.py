@@ -93,6 +93,14 @@ class Student(abc.ABC, Generic[OptionsT, PolicyConfigT]):
         values = dataclasses.asdict(options)
         return values if self.name == MTDAGGER_TYPE else {"type": self.name, **values}
 
+    def task_dropout(self, options: OptionsT, unseen: bool) -> float:
+        """The share of training frames whose task is hidden (``unseen``: the suite has held-out tasks).
+
+        A student with none (the default) learns no task-free embedding, so its run evaluates no unseen task.
+        """
+        del options, unseen
+        return 0.0
+
     def check_run(self, config: RunConfig) -> None:
         """Refuses run options the student cannot train with (none by default) with a ``ValueError``."""
         del config

@@ -263,8 +263,12 @@ class LeRobotStudent(Student[PreTrainedConfig, "LeRobotStudentConfig"]):
         unseen: bool,
     ) -> LeRobotStudentConfig:
         """``lerobot_student_config`` (task dropout ``UNSEEN_TASK_DROPOUT`` with held-out tasks, else 0)."""
-        task_dropout = UNSEEN_TASK_DROPOUT if unseen else 0.0
-        return lerobot_student_config(options, suite_features, task_names, task_dropout)
+        return lerobot_student_config(options, suite_features, task_names, self.task_dropout(options, unseen))
+
+    def task_dropout(self, options: PreTrainedConfig, unseen: bool) -> float:
+        """``UNSEEN_TASK_DROPOUT`` with held-out tasks, else 0."""
+        del options
+        return UNSEEN_TASK_DROPOUT if unseen else 0.0
 
     def make_policy(
         self, policy_cfg: LeRobotStudentConfig, stats: Stats

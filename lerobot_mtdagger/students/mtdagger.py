@@ -169,8 +169,13 @@ class MTDAggerStudent(Student[PolicyOptions, MTDAggerConfig]):
         self, options: PolicyOptions, suite_features: dict[str, Any], task_names: Sequence[str], unseen: bool
     ) -> MTDAggerConfig:
         """An ``MTDAggerConfig`` (task dropout ``options.resolved_task_dropout(unseen)``)."""
-        task_dropout = options.resolved_task_dropout(unseen)
-        return policy_config(suite_features, task_names, options, options.device, task_dropout)
+        return policy_config(
+            suite_features, task_names, options, options.device, self.task_dropout(options, unseen)
+        )
+
+    def task_dropout(self, options: PolicyOptions, unseen: bool) -> float:
+        """``options.resolved_task_dropout(unseen)``."""
+        return options.resolved_task_dropout(unseen)
 
     def make_policy(
         self, policy_cfg: MTDAggerConfig, stats: Stats
