@@ -9,6 +9,9 @@
 #     .venv/bin/python scripts/compare_experiments.py outputs/check/before/$r outputs/check/after/$r
 #   done
 # Each run is skipped when its folder exists. About 10 min on 2 idle cores (the point-cloud run most).
+# Each run uses one thread (OMP_NUM_THREADS=1 unless set): with two, ACT's CPU training differs between
+# two runs of the same code in the last digits (250 differences in its weights and losses), with one
+# it is the same to the bit.
 set -euo pipefail
 TREE=$(cd "${1:?give the code tree, e.g. ../before}" && pwd)
 OUT=$(mkdir -p "${2:?give the output folder}" && cd "$2" && pwd)
@@ -17,7 +20,7 @@ cd "$TREE"
 run() {  # run NAME OPTIONS...: one run of TREE's code into OUT/NAME, unless it exists
   local name=$1; shift
   [ -d "$OUT/$name" ] && return 0
-  MUJOCO_GL=egl PYTHONPATH=$TREE "$PYTHON" -m lerobot_mtdagger.cli run --progress=false \
+  OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} MUJOCO_GL=egl PYTHONPATH=$TREE "$PYTHON" -m lerobot_mtdagger.cli run --progress=false \
     --rollout.workers=0 "$@" --output_dir="$OUT/$name"
 }
 run toy --suite.name=toy --dagger.rounds=2
