@@ -5,5 +5,5 @@
 #   bash scripts/compact_records.sh experiments/STUDY/records
 # Read an archive by hand with: tar xzf .../runs-records.tar.gz -C <somewhere>
 set -euo pipefail
-exec "${PYTHON:-.venv/bin/python}" -m lerobot_mtdagger.cli records --action=compact \
+exec "${PYTHON:-$(dirname "$0")/../.venv/bin/python}" -m lerobot_mtdagger.cli records --action=compact \
   --source="${1:?give a study records folder, e.g. experiments/pixels-eval/records}"

@@ -11,5 +11,5 @@
 # this name for the studies' scripts (PYTHON: the interpreter with the package, default .venv/bin/python).
 set -euo pipefail
 STUDY=${1:?give the study, e.g. plateau-dagger-training-dev}
-exec "${PYTHON:-.venv/bin/python}" -m lerobot_mtdagger.cli records --action=save_compares \
+exec "${PYTHON:-$(dirname "$0")/../.venv/bin/python}" -m lerobot_mtdagger.cli records --action=save_compares \
   --source="outputs/$STUDY" --dest="experiments/$STUDY/records"

@@ -5,5 +5,5 @@
 # From the repository root (PYTHON: the interpreter with the package, default .venv/bin/python):
 #   bash scripts/save_run_records.sh RUNS DEST
 set -euo pipefail
-exec "${PYTHON:-.venv/bin/python}" -m lerobot_mtdagger.cli records --action=save \
+exec "${PYTHON:-$(dirname "$0")/../.venv/bin/python}" -m lerobot_mtdagger.cli records --action=save \
   --source="${1:?give a folder of run folders}" --dest="${2:?give where the records go}"
