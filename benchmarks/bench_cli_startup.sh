@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# How long a command takes to answer --help or refuse an option, this checkout against a reference
+# How long a command takes to answer --help or refuse an option or a path, this checkout against a reference
 # commit, side by side in one run (median of REPEATS runs each; the ratio is reference / now).
 #   bash benchmarks/bench_cli_startup.sh [REFERENCE]   (default: 19e28d3, before the lazy imports)
 # Uses this checkout's .venv for both (the reference's code from a temporary worktree).
@@ -22,7 +22,8 @@ median_seconds() {  # median_seconds DIR ARGS...: median wall time of `python -m
 
 printf '| command | %s (s) | now (s) | ratio |\n|---|---:|---:|---:|\n' "$REFERENCE"
 for args in "--help" "run --help" "run --preset=nope" "compare --help" "eval --help" "report --help" \
-  "verify --help" "run --policy.type=act --help"; do
+  "verify --help" "run --policy.type=act --help" "verify --experiment_dir=/no/such/run" \
+  "merge --experiment_dir=/no/such/run --output=/no/such/merged" "eval --policy_path=/no/such/policy"; do
   # shellcheck disable=SC2086  # the command's words
   before=$(median_seconds "$TREE" $args)
   # shellcheck disable=SC2086
