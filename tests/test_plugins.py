@@ -144,7 +144,7 @@ def test_an_installed_expert_type_is_found_by_name(monkeypatch, tmp_path):
 
 
 def test_a_registry_resolves_module_attribute_once_and_refuses_bad_ones_in_one_line():
-    things: Registry[object] = Registry("thing")
+    things: Registry[str, object] = Registry("thing")
     things.register("json", "json:dumps")
 
     @things.register("mine")

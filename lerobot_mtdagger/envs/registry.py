@@ -14,7 +14,6 @@ import importlib
 import logging
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import cast
 
 from lerobot_mtdagger.envs.base import ObservationConfig, TaskSuite
 from lerobot_mtdagger.utils.errors import UserError
@@ -60,7 +59,7 @@ class SuiteOptions:
 SuiteFactory = Callable[[SuiteOptions], TaskSuite]
 """``factory(options) -> TaskSuite``."""
 
-SUITES: Registry[SuiteFactory] = Registry(
+SUITES: Registry[str, SuiteFactory] = Registry(
     "suite",
     entry_point_group=SUITE_ENTRY_POINTS,
     refusal=lambda name, factory: (
@@ -84,7 +83,7 @@ def register_suite(name: str, factory: SuiteFactory | str) -> None:
 
 def suite_names() -> list[str]:
     """Every registered suite name, in the order of registration (the built-in suites first)."""
-    return cast("list[str]", SUITES.names())  # register_suite takes str names
+    return SUITES.names()
 
 
 def build_suite(options: SuiteOptions) -> TaskSuite:

@@ -12,7 +12,7 @@ import copy
 import inspect
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, cast
+from typing import Any
 
 from lerobot_mtdagger.datasets.checkpoints import check_local_policy, load_policy
 from lerobot_mtdagger.experts.base import Expert, LeRobotPolicyExpert
@@ -23,7 +23,7 @@ from lerobot_mtdagger.utils.registry import EntryPointError, Registry, resolve
 STATE_KEY = "observation.state"
 """The input a policy expert reads the privileged state from."""
 
-EXPERT_TYPES: Registry[Callable[[Any, str], Expert]] = Registry(
+EXPERT_TYPES: Registry[str, Callable[[Any, str], Expert]] = Registry(
     "expert type", entry_point_group=EXPERT_ENTRY_POINTS
 )
 """Expert factories by the name ``--expert.type`` gives (installed ones by entry point)."""
@@ -40,7 +40,7 @@ def expert_type_factory(name: str) -> Callable[[Any, str], Expert]:
     """The ``--expert.type`` factory: a registered name or ``module:attribute`` (else a ``UserError``)."""
     if name in EXPERT_TYPES:
         return EXPERT_TYPES.get(name)
-    known = sorted(cast("list[str]", EXPERT_TYPES.names())) or "none"  # registered by str name
+    known = sorted(EXPERT_TYPES.names()) or "none"
     hint = (
         f"--expert.type={name} is neither a registered expert type ({known}) nor an importable "
         "module:attribute factory(suite, task) -> Expert"

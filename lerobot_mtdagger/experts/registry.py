@@ -11,8 +11,8 @@ factory for ``(family, task)``, or the family's; wrapped in ``ActionCheckedExper
 
 from __future__ import annotations
 
-from collections.abc import Callable, Hashable
-from typing import Any, cast
+from collections.abc import Callable
+from typing import Any
 
 from lerobot_mtdagger.experts.base import ActionCheckedExpert, Expert
 from lerobot_mtdagger.utils.errors import UserError
@@ -25,16 +25,16 @@ ExpertFactory = Callable[[Any, str], Expert]
 """``factory(suite, task_name) -> Expert``."""
 
 
-def _refusal(key: Hashable, factory: object) -> str:
+def _refusal(key: tuple[str, str], factory: object) -> str:
     """The message refusing ``factory`` under ``key``, a ``(suite family, task)`` pair."""
-    family_task = cast("tuple[str, str]", key)
+    family, task = key
     return (
-        f"The expert factory for {family_task[0]}/{family_task[1]} must be callable or a "
+        f"The expert factory for {family}/{task} must be callable or a "
         f"'module:attribute' string, got {factory!r}."
     )
 
 
-EXPERTS: Registry[ExpertFactory] = Registry("expert factory", refusal=_refusal)
+EXPERTS: Registry[tuple[str, str], ExpertFactory] = Registry("expert factory", refusal=_refusal)
 """Expert factories by ``(suite family, task)`` (``ANY_TASK``: every task of the family)."""
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import abc
 import dataclasses
 import functools
-from collections.abc import Hashable, Sequence
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar
 
 from lerobot_mtdagger.datasets.student_types import (
@@ -147,14 +147,14 @@ StudentEntry = type[Student[Any, Any]] | str
 """A ``Student`` subclass, or its ``"module:attribute"`` entry point."""
 
 
-def _refusal(name: Hashable, student: object) -> str:
+def _refusal(name: str, student: object) -> str:
     """The ``TypeError`` message for a registration neither a ``Student`` subclass nor an entry point."""
     if isinstance(student, str):
         return f"The student {name!r} must be a 'module:attribute' string, got {student!r}."
     return f"The student {name!r} must be a Student subclass, got {student!r}."
 
 
-STUDENTS: Registry[type[Student[Any, Any]]] = Registry(
+STUDENTS: Registry[str, type[Student[Any, Any]]] = Registry(
     "student",
     accepts=lambda student: isinstance(student, type) and issubclass(student, Student),
     entry_point_group=STUDENT_ENTRY_POINTS,
@@ -177,7 +177,7 @@ def register_student(name: str, student: StudentEntry) -> None:
 
 def student_names() -> list[str]:
     """Every registered ``--policy.type``, the built-in ones first."""
-    return [str(name) for name in STUDENTS.names()]
+    return STUDENTS.names()
 
 
 def check_student_name(name: str) -> str:

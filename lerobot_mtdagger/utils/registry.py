@@ -4,7 +4,7 @@ A ``Registry`` maps names to objects, or to ``"module:attribute"`` strings impor
 for, so registering the built-in parts imports none of them; installed packages add theirs through an
 entry-point group (``utils.plugins``)::
 
-    SUITES: Registry[SuiteFactory] = Registry("suite", accepts=callable)
+    SUITES: Registry[str, SuiteFactory] = Registry("suite", accepts=callable)
     SUITES.register("my-suite", "my_package.suites:make_my_suite")
     factory = SUITES.get("my-suite")  # imports my_package.suites
 """
@@ -13,11 +13,12 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable, Hashable, Iterator
-from typing import Any, Generic, TypeVar
+from typing import Any, Generic, TypeVar, cast
 
 from lerobot_mtdagger.utils.errors import UserError
 from lerobot_mtdagger.utils.plugins import register_installed
 
+K = TypeVar("K", bound=Hashable)
 T = TypeVar("T")
 
 
@@ -63,8 +64,10 @@ def resolve(spec: str) -> Any:
         ) from None
 
 
-class Registry(Generic[T]):
+class Registry(Generic[K, T]):
     """Objects by name, each given as itself or as a ``"module:attribute"`` string imported on first use.
+
+    Names (``K``) are strings, or tuples such as the experts' ``(suite family, task)``.
 
     Args:
         kind: What is registered, for messages ("suite", "student").
@@ -78,16 +81,16 @@ class Registry(Generic[T]):
         kind: str,
         accepts: Callable[[object], bool] = callable,
         entry_point_group: str | None = None,
-        refusal: Callable[[Hashable, object], str] | None = None,
+        refusal: Callable[[K, object], str] | None = None,
     ) -> None:
         self.kind = kind
         self.accepts = accepts
         self.refusal = refusal
         self.entry_point_group = entry_point_group
-        self._entries: dict[Hashable, T | str] = {}
-        self._resolved: dict[Hashable, T] = {}
+        self._entries: dict[K, T | str] = {}
+        self._resolved: dict[K, T] = {}
 
-    def register(self, name: Hashable, obj: T | str | None = None, replace: bool = False) -> Any:
+    def register(self, name: K, obj: T | str | None = None, replace: bool = False) -> Any:
         """Registers ``obj`` (or its ``"module:attribute"``) under ``name``; without ``obj``, a decorator.
 
         Raises:
@@ -117,19 +120,19 @@ class Registry(Generic[T]):
         """Whether ``name`` is registered."""
         return name in self._entries
 
-    def __iter__(self) -> Iterator[Hashable]:
+    def __iter__(self) -> Iterator[K]:
         """The registered names, in order of registration."""
         return iter(list(self._entries))
 
-    def names(self) -> list[Hashable]:
+    def names(self) -> list[K]:
         """The registered names, in order of registration (the built-in ones first)."""
         return list(self._entries)
 
-    def entry(self, name: Hashable) -> T | str | None:
+    def entry(self, name: K) -> T | str | None:
         """What ``name`` was registered with (an object or an entry-point string), or None."""
         return self._entries.get(name)
 
-    def get(self, name: Hashable, unknown: str | None = None) -> T:
+    def get(self, name: K, unknown: str | None = None) -> T:
         """The object registered under ``name``, its entry point imported once.
 
         ``unknown`` is the message for a name not registered (None: one listing the registered names).
@@ -144,14 +147,14 @@ class Registry(Generic[T]):
             self._resolved[name] = resolve(entry) if isinstance(entry, str) else entry
         return self._resolved[name]
 
-    def copy(self) -> Registry[T]:
+    def copy(self) -> Registry[K, T]:
         """A registry with the same entries (registering into it leaves this one as it is)."""
-        twin: Registry[T] = Registry(self.kind, self.accepts, self.entry_point_group, self.refusal)
+        twin: Registry[K, T] = Registry(self.kind, self.accepts, self.entry_point_group, self.refusal)
         twin._entries = dict(self._entries)
         twin._resolved = dict(self._resolved)
         return twin
 
-    def unknown_message(self, name: Hashable) -> str:
+    def unknown_message(self, name: K) -> str:
         """One line naming the registered names and how to add one."""
         where = f", or installed by a package's entry point in the group {self.entry_point_group!r}"
         return (
@@ -162,8 +165,10 @@ class Registry(Generic[T]):
     def load_entry_points(self, register: Callable[[str, str], None] | None = None) -> list[str]:
         """Registers the group's entry points whose names are not taken (built-ins win); returns the names.
 
-        ``register(name, "module:attribute")`` registers one (None: ``self.register``).
+        ``register(name, "module:attribute")`` registers one (None: ``self.register``); entry points are
+        named by strings, so only a registry keyed by ``str`` has a group.
         """
         if self.entry_point_group is None:
             return []
-        return register_installed(self.entry_point_group, self._entries, register or self.register)
+        register = register or cast("Callable[[str, str], None]", self.register)
+        return register_installed(self.entry_point_group, self._entries, register)
